@@ -1,0 +1,17 @@
+//! Pure numerics for sea-trial system identification of ROVs and DP ships.
+//!
+//! No I/O, no async, no database: plain functions and types over vectors and
+//! matrices, in the spirit of `scipy.signal` and `python-control`. The service
+//! (`seatrial`) parses, calls into this crate, stores and responds.
+//!
+//! Map of the domain:
+//! - [`signals`]: excitation signals (PRBS, square wave, multisine), shaping to
+//!   actuator limits, persistence of excitation.
+//! - [`spectra`]: Welch PSD, cross-PSD, coherence, transfer-function estimates
+//!   with `scipy.signal`'s definitions.
+//! - [`planning`]: vessel profiles, LPV speed grid, experiment families and the
+//!   campaign plan.
+
+pub mod planning;
+pub mod signals;
+pub mod spectra;

@@ -1,0 +1,96 @@
+//! Reference vessels from the two source documents, used for the demo
+//! campaign and as test fixtures.
+
+use std::collections::BTreeMap;
+
+use super::dof::{Dof, KNOT};
+use super::vessel::{DofLimits, InputChannels, Thruster, ThrusterKind, VesselKind, VesselProfile};
+
+/// The Surveyor ROV of the thesis (≈ 5 t, 9 hydraulic thrusters, τ logged per
+/// DOF, 20 Hz controller logged at 10 Hz). Velocity limits follow the
+/// experiment plan of ch. 3: sway/heave ±1.5 kn, roll/pitch/yaw ±0.3 rad/s,
+/// forward speed up to 4.3 kn. Forces and time constants are engineering
+/// guesses for a vehicle of that size; the pilots override them.
+pub fn surveyor_rov() -> VesselProfile {
+    let lin = |v: f64, f: f64, t: f64| DofLimits {
+        max_velocity: v,
+        max_force: f,
+        max_force_rate: f / 2.0,
+        max_accel: Some(0.3),
+        time_constant_s: t,
+    };
+    let ang = |f: f64, t: f64| DofLimits {
+        max_velocity: 0.3,
+        max_force: f,
+        max_force_rate: f / 2.0,
+        max_accel: Some(0.3),
+        time_constant_s: t,
+    };
+    let limits = BTreeMap::from([
+        (Dof::Surge, lin(4.3 * KNOT, 10_000.0, 4.0)),
+        (Dof::Sway, lin(1.5 * KNOT, 6_000.0, 3.0)),
+        (Dof::Heave, lin(1.5 * KNOT, 8_000.0, 3.0)),
+        (Dof::Roll, ang(5_000.0, 1.5)),
+        (Dof::Pitch, ang(5_000.0, 1.5)),
+        (Dof::Yaw, ang(5_000.0, 2.0)),
+    ]);
+    VesselProfile {
+        name: "Surveyor ROV".into(),
+        kind: VesselKind::Rov6,
+        dofs: Dof::ALL.to_vec(),
+        inputs: InputChannels::GeneralizedForces,
+        limits,
+        controller_rate_hz: 20.0,
+        logger_rate_hz: 10.0,
+    }
+}
+
+/// Fossen, Sagatun & Sørensen's supply vessel (L = 76.2 m): two main
+/// propellers, three tunnel thrusters, one azimuth at α = 90°, with the
+/// thruster configuration matrix T″ of eq. 29 (non-dimensional, bis system).
+/// Time constants follow the identified A″ of eq. 51 scaled by √(L/g):
+/// surge 2.787/0.0318 ≈ 88 s, sway 2.787/0.0628 ≈ 44 s, yaw 2.787/0.2428 ≈ 11 s.
+pub fn supply_vessel() -> VesselProfile {
+    let time_unit = (76.2_f64 / 9.81).sqrt();
+    let dof = |v: f64, f: f64, a_ii: f64| DofLimits {
+        max_velocity: v,
+        max_force: f,
+        max_force_rate: f / 10.0,
+        max_accel: None,
+        time_constant_s: time_unit / a_ii,
+    };
+    let limits = BTreeMap::from([
+        (Dof::Surge, dof(4.0, 1.3e6, 0.0318)),
+        (Dof::Sway, dof(1.0, 5.5e5, 0.0628)),
+        (Dof::Yaw, dof(0.035, 1.6e7, 0.2428)),
+    ]);
+    let thr = |name: &str, kind| Thruster {
+        name: name.into(),
+        kind,
+        max_command: 1.0,
+        max_rate: 0.1,
+    };
+    VesselProfile {
+        name: "Supply vessel (Fossen et al. 1995)".into(),
+        kind: VesselKind::Dp3,
+        dofs: Dof::HORIZONTAL.to_vec(),
+        inputs: InputChannels::Thrusters {
+            thrusters: vec![
+                thr("port main propeller", ThrusterKind::Main),
+                thr("starboard main propeller", ThrusterKind::Main),
+                thr("aft tunnel thruster I", ThrusterKind::Tunnel),
+                thr("aft tunnel thruster II", ThrusterKind::Tunnel),
+                thr("bow tunnel thruster", ThrusterKind::Tunnel),
+                thr("bow azimuth thruster", ThrusterKind::Azimuth),
+            ],
+            configuration: vec![
+                vec![1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+                vec![0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+                vec![0.0472, -0.0472, -0.4108, -0.3858, 0.4554, 0.3373],
+            ],
+        },
+        limits,
+        controller_rate_hz: 1.0,
+        logger_rate_hz: 1.0,
+    }
+}

@@ -1,0 +1,23 @@
+//! Trial-campaign planning: vessel profiles, the LPV forward-speed grid,
+//! experiment families (thesis ch. 3; Fossen et al. sec. 4.2), excitation
+//! design per grid point × DOF × repetition, and the plan with its run order
+//! and trial time.
+
+pub mod analysis;
+pub mod campaign;
+pub mod design;
+pub mod dof;
+pub mod error;
+pub mod examples;
+pub mod plan;
+pub mod vessel;
+pub mod waveform;
+
+pub use campaign::{CampaignSpec, ExperimentFamily, Quantity, SignalKind, SpeedGrid, SpeedUnit};
+pub use dof::{Dof, KNOT};
+pub use error::PlanError;
+pub use plan::{Experiment, Plan, PlanTotals, PlannedExperiment, Schedule, generate_plan};
+pub use vessel::VesselProfile;
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,1059 @@
+//! The campaign plan: every experiment (grid point × DOF × repetition) with
+//! its reference schedule, in the order it is flown, and the trial time.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use super::analysis::{ChannelAnalysis, analyse};
+use super::campaign::{CampaignSpec, ExperimentFamily, Quantity, SignalKind, SpeedUnit};
+use super::design::{ChannelRequest, SQUARE_HOLD_TIME_CONSTANTS, design_channel};
+use super::dof::{Dof, KNOT};
+use super::error::PlanError;
+use super::vessel::{ThrusterKind, VesselKind, VesselProfile};
+use super::waveform::Waveform;
+use crate::signals;
+
+/// Most samples one run may hold per channel (4 h at 1 kHz).
+pub const MAX_SAMPLES_PER_CHANNEL: usize = 14_400_000;
+/// Fraction of power above the logger's Nyquist frequency that earns a warning.
+pub const NYQUIST_WARNING_FRACTION: f64 = 0.05;
+
+/// One reference column of a schedule.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct ChannelPlan {
+    /// CSV column: `u_ref`…`r_ref` (velocity), `tau_Y`… (force), `thr_1`… (thrusters).
+    pub column: String,
+    /// SI unit of the column.
+    pub unit: String,
+    /// DOF of the column (velocity or force channels).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dof: Option<Dof>,
+    /// Thruster index (0-based) for thruster channels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub thruster: Option<usize>,
+    /// True when this channel carries the excitation; false when held.
+    pub excited: bool,
+    /// Shape.
+    pub waveform: Waveform,
+    /// Operating point.
+    pub offset: f64,
+    /// Amplitude about the operating point.
+    pub amplitude: f64,
+    /// Clip bound: the reference stays in [−limit, limit].
+    pub limit: f64,
+    /// Slew-rate limit applied (unit/s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rate_limit: Option<f64>,
+    /// Excitation figures (excited channels only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub analysis: Option<ChannelAnalysis>,
+}
+
+/// One planned experiment (without its samples).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct Experiment {
+    /// Position in the run order, from 1.
+    pub seq: u32,
+    /// Human code, e.g. `DYN-1.5kn-sway-r1`.
+    pub code: String,
+    /// Family.
+    pub family: ExperimentFamily,
+    /// Index into the grid (none for the validation run, which spans it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid_index: Option<usize>,
+    /// Grid speed (m/s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid_speed_mps: Option<f64>,
+    /// Excited DOFs.
+    pub dofs: Vec<Dof>,
+    /// Sign of a static run (+1 / −1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sign: Option<i8>,
+    /// Repetition, from 1.
+    pub repetition: u32,
+    /// What the pilot does, in words.
+    pub instruction: String,
+    /// Run length (s).
+    pub duration_s: f64,
+    /// Schedule sample rate: the controller rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Columns.
+    pub channels: Vec<ChannelPlan>,
+    /// Things the supervisor should know.
+    pub warnings: Vec<String>,
+}
+
+/// Sampled reference columns of one experiment, at `sample_rate_hz`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Schedule {
+    /// Sample rate (Hz); t_k = k / rate.
+    pub sample_rate_hz: f64,
+    /// Column names, as in [`Experiment::channels`].
+    pub columns: Vec<String>,
+    /// One vector per column, all of equal length.
+    pub values: Vec<Vec<f64>>,
+}
+
+impl Schedule {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.values.first().map_or(0, Vec::len)
+    }
+
+    /// True when there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// An experiment with its schedule.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannedExperiment {
+    /// Description and checks.
+    pub experiment: Experiment,
+    /// Samples.
+    pub schedule: Schedule,
+}
+
+/// Totals of a plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct PlanTotals {
+    /// Number of experiments.
+    pub experiments: usize,
+    /// Experiments per family.
+    pub per_family: BTreeMap<String, usize>,
+    /// Sum of run lengths (s).
+    pub run_time_s: f64,
+    /// Set-up time between runs (s).
+    pub setup_time_s: f64,
+    /// Total trial time (s).
+    pub total_time_s: f64,
+}
+
+/// A complete plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    /// Experiments in run order.
+    pub experiments: Vec<PlannedExperiment>,
+    /// Totals.
+    pub totals: PlanTotals,
+}
+
+/// SplitMix64 mixing: independent, reproducible seeds per run.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+fn run_seed(seed: u64, family: ExperimentFamily, grid: usize, dof: usize, rep: u32) -> u64 {
+    let mut h = mix(seed);
+    for v in [family as u64, grid as u64, dof as u64, u64::from(rep)] {
+        h = mix(h ^ v);
+    }
+    h
+}
+
+/// A channel before sampling.
+struct ChannelSpec {
+    plan: ChannelPlan,
+    duration_s: f64,
+}
+
+/// Shared context while planning.
+struct Ctx<'a> {
+    vessel: &'a VesselProfile,
+    spec: &'a CampaignSpec,
+    speeds: Vec<f64>,
+    fs: f64,
+    decimation: usize,
+}
+
+impl Ctx<'_> {
+    fn speed_label(&self, i: usize) -> String {
+        let (v, unit) = match self.spec.grid.unit {
+            SpeedUnit::Knots => (self.spec.grid.speeds[i], "kn"),
+            SpeedUnit::MetersPerSecond => (self.spec.grid.speeds[i], "m/s"),
+        };
+        format!("{v}{unit}")
+    }
+
+    fn quantity(&self) -> Quantity {
+        self.spec.excitation.quantity
+    }
+
+    fn override_of(&self, d: Dof) -> Option<&super::campaign::DofExcitation> {
+        self.spec.excitation.per_dof.get(&d)
+    }
+
+    fn signal_for(&self, d: Dof) -> SignalKind {
+        self.override_of(d)
+            .and_then(|o| o.signal)
+            .unwrap_or(self.spec.excitation.signal)
+    }
+
+    /// Column, unit, clip limit and slew limit of a DOF channel.
+    fn dof_channel(&self, d: Dof) -> (String, String, f64, Option<f64>, String) {
+        let l = self.vessel.limit(d);
+        if d == Dof::Surge || self.quantity() == Quantity::Velocity {
+            (
+                format!("{}_ref", d.velocity_symbol()),
+                d.velocity_unit().to_string(),
+                l.max_velocity,
+                l.max_accel,
+                format!("limits.{}.max_accel", d.name()),
+            )
+        } else {
+            (
+                d.force_column().to_string(),
+                d.force_unit().to_string(),
+                l.max_force,
+                Some(l.max_force_rate),
+                format!("limits.{}.max_force_rate", d.name()),
+            )
+        }
+    }
+
+    /// Amplitude of a non-surge DOF, checked against its limit.
+    fn amplitude(&self, d: Dof) -> Result<f64, PlanError> {
+        let (_, unit, limit, _, _) = self.dof_channel(d);
+        match self.override_of(d).and_then(|o| o.amplitude) {
+            Some(a) => check_amplitude(
+                &format!("excitation.per_dof.{}.amplitude", d.name()),
+                a,
+                limit,
+                &unit,
+            ),
+            None => Ok(self.spec.excitation.amplitude_fraction * limit),
+        }
+    }
+
+    /// Surge excursion about grid speed u0, and the offset it is flown about.
+    fn surge_excursion(&self, u0: f64) -> Result<(f64, f64), PlanError> {
+        let max = self.vessel.max_forward_speed();
+        match self.override_of(Dof::Surge).and_then(|o| o.amplitude) {
+            Some(a) => {
+                let a = check_amplitude("excitation.per_dof.surge.amplitude", a, max, "m/s")?;
+                if u0 + a > max + 1e-12 {
+                    return Err(PlanError::over_limit(
+                        "excitation.per_dof.surge.amplitude",
+                        format!(
+                            "{a} m/s about the grid speed {u0:.3} m/s exceeds the maximum forward speed {max:.3} m/s"
+                        ),
+                        max - u0,
+                    ));
+                }
+                Ok((a, u0))
+            }
+            None => {
+                // Table 3.1: u within ±0.3 kn of the grid speed; at the top of
+                // the envelope the band is flown just below it.
+                let a = (0.3 * KNOT).min(self.spec.excitation.amplitude_fraction * max);
+                Ok((a, u0.min(max - a)))
+            }
+        }
+    }
+
+    fn held(&self, d: Dof, u0: f64) -> ChannelPlan {
+        let (column, unit, limit, rate, _) = self.dof_channel(d);
+        ChannelPlan {
+            column,
+            unit,
+            dof: Some(d),
+            thruster: None,
+            excited: false,
+            waveform: Waveform::Constant,
+            offset: if d == Dof::Surge { u0 } else { 0.0 },
+            amplitude: 0.0,
+            limit,
+            rate_limit: rate,
+            analysis: None,
+        }
+    }
+
+    /// Designs an excited DOF channel.
+    #[allow(clippy::too_many_arguments)]
+    fn dynamic_dof(
+        &self,
+        d: Dof,
+        u0: f64,
+        min_duration: f64,
+        signal: SignalKind,
+        seed: u64,
+        channel: (usize, usize),
+    ) -> Result<ChannelSpec, PlanError> {
+        let (column, unit, limit, rate, rate_field) = self.dof_channel(d);
+        let (amplitude, offset) = if d == Dof::Surge {
+            self.surge_excursion(u0)?
+        } else {
+            (self.amplitude(d)?, 0.0)
+        };
+        let field = format!("excitation.per_dof.{}", d.name());
+        let o = self.override_of(d);
+        let design = design_channel(&ChannelRequest {
+            field: &field,
+            signal,
+            time_constant_s: self.vessel.limit(d).time_constant_s,
+            amplitude,
+            rate_limit: rate,
+            rate_field: &rate_field,
+            clock_period_s: o.and_then(|o| o.clock_period_s),
+            prbs_order: o.and_then(|o| o.prbs_order),
+            min_duration_s: min_duration,
+            logger_rate_hz: self.vessel.logger_rate_hz,
+            seed,
+            channel,
+        })?;
+        Ok(ChannelSpec {
+            plan: ChannelPlan {
+                column,
+                unit,
+                dof: Some(d),
+                thruster: None,
+                excited: true,
+                waveform: design.waveform,
+                offset,
+                amplitude,
+                limit,
+                rate_limit: rate,
+                analysis: None,
+            },
+            duration_s: design.duration_s,
+        })
+    }
+}
+
+fn check_amplitude(field: &str, a: f64, limit: f64, unit: &str) -> Result<f64, PlanError> {
+    if !(a.is_finite() && a > 0.0) {
+        return Err(PlanError::invalid(
+            field,
+            format!("must be a finite number > 0 (got {a})"),
+        ));
+    }
+    if a > limit + 1e-12 {
+        return Err(PlanError::over_limit(
+            field,
+            format!("amplitude {a} {unit} is over the limit of {limit} {unit}"),
+            limit,
+        ));
+    }
+    Ok(a)
+}
+
+/// PE order an experiment needs per excited channel: two per DOF its data
+/// must identify (a first-order response per DOF: A_λ and B_λ entries), one
+/// for a static run (a steady-state gain).
+fn pe_required(family: ExperimentFamily, n_dofs: usize) -> usize {
+    use ExperimentFamily::*;
+    match family {
+        Static => 1,
+        Dynamic | DpSurge | DpAzimuth => 2,
+        DpSwayYaw => 4,
+        Recursive | Validation => 2 * n_dofs,
+    }
+}
+
+/// Builds the plan for a campaign. Pure and deterministic for a given seed.
+pub fn generate_plan(vessel: &VesselProfile, spec: &CampaignSpec) -> Result<Plan, PlanError> {
+    vessel.validate()?;
+    spec.validate(vessel)?;
+    let fs = vessel.controller_rate_hz;
+    let ratio = vessel.controller_rate_hz / vessel.logger_rate_hz;
+    let decimation = if ratio >= 1.0 && (ratio - ratio.round()).abs() < 1e-9 {
+        ratio.round() as usize
+    } else {
+        1
+    };
+    let ctx = Ctx {
+        vessel,
+        spec,
+        speeds: spec.grid.speeds_si(),
+        fs,
+        decimation,
+    };
+    let reps = spec.repetitions_for(vessel.kind);
+    let mut out: Vec<PlannedExperiment> = Vec::new();
+    let has = |f: ExperimentFamily| spec.families.contains(&f);
+    match vessel.kind {
+        VesselKind::Rov6 => {
+            for gi in 0..ctx.speeds.len() {
+                if has(ExperimentFamily::Static) {
+                    rov_static(&ctx, gi, reps, &mut out)?;
+                }
+                if has(ExperimentFamily::Dynamic) {
+                    rov_dynamic(&ctx, gi, reps, &mut out)?;
+                }
+                if has(ExperimentFamily::Recursive) {
+                    rov_recursive(&ctx, gi, reps, &mut out)?;
+                }
+            }
+        }
+        VesselKind::Dp3 => {
+            // SI1 → SI2 → SI3: each stage's parameters are frozen for the next (Fig. 4).
+            for fam in [
+                ExperimentFamily::DpSurge,
+                ExperimentFamily::DpSwayYaw,
+                ExperimentFamily::DpAzimuth,
+            ] {
+                if has(fam) {
+                    for gi in 0..ctx.speeds.len() {
+                        dp_manoeuvre(&ctx, fam, gi, reps, &mut out)?;
+                    }
+                }
+            }
+        }
+    }
+    if has(ExperimentFamily::Validation) {
+        validation(&ctx, reps, &mut out)?;
+    }
+    let mut per_family = BTreeMap::new();
+    let mut run_time_s = 0.0;
+    for (i, p) in out.iter_mut().enumerate() {
+        p.experiment.seq = i as u32 + 1;
+        run_time_s += p.experiment.duration_s;
+        *per_family
+            .entry(p.experiment.family.name().to_string())
+            .or_insert(0) += 1;
+    }
+    let setup_time_s = spec.durations.setup_s * out.len() as f64;
+    let totals = PlanTotals {
+        experiments: out.len(),
+        per_family,
+        run_time_s,
+        setup_time_s,
+        total_time_s: run_time_s + setup_time_s,
+    };
+    Ok(Plan {
+        experiments: out,
+        totals,
+    })
+}
+
+struct ExperimentHead {
+    code: String,
+    family: ExperimentFamily,
+    grid_index: Option<usize>,
+    dofs: Vec<Dof>,
+    sign: Option<i8>,
+    repetition: u32,
+    instruction: String,
+    pe_required: usize,
+    /// Field to blame when the excitation is not persistent enough.
+    field: String,
+}
+
+/// Samples, shapes and checks the channels of one experiment.
+fn assemble(
+    ctx: &Ctx<'_>,
+    head: ExperimentHead,
+    channels: Vec<ChannelSpec>,
+) -> Result<PlannedExperiment, PlanError> {
+    let duration = channels
+        .iter()
+        .map(|c| c.duration_s)
+        .fold(0.0_f64, f64::max);
+    let n = (duration * ctx.fs).round() as usize;
+    if n > MAX_SAMPLES_PER_CHANNEL {
+        return Err(PlanError::over_limit(
+            head.field.clone(),
+            format!(
+                "experiment {} would need {n} samples per channel ({duration:.0} s at {} Hz)",
+                head.code, ctx.fs
+            ),
+            MAX_SAMPLES_PER_CHANNEL as f64,
+        ));
+    }
+    let mut warnings = Vec::new();
+    let mut columns = Vec::new();
+    let mut values = Vec::new();
+    let mut plans = Vec::new();
+    let pe_cap = (2 * head.pe_required).clamp(8, 32);
+    for c in channels {
+        let mut p = c.plan;
+        let raw = p
+            .waveform
+            .sample(p.offset, p.amplitude, ctx.fs, n)
+            .map_err(|e| PlanError::invalid(head.field.clone(), e.to_string()))?;
+        let shaped = match p.rate_limit {
+            Some(r) => signals::rate_limit(&raw, r, ctx.fs, p.offset),
+            None => raw,
+        };
+        let x = signals::clip(&shaped, -p.limit, p.limit);
+        if p.excited {
+            let a = analyse(
+                &x,
+                p.offset,
+                ctx.fs,
+                ctx.decimation,
+                ctx.vessel.logger_rate_hz,
+                head.pe_required,
+                pe_cap,
+            );
+            if p.waveform.is_dynamic() && a.pe_order < a.pe_required {
+                return Err(PlanError::over_limit(
+                    head.field.clone(),
+                    format!(
+                        "{} in {}: the reference is persistently exciting of order {} as logged at {} Hz, but {} needs {}; shorten the clock or choose a PRBS",
+                        p.column,
+                        head.code,
+                        a.pe_order,
+                        ctx.vessel.logger_rate_hz,
+                        head.family.name(),
+                        a.pe_required
+                    ),
+                    a.pe_required as f64,
+                ));
+            }
+            if a.power_above_logger_nyquist > NYQUIST_WARNING_FRACTION {
+                warnings.push(format!(
+                    "{}: {:.0} % of the reference's power lies above the logger's Nyquist frequency ({} Hz); log faster or lengthen the clock",
+                    p.column,
+                    100.0 * a.power_above_logger_nyquist,
+                    ctx.vessel.logger_rate_hz / 2.0
+                ));
+            }
+            if let (Some(d), Some([_, hi])) = (p.dof, a.band_hz) {
+                let corner =
+                    1.0 / (2.0 * std::f64::consts::PI * ctx.vessel.limit(d).time_constant_s);
+                if p.waveform.is_dynamic() && hi < corner {
+                    warnings.push(format!(
+                        "{}: usable band ends at {hi:.3} Hz, below the {} corner frequency 1/(2πT) = {corner:.3} Hz; a shorter clock would excite the dynamics better",
+                        p.column,
+                        d.name()
+                    ));
+                }
+            }
+            p.analysis = Some(a);
+        }
+        columns.push(p.column.clone());
+        values.push(x);
+        plans.push(p);
+    }
+    let experiment = Experiment {
+        seq: 0,
+        code: head.code,
+        family: head.family,
+        grid_index: head.grid_index,
+        grid_speed_mps: head.grid_index.map(|i| ctx.speeds[i]),
+        dofs: head.dofs,
+        sign: head.sign,
+        repetition: head.repetition,
+        instruction: head.instruction,
+        duration_s: n as f64 / ctx.fs,
+        sample_rate_hz: ctx.fs,
+        channels: plans,
+        warnings,
+    };
+    Ok(PlannedExperiment {
+        experiment,
+        schedule: Schedule {
+            sample_rate_hz: ctx.fs,
+            columns,
+            values,
+        },
+    })
+}
+
+fn fmt_speed(ctx: &Ctx<'_>, gi: usize) -> String {
+    format!(
+        "{} ({:.3} m/s)",
+        ctx.speed_label(gi)
+            .replace("kn", " kn")
+            .replace("m/s", " m/s"),
+        ctx.speeds[gi]
+    )
+}
+
+/// Static runs (Tables 3.2–3.3): surge alone at u0, then ±level in each other DOF.
+fn rov_static(
+    ctx: &Ctx<'_>,
+    gi: usize,
+    reps: u32,
+    out: &mut Vec<PlannedExperiment>,
+) -> Result<(), PlanError> {
+    let u0 = ctx.speeds[gi];
+    let dofs = &ctx.vessel.dofs;
+    let hold = ctx.spec.durations.static_hold_s;
+    for &d in dofs {
+        let signs: &[i8] = if d == Dof::Surge { &[1] } else { &[1, -1] };
+        for &sign in signs {
+            for rep in 1..=reps {
+                let l = ctx.vessel.limit(d);
+                let settle = SQUARE_HOLD_TIME_CONSTANTS * l.time_constant_s;
+                let mut channels = Vec::new();
+                let (level, instruction) = if d == Dof::Surge {
+                    (
+                        0.0,
+                        format!(
+                            "Fly forward at {} with no other motion; hold until steady (≈ {settle:.0} s), then {hold:.0} s more.",
+                            fmt_speed(ctx, gi)
+                        ),
+                    )
+                } else {
+                    let a = ctx.amplitude(d)?;
+                    let (_, unit, ..) = ctx.dof_channel(d);
+                    (
+                        a,
+                        format!(
+                            "At {}, bring {} to {}{a:.3} {unit} and hold until steady (≈ {settle:.0} s), then {hold:.0} s more; no other motion.",
+                            fmt_speed(ctx, gi),
+                            d.name(),
+                            if sign > 0 { "+" } else { "−" }
+                        ),
+                    )
+                };
+                let (_, _, _, rate, _) = ctx.dof_channel(d);
+                let ramp = rate.map_or(0.0, |r| level / r);
+                let duration = ramp + settle + hold;
+                for &c in dofs {
+                    let mut p = ctx.held(c, u0);
+                    if c == d {
+                        p.excited = true;
+                        if d != Dof::Surge {
+                            p.waveform = Waveform::Step {
+                                sign: f64::from(sign),
+                            };
+                            p.amplitude = level;
+                        }
+                    }
+                    channels.push(ChannelSpec {
+                        plan: p,
+                        duration_s: duration,
+                    });
+                }
+                let code = format!(
+                    "STA-{}-{}{}-r{rep}",
+                    ctx.speed_label(gi),
+                    d.name(),
+                    if d == Dof::Surge {
+                        ""
+                    } else if sign > 0 {
+                        "+"
+                    } else {
+                        "-"
+                    }
+                );
+                out.push(assemble(
+                    ctx,
+                    ExperimentHead {
+                        code,
+                        family: ExperimentFamily::Static,
+                        grid_index: Some(gi),
+                        dofs: vec![d],
+                        sign: (d != Dof::Surge).then_some(sign),
+                        repetition: rep,
+                        instruction,
+                        pe_required: 1,
+                        field: format!("excitation.per_dof.{}", d.name()),
+                    },
+                    channels,
+                )?);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Dynamic runs (Tables 3.4–3.5): one DOF excited about the grid speed.
+fn rov_dynamic(
+    ctx: &Ctx<'_>,
+    gi: usize,
+    reps: u32,
+    out: &mut Vec<PlannedExperiment>,
+) -> Result<(), PlanError> {
+    let u0 = ctx.speeds[gi];
+    for &d in &ctx.vessel.dofs {
+        for rep in 1..=reps {
+            let seed = run_seed(ctx.spec.seed, ExperimentFamily::Dynamic, gi, d.index(), rep);
+            let signal = ctx.signal_for(d);
+            let ex = ctx.dynamic_dof(d, u0, ctx.spec.durations.dynamic_s, signal, seed, (0, 1))?;
+            let duration = ex.duration_s;
+            let instruction = if d == Dof::Surge {
+                format!(
+                    "Alternate the forward speed about {} following the u_ref schedule (±{:.3} m/s); no other motion.",
+                    fmt_speed(ctx, gi),
+                    ex.plan.amplitude
+                )
+            } else {
+                format!(
+                    "At a constant {}, follow the {} schedule on {} (±{:.3} {} about 0); no other motion.",
+                    fmt_speed(ctx, gi),
+                    ex.plan.column,
+                    d.name(),
+                    ex.plan.amplitude,
+                    ex.plan.unit
+                )
+            };
+            let mut channels = Vec::new();
+            let mut ex = Some(ex);
+            for &c in &ctx.vessel.dofs {
+                if c == d {
+                    channels.push(ex.take().expect("one excited channel"));
+                } else {
+                    channels.push(ChannelSpec {
+                        plan: ctx.held(c, u0),
+                        duration_s: duration,
+                    });
+                }
+            }
+            out.push(assemble(
+                ctx,
+                ExperimentHead {
+                    code: format!("DYN-{}-{}-r{rep}", ctx.speed_label(gi), d.name()),
+                    family: ExperimentFamily::Dynamic,
+                    grid_index: Some(gi),
+                    dofs: vec![d],
+                    sign: None,
+                    repetition: rep,
+                    instruction,
+                    pe_required: pe_required(ExperimentFamily::Dynamic, 1),
+                    field: format!("excitation.per_dof.{}", d.name()),
+                },
+                channels,
+            )?);
+        }
+    }
+    Ok(())
+}
+
+/// Recursive runs (Table 3.1): every DOF excited at once about the grid speed.
+fn rov_recursive(
+    ctx: &Ctx<'_>,
+    gi: usize,
+    reps: u32,
+    out: &mut Vec<PlannedExperiment>,
+) -> Result<(), PlanError> {
+    let u0 = ctx.speeds[gi];
+    let dofs = &ctx.vessel.dofs;
+    for rep in 1..=reps {
+        let seed = run_seed(ctx.spec.seed, ExperimentFamily::Recursive, gi, 0, rep);
+        let mut channels = Vec::new();
+        for (i, &d) in dofs.iter().enumerate() {
+            channels.push(ctx.dynamic_dof(
+                d,
+                u0,
+                ctx.spec.durations.recursive_s,
+                ctx.signal_for(d),
+                seed,
+                (i, dofs.len()),
+            )?);
+        }
+        out.push(assemble(
+            ctx,
+            ExperimentHead {
+                code: format!("REC-{}-r{rep}", ctx.speed_label(gi)),
+                family: ExperimentFamily::Recursive,
+                grid_index: Some(gi),
+                dofs: dofs.clone(),
+                sign: None,
+                repetition: rep,
+                instruction: format!(
+                    "Fly about {} and follow the references on all DOFs at once (Table 3.1).",
+                    fmt_speed(ctx, gi)
+                ),
+                pe_required: pe_required(ExperimentFamily::Recursive, dofs.len()),
+                field: "excitation".into(),
+            },
+            channels,
+        )?);
+    }
+    Ok(())
+}
+
+/// The thruster groups of a DP manoeuvre: thrusters in one group share a signal.
+fn dp_groups(vessel: &VesselProfile, fam: ExperimentFamily) -> Vec<Vec<usize>> {
+    let thr = vessel.thrusters();
+    let of_kind =
+        |k: ThrusterKind| -> Vec<usize> { (0..thr.len()).filter(|&i| thr[i].kind == k).collect() };
+    let yaw_arm = |i: usize| -> f64 {
+        match &vessel.inputs {
+            super::vessel::InputChannels::Thrusters { configuration, .. } => vessel
+                .dofs
+                .iter()
+                .position(|d| *d == Dof::Yaw)
+                .map_or(0.0, |r| configuration[r][i]),
+            _ => 0.0,
+        }
+    };
+    let nonempty = |g: Vec<Vec<usize>>| g.into_iter().filter(|v| !v.is_empty()).collect();
+    match fam {
+        // Main propellers together: K₁ = K₂ (eq. 31).
+        ExperimentFamily::DpSurge => nonempty(vec![of_kind(ThrusterKind::Main)]),
+        // Stern and bow tunnels driven independently, so sway and yaw are both excited.
+        ExperimentFamily::DpSwayYaw => {
+            let t = of_kind(ThrusterKind::Tunnel);
+            let (stern, bow): (Vec<usize>, Vec<usize>) =
+                t.into_iter().partition(|&i| yaw_arm(i) < 0.0);
+            nonempty(vec![stern, bow])
+        }
+        ExperimentFamily::DpAzimuth => nonempty(vec![of_kind(ThrusterKind::Azimuth)]),
+        _ => nonempty(vec![
+            of_kind(ThrusterKind::Main),
+            of_kind(ThrusterKind::Tunnel),
+            of_kind(ThrusterKind::Azimuth),
+        ]),
+    }
+}
+
+/// DP time constant that sets the clock of a manoeuvre.
+fn dp_time_constant(vessel: &VesselProfile, fam: ExperimentFamily) -> f64 {
+    let t = |d: Dof| {
+        vessel
+            .limits
+            .get(&d)
+            .map_or(f64::INFINITY, |l| l.time_constant_s)
+    };
+    let v = match fam {
+        ExperimentFamily::DpSurge => t(Dof::Surge),
+        ExperimentFamily::DpSwayYaw => t(Dof::Sway).min(t(Dof::Yaw)),
+        _ => t(Dof::Yaw).min(t(Dof::Sway)),
+    };
+    if v.is_finite() {
+        v
+    } else {
+        vessel.limit(Dof::Surge).time_constant_s
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn thruster_channels(
+    ctx: &Ctx<'_>,
+    groups: &[Vec<usize>],
+    fam: ExperimentFamily,
+    min_duration: f64,
+    seed: u64,
+) -> Result<Vec<ChannelSpec>, PlanError> {
+    let thr = ctx.vessel.thrusters();
+    let t = dp_time_constant(ctx.vessel, fam);
+    let mut specs: Vec<Option<ChannelSpec>> = (0..thr.len()).map(|_| None).collect();
+    for (gi, group) in groups.iter().enumerate() {
+        // The group's amplitude and rate are set by its weakest thruster.
+        let max_cmd = group
+            .iter()
+            .map(|&i| thr[i].max_command)
+            .fold(f64::INFINITY, f64::min);
+        let rate = group
+            .iter()
+            .map(|&i| thr[i].max_rate)
+            .fold(f64::INFINITY, f64::min);
+        let amplitude = ctx.spec.excitation.amplitude_fraction * max_cmd;
+        let field = format!("inputs.thrusters[{}]", group[0]);
+        let design = design_channel(&ChannelRequest {
+            field: "excitation",
+            signal: if fam == ExperimentFamily::Validation {
+                SignalKind::RandomBinary
+            } else {
+                ctx.spec.excitation.signal
+            },
+            time_constant_s: t,
+            amplitude,
+            rate_limit: Some(rate),
+            rate_field: &format!("{field}.max_rate"),
+            clock_period_s: None,
+            prbs_order: None,
+            min_duration_s: min_duration,
+            logger_rate_hz: ctx.vessel.logger_rate_hz,
+            seed,
+            channel: (gi, groups.len()),
+        })?;
+        for &i in group {
+            specs[i] = Some(ChannelSpec {
+                plan: ChannelPlan {
+                    column: format!("thr_{}", i + 1),
+                    unit: "1".into(),
+                    dof: None,
+                    thruster: Some(i),
+                    excited: true,
+                    waveform: design.waveform.clone(),
+                    offset: 0.0,
+                    amplitude,
+                    limit: thr[i].max_command,
+                    rate_limit: Some(thr[i].max_rate),
+                    analysis: None,
+                },
+                duration_s: design.duration_s,
+            });
+        }
+    }
+    let duration = specs
+        .iter()
+        .flatten()
+        .map(|s| s.duration_s)
+        .fold(0.0, f64::max);
+    Ok(specs
+        .into_iter()
+        .enumerate()
+        .map(|(i, s)| {
+            s.unwrap_or_else(|| ChannelSpec {
+                plan: ChannelPlan {
+                    column: format!("thr_{}", i + 1),
+                    unit: "1".into(),
+                    dof: None,
+                    thruster: Some(i),
+                    excited: false,
+                    waveform: Waveform::Constant,
+                    offset: 0.0,
+                    amplitude: 0.0,
+                    limit: thr[i].max_command,
+                    rate_limit: Some(thr[i].max_rate),
+                    analysis: None,
+                },
+                duration_s: duration,
+            })
+        })
+        .collect())
+}
+
+/// Decoupled DP manoeuvres (Fossen et al. sec. 4.2), N ≥ 2 each.
+fn dp_manoeuvre(
+    ctx: &Ctx<'_>,
+    fam: ExperimentFamily,
+    gi: usize,
+    reps: u32,
+    out: &mut Vec<PlannedExperiment>,
+) -> Result<(), PlanError> {
+    let groups = dp_groups(ctx.vessel, fam);
+    let thr = ctx.vessel.thrusters();
+    if groups.is_empty() {
+        let kind = match fam {
+            ExperimentFamily::DpSurge => "main propeller",
+            ExperimentFamily::DpSwayYaw => "tunnel thruster",
+            _ => "azimuth thruster",
+        };
+        return Err(PlanError::invalid(
+            "families",
+            format!(
+                "'{}' needs at least one {kind}; the vessel has none",
+                fam.name()
+            ),
+        ));
+    }
+    let names: Vec<&str> = groups
+        .iter()
+        .flatten()
+        .map(|&i| thr[i].name.as_str())
+        .collect();
+    let (dofs, instruction) = match fam {
+        ExperimentFamily::DpSurge => (
+            vec![Dof::Surge],
+            format!(
+                "Uncoupled surge (SI1): drive {} with the schedule; hold heading with a bow thruster on the heading autopilot; no sway command.",
+                names.join(" and ")
+            ),
+        ),
+        ExperimentFamily::DpSwayYaw => (
+            vec![Dof::Sway, Dof::Yaw],
+            format!(
+                "Coupled sway–yaw (SI2): drive {} with the schedules (stern and bow independent); the heading is free to change; main propellers idle.",
+                names.join(", ")
+            ),
+        ),
+        _ => (
+            vec![Dof::Sway, Dof::Yaw],
+            format!(
+                "Azimuth test (SI3): run {} alone with the schedule; all other thrusters idle.",
+                names.join(", ")
+            ),
+        ),
+    };
+    for rep in 1..=reps {
+        let seed = run_seed(ctx.spec.seed, fam, gi, 0, rep);
+        let channels =
+            thruster_channels(ctx, &groups, fam, ctx.spec.durations.dp_manoeuvre_s, seed)?;
+        out.push(assemble(
+            ctx,
+            ExperimentHead {
+                code: format!("{}-{}-r{rep}", fam.code(), ctx.speed_label(gi)),
+                family: fam,
+                grid_index: Some(gi),
+                dofs: dofs.clone(),
+                sign: None,
+                repetition: rep,
+                instruction: format!("At {}: {instruction}", fmt_speed(ctx, gi)),
+                pe_required: pe_required(fam, dofs.len()),
+                field: "excitation".into(),
+            },
+            channels,
+        )?);
+    }
+    Ok(())
+}
+
+/// Validation (thesis sec. 3.5): ≥ 300 s over the whole grid, constant and
+/// changing speeds in every DOF.
+fn validation(ctx: &Ctx<'_>, reps: u32, out: &mut Vec<PlannedExperiment>) -> Result<(), PlanError> {
+    let total = ctx.spec.durations.validation_s;
+    let n_grid = ctx.speeds.len();
+    let dofs = &ctx.vessel.dofs;
+    for rep in 1..=reps {
+        let seed = run_seed(ctx.spec.seed, ExperimentFamily::Validation, 0, 0, rep);
+        let channels = match ctx.vessel.kind {
+            VesselKind::Dp3 => {
+                let groups = dp_groups(ctx.vessel, ExperimentFamily::Validation);
+                thruster_channels(ctx, &groups, ExperimentFamily::Validation, total, seed)?
+            }
+            VesselKind::Rov6 => {
+                let t_max = dofs
+                    .iter()
+                    .map(|&d| ctx.vessel.limit(d).time_constant_s)
+                    .fold(0.0, f64::max);
+                let segment = (total / n_grid as f64).max(2.0 * SQUARE_HOLD_TIME_CONSTANTS * t_max);
+                let duration = segment * n_grid as f64;
+                let mut channels = Vec::new();
+                for (i, &d) in dofs.iter().enumerate() {
+                    let mut p = ctx.held(d, ctx.speeds[0]);
+                    p.excited = true;
+                    if d == Dof::Surge {
+                        p.waveform = Waveform::Staircase {
+                            levels: ctx.speeds.clone(),
+                            segment_s: segment,
+                        };
+                    } else {
+                        p.amplitude = ctx.amplitude(d)?;
+                        p.offset = 0.0;
+                        p.waveform = Waveform::ConstantThenRandom {
+                            segment_s: segment,
+                            constant_fraction: 0.4,
+                            clock_period_s: ctx.vessel.limit(d).time_constant_s,
+                            seed: mix(seed ^ i as u64),
+                        };
+                    }
+                    channels.push(ChannelSpec {
+                        plan: p,
+                        duration_s: duration,
+                    });
+                }
+                channels
+            }
+        };
+        let instruction = match ctx.vessel.kind {
+            VesselKind::Rov6 => format!(
+                "Validation (never used for fitting): step the forward speed through every grid speed; in each step hold all other DOFs still for the first 40 %, then follow their changing references. Covers {:.3}–{:.3} m/s.",
+                ctx.speeds[0],
+                ctx.speeds[n_grid - 1]
+            ),
+            VesselKind::Dp3 => "Validation (never used for fitting): drive all thruster groups together with independent random-binary schedules.".to_string(),
+        };
+        out.push(assemble(
+            ctx,
+            ExperimentHead {
+                code: format!("VAL-r{rep}"),
+                family: ExperimentFamily::Validation,
+                grid_index: None,
+                dofs: dofs.clone(),
+                sign: None,
+                repetition: rep,
+                instruction,
+                pe_required: 2,
+                field: "durations.validation_s".into(),
+            },
+            channels,
+        )?);
+    }
+    Ok(())
+}

@@ -1,0 +1,304 @@
+//! Vessel profiles: what the vessel is, which DOFs are modeled, how it is
+//! actuated (τ per DOF, or thruster commands through τ = T K u, eq. 4/7 of
+//! Fossen et al.), and the limits the pilots give.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use super::dof::Dof;
+use super::error::{PlanError, positive};
+
+/// 6-DOF ROV (the Surveyor of the thesis) or 3-DOF DP surface vessel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum VesselKind {
+    /// Remotely operated vehicle, up to 6 DOF, LPV-scheduled on forward speed.
+    Rov6,
+    /// Dynamically positioned surface vessel, surge–sway–yaw LF model.
+    Dp3,
+}
+
+/// Limits per DOF, in SI units, as given by the pilots.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct DofLimits {
+    /// Largest velocity excursion |ν_i| (m/s or rad/s). For surge this is the
+    /// vessel's maximum forward speed: no grid speed may exceed it.
+    pub max_velocity: f64,
+    /// Largest generalized force |τ_i| (N or N·m).
+    pub max_force: f64,
+    /// Largest rate of change of τ_i (N/s or N·m/s): hydraulic thrusters
+    /// cannot follow jumps, so force schedules are slew-limited to this.
+    pub max_force_rate: f64,
+    /// Largest rate of change of a velocity reference (m/s² or rad/s²);
+    /// velocity schedules are slew-limited to it when given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_accel: Option<f64>,
+    /// Expected dominant time constant T_i ≈ m_i/d_i of the DOF (s); it sets the
+    /// square-wave period, the PRBS clock and the settling time of static runs.
+    pub time_constant_s: f64,
+}
+
+/// What a thruster does, to assign it to the decoupled DP manoeuvres
+/// (sec. 4.2 of Fossen et al.).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum ThrusterKind {
+    /// Main propeller: surge (manoeuvre 1).
+    Main,
+    /// Tunnel thruster: sway and yaw (manoeuvre 2).
+    Tunnel,
+    /// Azimuth thruster: run alone (manoeuvre 3).
+    Azimuth,
+}
+
+/// One thruster input channel u_i (eq. 5: u_i = |p_i − p_i0|(p_i − p_i0),
+/// normalized so that |u_i| ≤ max_command).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct Thruster {
+    /// Name the pilots use, e.g. "port main propeller".
+    pub name: String,
+    /// Role in the decoupled manoeuvres.
+    pub kind: ThrusterKind,
+    /// Largest |u_i| (normalized command, 1.0 = 100 % pitch).
+    pub max_command: f64,
+    /// Largest rate of change of u_i per second.
+    pub max_rate: f64,
+}
+
+/// How the vessel is actuated.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum InputChannels {
+    /// Generalized forces τ per modeled DOF (the thesis's logger records τ).
+    GeneralizedForces,
+    /// Thruster commands u with a thruster configuration matrix T
+    /// (rows: modeled DOFs in order, columns: thrusters), τ = T K u.
+    Thrusters {
+        /// The thrusters, in the column order of T.
+        thrusters: Vec<Thruster>,
+        /// T, row-major: one row per modeled DOF.
+        configuration: Vec<Vec<f64>>,
+    },
+}
+
+/// A vessel as the planner needs it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct VesselProfile {
+    /// Name, e.g. "Surveyor ROV".
+    pub name: String,
+    /// ROV or DP vessel.
+    pub kind: VesselKind,
+    /// Modeled DOFs (surge is required: it is the LPV scheduling variable).
+    pub dofs: Vec<Dof>,
+    /// Input channels.
+    pub inputs: InputChannels,
+    /// Limits for every modeled DOF.
+    #[serde(deserialize_with = "super::dof::deserialize_dof_map")]
+    pub limits: BTreeMap<Dof, DofLimits>,
+    /// Rate of the vessel's controller, at which references are fed (Hz).
+    pub controller_rate_hz: f64,
+    /// Rate of the data logger (Hz); the thesis logged a 20 Hz controller at 10 Hz.
+    pub logger_rate_hz: f64,
+}
+
+impl VesselProfile {
+    /// The limits of a modeled DOF. Only valid after [`VesselProfile::validate`].
+    pub fn limit(&self, dof: Dof) -> &DofLimits {
+        &self.limits[&dof]
+    }
+
+    /// Maximum forward speed (m/s): the surge velocity limit.
+    pub fn max_forward_speed(&self) -> f64 {
+        self.limit(Dof::Surge).max_velocity
+    }
+
+    /// The thrusters, if the vessel is actuated by thruster commands.
+    pub fn thrusters(&self) -> &[Thruster] {
+        match &self.inputs {
+            InputChannels::Thrusters { thrusters, .. } => thrusters,
+            InputChannels::GeneralizedForces => &[],
+        }
+    }
+
+    /// Checks the profile for completeness and physical sense.
+    pub fn validate(&self) -> Result<(), PlanError> {
+        if self.name.trim().is_empty() {
+            return Err(PlanError::invalid("name", "must not be empty"));
+        }
+        if self.name.len() > 200 {
+            return Err(PlanError::invalid("name", "must be at most 200 characters"));
+        }
+        if self.dofs.is_empty() {
+            return Err(PlanError::invalid(
+                "dofs",
+                "at least one DOF must be modeled",
+            ));
+        }
+        for (i, d) in self.dofs.iter().enumerate() {
+            if self.dofs[..i].contains(d) {
+                return Err(PlanError::invalid(
+                    format!("dofs[{i}]"),
+                    format!("{} is listed twice", d.name()),
+                ));
+            }
+            if self.kind == VesselKind::Dp3 && !Dof::HORIZONTAL.contains(d) {
+                return Err(PlanError::invalid(
+                    format!("dofs[{i}]"),
+                    format!(
+                        "a 3-DOF DP vessel models surge, sway and yaw only, not {}",
+                        d.name()
+                    ),
+                ));
+            }
+        }
+        if !self.dofs.contains(&Dof::Surge) {
+            return Err(PlanError::invalid(
+                "dofs",
+                "surge must be modeled: forward speed is the scheduling variable",
+            ));
+        }
+        positive("controller_rate_hz", self.controller_rate_hz)?;
+        positive("logger_rate_hz", self.logger_rate_hz)?;
+        if self.controller_rate_hz > 1000.0 || self.logger_rate_hz > 1000.0 {
+            return Err(PlanError::over_limit(
+                "controller_rate_hz",
+                "sample rates above 1000 Hz are not supported",
+                1000.0,
+            ));
+        }
+        for &d in &self.dofs {
+            let Some(l) = self.limits.get(&d) else {
+                return Err(PlanError::invalid(
+                    format!("limits.{}", d.name()),
+                    format!("limits for the modeled DOF {} are missing", d.name()),
+                ));
+            };
+            let f = |name: &str| format!("limits.{}.{name}", d.name());
+            positive(&f("max_velocity"), l.max_velocity)?;
+            positive(&f("max_force"), l.max_force)?;
+            positive(&f("max_force_rate"), l.max_force_rate)?;
+            positive(&f("time_constant_s"), l.time_constant_s)?;
+            if let Some(a) = l.max_accel {
+                positive(&f("max_accel"), a)?;
+            }
+            if l.time_constant_s > 3600.0 {
+                return Err(PlanError::over_limit(
+                    f("time_constant_s"),
+                    "a time constant above one hour cannot be identified in a sea trial",
+                    3600.0,
+                ));
+            }
+        }
+        if let Some(d) = self.limits.keys().find(|d| !self.dofs.contains(d)) {
+            return Err(PlanError::invalid(
+                format!("limits.{}", d.name()),
+                format!("{} is not among the modeled DOFs", d.name()),
+            ));
+        }
+        if let InputChannels::Thrusters {
+            thrusters,
+            configuration,
+        } = &self.inputs
+        {
+            if thrusters.is_empty() {
+                return Err(PlanError::invalid(
+                    "inputs.thrusters",
+                    "at least one thruster is needed",
+                ));
+            }
+            for (i, t) in thrusters.iter().enumerate() {
+                if t.name.trim().is_empty() {
+                    return Err(PlanError::invalid(
+                        format!("inputs.thrusters[{i}].name"),
+                        "must not be empty",
+                    ));
+                }
+                positive(&format!("inputs.thrusters[{i}].max_command"), t.max_command)?;
+                positive(&format!("inputs.thrusters[{i}].max_rate"), t.max_rate)?;
+            }
+            if configuration.len() != self.dofs.len() {
+                return Err(PlanError::invalid(
+                    "inputs.configuration",
+                    format!(
+                        "T must have one row per modeled DOF ({} rows), got {}",
+                        self.dofs.len(),
+                        configuration.len()
+                    ),
+                ));
+            }
+            for (r, row) in configuration.iter().enumerate() {
+                if row.len() != thrusters.len() {
+                    return Err(PlanError::invalid(
+                        format!("inputs.configuration[{r}]"),
+                        format!(
+                            "T must have one column per thruster ({}), got {}",
+                            thrusters.len(),
+                            row.len()
+                        ),
+                    ));
+                }
+                if let Some(c) = row.iter().position(|x| !x.is_finite()) {
+                    return Err(PlanError::invalid(
+                        format!("inputs.configuration[{r}][{c}]"),
+                        "must be a finite number",
+                    ));
+                }
+            }
+            for c in 0..thrusters.len() {
+                if configuration.iter().all(|row| row[c] == 0.0) {
+                    return Err(PlanError::invalid(
+                        format!("inputs.configuration (column {c})"),
+                        format!(
+                            "thruster '{}' acts on no modeled DOF: its column of T is zero",
+                            thrusters[c].name
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::examples::{supply_vessel, surveyor_rov};
+    use super::*;
+
+    #[test]
+    fn examples_are_valid() {
+        surveyor_rov().validate().unwrap();
+        supply_vessel().validate().unwrap();
+    }
+
+    #[test]
+    fn missing_limits_and_bad_configuration_name_the_field() {
+        let mut v = surveyor_rov();
+        v.limits.remove(&Dof::Roll);
+        assert_eq!(v.validate().unwrap_err().field, "limits.roll");
+
+        let mut v = supply_vessel();
+        if let InputChannels::Thrusters { configuration, .. } = &mut v.inputs {
+            configuration[1].pop();
+        }
+        assert_eq!(v.validate().unwrap_err().field, "inputs.configuration[1]");
+
+        let mut v = supply_vessel();
+        v.dofs.push(Dof::Heave);
+        assert_eq!(v.validate().unwrap_err().field, "dofs[3]");
+
+        let mut v = surveyor_rov();
+        v.limits.get_mut(&Dof::Yaw).unwrap().max_force_rate = f64::NAN;
+        assert_eq!(v.validate().unwrap_err().field, "limits.yaw.max_force_rate");
+    }
+}

@@ -1,0 +1,94 @@
+//! Phase unwrapping (numpy.unwrap semantics).
+
+use std::f64::consts::PI;
+
+/// Unwraps a phase sequence in radians exactly as `numpy.unwrap(p)` with its
+/// defaults (`discont = π`, `period = 2π`): every jump between consecutive
+/// samples larger than π in magnitude is replaced by its 2π-complement, and
+/// the corrections are accumulated. A jump of exactly ±π is kept (as +π when
+/// the raw difference is positive), as numpy does.
+///
+/// Non-finite samples propagate as in numpy (the output becomes NaN from
+/// there on).
+pub fn unwrap_phase(phase: &[f64]) -> Vec<f64> {
+    let period = 2.0 * PI;
+    let high = period / 2.0;
+    let low = -high;
+    let mut out = Vec::with_capacity(phase.len());
+    let Some(&first) = phase.first() else {
+        return out;
+    };
+    out.push(first);
+    let mut correction = 0.0;
+    for w in phase.windows(2) {
+        let dd = w[1] - w[0];
+        let mut ddmod = py_mod(dd - low, period) + low;
+        if ddmod == low && dd > 0.0 {
+            ddmod = high;
+        }
+        let mut ph_correct = ddmod - dd;
+        if dd.abs() < high {
+            ph_correct = 0.0;
+        }
+        correction += ph_correct;
+        out.push(w[1] + correction);
+    }
+    out
+}
+
+/// Floor-division remainder with the sign of `b` (numpy's `np.mod` for
+/// floats, including its `fmod`-then-adjust rounding).
+fn py_mod(a: f64, b: f64) -> f64 {
+    let m = a % b;
+    if m != 0.0 {
+        if (b < 0.0) != (m < 0.0) { m + b } else { m }
+    } else {
+        0.0f64.copysign(b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unwraps_a_linear_ramp() {
+        let truth: Vec<f64> = (0..200).map(|i| -0.3 * i as f64).collect();
+        let wrapped: Vec<f64> = truth.iter().map(|p| p.sin().atan2(p.cos())).collect();
+        let un = unwrap_phase(&wrapped);
+        for (u, t) in un.iter().zip(&truth) {
+            assert!((u - t).abs() < 1e-9, "{u} vs {t}");
+        }
+    }
+
+    #[test]
+    fn matches_numpy_on_edge_cases() {
+        // np.unwrap([0, 3.5, 7.0, 0.5, -3.0]) = [0, -2.783.., -5.566.., -5.783.., -3.0].
+        assert!(unwrap_phase(&[]).is_empty());
+        assert_eq!(unwrap_phase(&[1.5]), vec![1.5]);
+        let p = [0.0, 3.5, 7.0, 0.5, -3.0];
+        let u = unwrap_phase(&p);
+        let expected = [
+            0.0,
+            3.5 - 2.0 * PI,
+            7.0 - 4.0 * PI,
+            0.5 - 2.0 * PI,
+            -3.0 - 2.0 * PI + 2.0 * PI,
+        ];
+        for (a, e) in u.iter().zip(expected) {
+            assert!((a - e).abs() < 1e-12, "{u:?}");
+        }
+        // A jump of exactly +π is kept; −π likewise.
+        assert_eq!(unwrap_phase(&[0.0, PI]), vec![0.0, PI]);
+        assert_eq!(unwrap_phase(&[0.0, -PI]), vec![0.0, -PI]);
+        // Small steps are untouched.
+        assert_eq!(unwrap_phase(&[0.1, 0.2, -0.3]), vec![0.1, 0.2, -0.3]);
+    }
+
+    #[test]
+    fn py_mod_is_floor_mod() {
+        assert_eq!(py_mod(-1.0, 3.0), 2.0);
+        assert_eq!(py_mod(4.0, 3.0), 1.0);
+        assert_eq!(py_mod(6.0, 3.0), 0.0);
+    }
+}

@@ -1,0 +1,109 @@
+//! The service's one error type and its mapping to HTTP status codes
+//! (the pattern of launchbadge's realworld-axum-sqlx). Every error body is
+//! JSON: `{ "status", "message", "field"?, "limit"? }`.
+
+use axum::Json;
+use axum::http::StatusCode;
+use axum::response::{IntoResponse, Response};
+use seatrial_core::planning::PlanError;
+use serde::Serialize;
+
+/// JSON body of every error response.
+#[derive(Debug, Serialize, utoipa::ToSchema)]
+pub struct ErrorBody {
+    /// HTTP status code.
+    pub status: u16,
+    /// What went wrong, in plain words.
+    pub message: String,
+    /// The offending field (JSON path into the request, or the parameter name).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub field: Option<String>,
+    /// The limit that was broken, in SI units.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit: Option<f64>,
+}
+
+/// Errors of the HTTP layer.
+#[derive(Debug, thiserror::Error)]
+pub enum ApiError {
+    /// Malformed request: unparsable JSON, wrong types (400).
+    #[error("{message}")]
+    BadRequest {
+        /// Message.
+        message: String,
+        /// Offending field.
+        field: Option<String>,
+    },
+    /// Nothing with that id (404).
+    #[error("{0}")]
+    NotFound(String),
+    /// Understood but impossible or unsafe (422).
+    #[error("{0}")]
+    Unprocessable(#[from] PlanError),
+    /// Request body over the size limit (413).
+    #[error("{0}")]
+    TooLarge(String),
+    /// Wrong content type (415).
+    #[error("{0}")]
+    UnsupportedMediaType(String),
+    /// Database failure (500, logged).
+    #[error("database error: {0}")]
+    Database(#[from] sqlx::Error),
+    /// Anything else unexpected (500, logged).
+    #[error("internal error: {0}")]
+    Internal(#[from] anyhow::Error),
+}
+
+impl ApiError {
+    /// A 400 naming a field.
+    pub fn bad_field(field: impl Into<String>, message: impl Into<String>) -> Self {
+        ApiError::BadRequest {
+            message: message.into(),
+            field: Some(field.into()),
+        }
+    }
+
+    fn status(&self) -> StatusCode {
+        match self {
+            ApiError::BadRequest { .. } => StatusCode::BAD_REQUEST,
+            ApiError::NotFound(_) => StatusCode::NOT_FOUND,
+            ApiError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::TooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
+            ApiError::UnsupportedMediaType(_) => StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            ApiError::Database(_) | ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
+        }
+    }
+}
+
+impl IntoResponse for ApiError {
+    fn into_response(self) -> Response {
+        let status = self.status();
+        let (message, field, limit) = match self {
+            ApiError::BadRequest { message, field } => (message, field, None),
+            ApiError::Unprocessable(e) => (e.message, Some(e.field), e.limit),
+            ApiError::Database(e) => {
+                tracing::error!(error = %e, "database error");
+                (
+                    "internal database error; see the server log".to_string(),
+                    None,
+                    None,
+                )
+            }
+            ApiError::Internal(e) => {
+                tracing::error!(error = %e, "internal error");
+                ("internal error; see the server log".to_string(), None, None)
+            }
+            other => (other.to_string(), None, None),
+        };
+        let body = ErrorBody {
+            status: status.as_u16(),
+            message,
+            field,
+            limit,
+        };
+        (status, Json(body)).into_response()
+    }
+}
+
+/// Result of a handler.
+pub type ApiResult<T> = Result<T, ApiError>;

@@ -1,0 +1,113 @@
+//! Campaigns: the LPV grid, families and excitation settings for a vessel.
+
+use axum::Json;
+use axum::extract::{Path, Query, State};
+use axum::http::StatusCode;
+use seatrial_core::planning::campaign::{Durations, Excitation};
+use seatrial_core::planning::{CampaignSpec, ExperimentFamily, SpeedGrid, generate_plan};
+use serde::Deserialize;
+
+use super::json::ApiJson;
+use super::{AppState, blocking, found};
+use crate::error::{ApiError, ApiResult, ErrorBody};
+use crate::storage::campaigns::{self, Campaign};
+use crate::storage::vessels;
+
+/// A new campaign: the vessel it is for, and the campaign itself.
+#[derive(Debug, Deserialize, utoipa::ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct NewCampaign {
+    /// Vessel id.
+    pub vessel_id: String,
+    /// Name.
+    pub name: String,
+    /// Forward-speed grid, in kn or m/s.
+    pub grid: SpeedGrid,
+    /// Families to fly.
+    pub families: Vec<ExperimentFamily>,
+    /// Repetitions (default 1 for a ROV, 2 for a DP vessel; DP needs ≥ 2).
+    #[serde(default)]
+    pub repetitions: Option<u32>,
+    /// Excitation settings.
+    #[serde(default)]
+    pub excitation: Excitation,
+    /// Durations.
+    #[serde(default)]
+    pub durations: Durations,
+    /// Seed of every pseudo-random sequence.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// Filter of the campaign list.
+#[derive(Debug, Deserialize, utoipa::IntoParams)]
+pub struct CampaignFilter {
+    /// Only campaigns of this vessel.
+    pub vessel_id: Option<String>,
+}
+
+/// Create a campaign. It is planned once as a dry run, so a campaign that
+/// exists can always be planned: every limit violation is a 422 here.
+#[utoipa::path(post, path = "/api/campaigns", tag = "planning",
+    request_body = NewCampaign,
+    responses(
+        (status = 201, description = "Created", body = Campaign),
+        (status = 400, description = "Malformed JSON; `field` names the JSON path", body = ErrorBody),
+        (status = 404, description = "No such vessel", body = ErrorBody),
+        (status = 413, description = "Body too large", body = ErrorBody),
+        (status = 415, description = "Not JSON", body = ErrorBody),
+        (status = 422, description = "Impossible request: `field` and `limit` name what and why", body = ErrorBody)))]
+pub async fn create_campaign(
+    State(s): State<AppState>,
+    ApiJson(req): ApiJson<NewCampaign>,
+) -> ApiResult<(StatusCode, Json<Campaign>)> {
+    let vessel = vessels::get(&s.db, &req.vessel_id).await?.ok_or_else(|| {
+        ApiError::NotFound(format!(
+            "no vessel with id '{}' (field vessel_id)",
+            req.vessel_id
+        ))
+    })?;
+    let spec = CampaignSpec {
+        name: req.name,
+        grid: req.grid,
+        families: req.families,
+        repetitions: req.repetitions,
+        excitation: req.excitation,
+        durations: req.durations,
+        seed: req.seed,
+    };
+    let profile = vessel.profile.clone();
+    let checked = spec.clone();
+    blocking(move || generate_plan(&profile, &checked).map(|_| ())).await??;
+    Ok((
+        StatusCode::CREATED,
+        Json(campaigns::insert(&s.db, &vessel.id, spec).await?),
+    ))
+}
+
+/// List campaigns.
+#[utoipa::path(get, path = "/api/campaigns", tag = "planning",
+    params(CampaignFilter),
+    responses((status = 200, description = "Campaigns, oldest first", body = [Campaign])))]
+pub async fn list_campaigns(
+    State(s): State<AppState>,
+    Query(f): Query<CampaignFilter>,
+) -> ApiResult<Json<Vec<Campaign>>> {
+    Ok(Json(campaigns::list(&s.db, f.vessel_id.as_deref()).await?))
+}
+
+/// One campaign.
+#[utoipa::path(get, path = "/api/campaigns/{id}", tag = "planning",
+    params(("id" = String, Path, description = "Campaign id")),
+    responses((status = 200, description = "The campaign", body = Campaign),
+              (status = 404, description = "No such campaign", body = ErrorBody)))]
+pub async fn get_campaign(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+) -> ApiResult<Json<Campaign>> {
+    Ok(Json(found(
+        campaigns::get(&s.db, &id).await?,
+        "campaign",
+        &id,
+    )?))
+}

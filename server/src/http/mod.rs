@@ -1,0 +1,99 @@
+//! HTTP: a thin layer that parses, calls the numerics core (off the async
+//! runtime for CPU work), stores and responds. Every `/api` route is
+//! declared through utoipa, so `openapi.yaml` is generated from the router
+//! itself and a test holds the two together.
+
+pub mod campaigns;
+pub mod export;
+pub mod health;
+pub mod json;
+pub mod plans;
+pub mod vessels;
+
+use std::path::PathBuf;
+
+use axum::Router;
+use axum::extract::DefaultBodyLimit;
+use axum::http::Uri;
+use tower_http::services::ServeDir;
+use tower_http::trace::TraceLayer;
+use utoipa::OpenApi;
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
+
+use crate::error::{ApiError, ErrorBody};
+use crate::storage::Db;
+
+/// Shared state of the handlers.
+#[derive(Clone)]
+pub struct AppState {
+    /// Database pool.
+    pub db: Db,
+}
+
+#[derive(OpenApi)]
+#[openapi(
+    info(
+        title = "seatrial",
+        description = "Sea-trial system identification of ROVs and dynamically positioned ships: plan trial campaigns, score runs, identify and validate models.",
+        license(name = "MIT")
+    ),
+    components(schemas(ErrorBody)),
+    tags(
+        (name = "service", description = "Service health"),
+        (name = "planning", description = "Vessels, campaigns, excitation plans and their exports")
+    )
+)]
+struct ApiDoc;
+
+/// The `/api` routes with their OpenAPI description.
+pub fn api() -> OpenApiRouter<AppState> {
+    OpenApiRouter::with_openapi(ApiDoc::openapi())
+        .routes(routes!(health::health))
+        .routes(routes!(vessels::create_vessel, vessels::list_vessels))
+        .routes(routes!(vessels::get_vessel))
+        .routes(routes!(
+            campaigns::create_campaign,
+            campaigns::list_campaigns
+        ))
+        .routes(routes!(campaigns::get_campaign))
+        .routes(routes!(plans::generate_plan, plans::get_plan))
+        .routes(routes!(plans::get_experiment))
+        .routes(routes!(plans::schedule_csv))
+        .routes(routes!(plans::run_sheet))
+}
+
+/// The OpenAPI document of the service.
+pub fn openapi() -> utoipa::openapi::OpenApi {
+    api().split_for_parts().1
+}
+
+async fn api_not_found(uri: Uri) -> ApiError {
+    ApiError::NotFound(format!("no API route {}", uri.path()))
+}
+
+/// The whole application: `/api`, and the web UI from `web_dir`
+/// (uPlot from `web_dir/node_modules`, installed by `npm ci`).
+pub fn app(db: Db, web_dir: PathBuf) -> Router {
+    let (api, _) = api().split_for_parts();
+    let api = api
+        .route("/api/{*rest}", axum::routing::any(api_not_found))
+        .layer(DefaultBodyLimit::max(json::MAX_JSON_BODY));
+    api.fallback_service(ServeDir::new(web_dir).append_index_html_on_directories(true))
+        .layer(TraceLayer::new_for_http())
+        .with_state(AppState { db })
+}
+
+/// Maps a missing row to a 404 naming what was looked for.
+pub(crate) fn found<T>(v: Option<T>, what: &str, id: &str) -> Result<T, ApiError> {
+    v.ok_or_else(|| ApiError::NotFound(format!("no {what} with id '{id}'")))
+}
+
+/// Runs CPU-bound work off the async runtime.
+pub(crate) async fn blocking<T: Send + 'static>(
+    f: impl FnOnce() -> T + Send + 'static,
+) -> Result<T, ApiError> {
+    tokio::task::spawn_blocking(f)
+        .await
+        .map_err(|e| ApiError::Internal(anyhow::anyhow!("worker task failed: {e}")))
+}

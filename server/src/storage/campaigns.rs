@@ -1,0 +1,95 @@
+//! Campaigns.
+
+use seatrial_core::planning::CampaignSpec;
+use serde::Serialize;
+
+use super::{Db, new_id, now};
+
+/// A stored campaign.
+#[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
+pub struct Campaign {
+    /// Id (UUIDv7).
+    pub id: String,
+    /// The vessel it is planned for.
+    pub vessel_id: String,
+    /// Creation time (RFC 3339).
+    pub created_at: String,
+    /// The grid in m/s (SI), as stored for computation.
+    pub grid_speeds_mps: Vec<f64>,
+    /// The campaign as entered.
+    pub spec: CampaignSpec,
+}
+
+#[derive(sqlx::FromRow)]
+struct Row {
+    id: String,
+    vessel_id: String,
+    spec: String,
+    created_at: String,
+}
+
+impl TryFrom<Row> for Campaign {
+    type Error = anyhow::Error;
+    fn try_from(r: Row) -> anyhow::Result<Self> {
+        let spec: CampaignSpec = serde_json::from_str(&r.spec)?;
+        Ok(Campaign {
+            id: r.id,
+            vessel_id: r.vessel_id,
+            created_at: r.created_at,
+            grid_speeds_mps: spec.grid.speeds_si(),
+            spec,
+        })
+    }
+}
+
+/// Inserts a validated campaign.
+pub async fn insert(db: &Db, vessel_id: &str, spec: CampaignSpec) -> anyhow::Result<Campaign> {
+    let c = Campaign {
+        id: new_id(),
+        vessel_id: vessel_id.to_string(),
+        created_at: now(),
+        grid_speeds_mps: spec.grid.speeds_si(),
+        spec,
+    };
+    sqlx::query(
+        "INSERT INTO campaign (id, vessel_id, name, spec, created_at) VALUES ($1, $2, $3, $4, $5)",
+    )
+    .bind(&c.id)
+    .bind(&c.vessel_id)
+    .bind(&c.spec.name)
+    .bind(serde_json::to_string(&c.spec)?)
+    .bind(&c.created_at)
+    .execute(db)
+    .await?;
+    Ok(c)
+}
+
+/// All campaigns, oldest first, optionally of one vessel.
+pub async fn list(db: &Db, vessel_id: Option<&str>) -> anyhow::Result<Vec<Campaign>> {
+    let rows = match vessel_id {
+        Some(v) => sqlx::query_as::<_, Row>(
+            "SELECT id, vessel_id, spec, created_at FROM campaign WHERE vessel_id = $1 ORDER BY id",
+        )
+        .bind(v)
+        .fetch_all(db)
+        .await?,
+        None => {
+            sqlx::query_as::<_, Row>(
+                "SELECT id, vessel_id, spec, created_at FROM campaign ORDER BY id",
+            )
+            .fetch_all(db)
+            .await?
+        }
+    };
+    rows.into_iter().map(Campaign::try_from).collect()
+}
+
+/// One campaign.
+pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Campaign>> {
+    sqlx::query_as::<_, Row>("SELECT id, vessel_id, spec, created_at FROM campaign WHERE id = $1")
+        .bind(id)
+        .fetch_optional(db)
+        .await?
+        .map(Campaign::try_from)
+        .transpose()
+}

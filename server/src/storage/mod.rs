@@ -1,0 +1,50 @@
+//! Storage: SQLite through sqlx, migrations embedded from `migrations/`.
+//! Queries use `$N` placeholders and portable SQL so that the same code can
+//! later run on PostgreSQL (see the migration's header for the conventions).
+
+pub mod campaigns;
+pub mod plans;
+pub mod vessels;
+
+use std::path::Path;
+use std::str::FromStr;
+use std::time::Duration;
+
+use sqlx::sqlite::{SqliteConnectOptions, SqliteJournalMode, SqlitePoolOptions, SqliteSynchronous};
+
+/// The pool type used throughout.
+pub type Db = sqlx::SqlitePool;
+
+/// Opens (creating if needed) the database file, in WAL mode with foreign
+/// keys on, and applies pending migrations.
+pub async fn open(path: &Path) -> anyhow::Result<Db> {
+    if let Some(dir) = path.parent()
+        && !dir.as_os_str().is_empty()
+    {
+        std::fs::create_dir_all(dir)?;
+    }
+    let opts = SqliteConnectOptions::from_str(&format!("sqlite://{}", path.display()))?
+        .create_if_missing(true)
+        .journal_mode(SqliteJournalMode::Wal)
+        .synchronous(SqliteSynchronous::Normal)
+        .foreign_keys(true)
+        .busy_timeout(Duration::from_secs(10));
+    let pool = SqlitePoolOptions::new()
+        .max_connections(8)
+        .connect_with(opts)
+        .await?;
+    sqlx::migrate!("./migrations").run(&pool).await?;
+    Ok(pool)
+}
+
+/// A new time-ordered id.
+pub fn new_id() -> String {
+    uuid::Uuid::now_v7().to_string()
+}
+
+/// Now, RFC 3339 in UTC.
+pub fn now() -> String {
+    time::OffsetDateTime::now_utc()
+        .format(&time::format_description::well_known::Rfc3339)
+        .unwrap_or_default()
+}

@@ -1,0 +1,80 @@
+//! Vessel profiles.
+
+use seatrial_core::planning::VesselProfile;
+use serde::Serialize;
+
+use super::{Db, new_id, now};
+
+/// A stored vessel.
+#[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
+pub struct Vessel {
+    /// Id (UUIDv7).
+    pub id: String,
+    /// Creation time (RFC 3339).
+    pub created_at: String,
+    /// The profile.
+    pub profile: VesselProfile,
+}
+
+#[derive(sqlx::FromRow)]
+struct Row {
+    id: String,
+    profile: String,
+    created_at: String,
+}
+
+impl TryFrom<Row> for Vessel {
+    type Error = anyhow::Error;
+    fn try_from(r: Row) -> anyhow::Result<Self> {
+        Ok(Vessel {
+            id: r.id,
+            created_at: r.created_at,
+            profile: serde_json::from_str(&r.profile)?,
+        })
+    }
+}
+
+/// Inserts a validated profile.
+pub async fn insert(db: &Db, profile: VesselProfile) -> anyhow::Result<Vessel> {
+    let v = Vessel {
+        id: new_id(),
+        created_at: now(),
+        profile,
+    };
+    sqlx::query(
+        "INSERT INTO vessel (id, name, kind, profile, created_at) VALUES ($1, $2, $3, $4, $5)",
+    )
+    .bind(&v.id)
+    .bind(&v.profile.name)
+    .bind(
+        serde_json::to_value(v.profile.kind)?
+            .as_str()
+            .unwrap_or_default()
+            .to_string(),
+    )
+    .bind(serde_json::to_string(&v.profile)?)
+    .bind(&v.created_at)
+    .execute(db)
+    .await?;
+    Ok(v)
+}
+
+/// All vessels, oldest first.
+pub async fn list(db: &Db) -> anyhow::Result<Vec<Vessel>> {
+    sqlx::query_as::<_, Row>("SELECT id, profile, created_at FROM vessel ORDER BY id")
+        .fetch_all(db)
+        .await?
+        .into_iter()
+        .map(Vessel::try_from)
+        .collect()
+}
+
+/// One vessel.
+pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Vessel>> {
+    sqlx::query_as::<_, Row>("SELECT id, profile, created_at FROM vessel WHERE id = $1")
+        .bind(id)
+        .fetch_optional(db)
+        .await?
+        .map(Vessel::try_from)
+        .transpose()
+}

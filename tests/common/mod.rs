@@ -1,0 +1,157 @@
+//! Test harness: the real router over a fresh SQLite file, driven in-process,
+//! with every JSON response validated against the schema `openapi.yaml`
+//! documents for its route and status.
+
+#![allow(dead_code)]
+
+use axum::Router;
+use axum::body::Body;
+use axum::http::{Request, StatusCode};
+use serde_json::{Value, json};
+use tower::ServiceExt;
+
+pub struct TestApp {
+    pub router: Router,
+    pub spec: Value,
+    _dir: tempfile::TempDir,
+}
+
+/// A response: status, content type, body text and parsed JSON (if any).
+pub struct Resp {
+    pub status: StatusCode,
+    pub content_type: String,
+    pub text: String,
+    pub json: Value,
+}
+
+impl TestApp {
+    pub async fn new() -> Self {
+        let dir = tempfile::tempdir().unwrap();
+        let db = seatrial::storage::open(&dir.path().join("t.db"))
+            .await
+            .unwrap();
+        let web = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("web");
+        let spec = serde_json::to_value(seatrial::http::openapi()).unwrap();
+        TestApp {
+            router: seatrial::http::app(db, web),
+            spec,
+            _dir: dir,
+        }
+    }
+
+    /// Sends a request. `template` is the documented path (e.g.
+    /// `/api/vessels/{id}`), `args` fill its parameters in order; the
+    /// response is validated against the documented schema.
+    pub async fn call(
+        &self,
+        method: &str,
+        template: &str,
+        args: &[&str],
+        body: Option<Value>,
+    ) -> Resp {
+        let mut path = template.to_string();
+        for a in args {
+            let start = path.find('{').expect("more args than parameters");
+            let end = path[start..].find('}').unwrap() + start;
+            path.replace_range(start..=end, a);
+        }
+        let r = self
+            .raw(
+                method,
+                &path,
+                body.map(|b| ("application/json", b.to_string())),
+            )
+            .await;
+        self.check_contract(method, template, &r);
+        r
+    }
+
+    /// Sends a request without contract checks (for malformed bodies etc.).
+    pub async fn raw(&self, method: &str, path: &str, body: Option<(&str, String)>) -> Resp {
+        let mut req = Request::builder().method(method).uri(path);
+        let body = match body {
+            Some((ct, b)) => {
+                req = req.header("content-type", ct);
+                Body::from(b)
+            }
+            None => Body::empty(),
+        };
+        let resp = self
+            .router
+            .clone()
+            .oneshot(req.body(body).unwrap())
+            .await
+            .unwrap();
+        let status = resp.status();
+        let content_type = resp
+            .headers()
+            .get("content-type")
+            .map(|v| v.to_str().unwrap().to_string())
+            .unwrap_or_default();
+        let bytes = axum::body::to_bytes(resp.into_body(), usize::MAX)
+            .await
+            .unwrap();
+        let text = String::from_utf8(bytes.to_vec()).unwrap();
+        let json = serde_json::from_str(&text).unwrap_or(Value::Null);
+        Resp {
+            status,
+            content_type,
+            text,
+            json,
+        }
+    }
+
+    /// Asserts the route, method and status are documented and that a JSON
+    /// body validates against the documented schema.
+    pub fn check_contract(&self, method: &str, template: &str, r: &Resp) {
+        let op = &self.spec["paths"][template][method.to_lowercase()];
+        assert!(op.is_object(), "{method} {template} is not in openapi.yaml");
+        let doc = &op["responses"][r.status.as_str()];
+        assert!(
+            doc.is_object(),
+            "{method} {template} answered {} which openapi.yaml does not document: {}",
+            r.status,
+            r.text
+        );
+        if r.content_type.starts_with("application/json") {
+            let schema = &doc["content"]["application/json"]["schema"];
+            assert!(
+                schema.is_object(),
+                "{method} {template} {}: no JSON schema documented",
+                r.status
+            );
+            let root = json!({ "components": self.spec["components"], "allOf": [schema] });
+            let validator = jsonschema::validator_for(&root).expect("schema compiles");
+            let errors: Vec<String> = validator
+                .iter_errors(&r.json)
+                .map(|e| format!("{} at {}", e, e.instance_path()))
+                .collect();
+            assert!(
+                errors.is_empty(),
+                "{method} {template} {}: response violates its schema: {errors:#?}",
+                r.status
+            );
+        } else {
+            let documented: Vec<&String> = doc["content"]
+                .as_object()
+                .map(|m| m.keys().collect())
+                .unwrap_or_default();
+            let ct = r.content_type.split(';').next().unwrap_or("");
+            assert!(
+                documented.iter().any(|d| d.as_str() == ct),
+                "{method} {template} {}: content type {ct} not documented ({documented:?})",
+                r.status
+            );
+        }
+    }
+}
+
+/// The Surveyor ROV profile as JSON.
+pub fn rov_profile() -> Value {
+    serde_json::to_value(seatrial_core::planning::examples::surveyor_rov()).unwrap()
+}
+
+/// Fossen's supply vessel profile as JSON.
+pub fn dp_profile() -> Value {
+    serde_json::to_value(seatrial_core::planning::examples::supply_vessel()).unwrap()
+}
