@@ -408,6 +408,16 @@ async fn bad_input_gets_a_clear_4xx_on_every_route() {
         .await;
     assert_eq!(r.status, 404);
 
+    let r = app.raw("DELETE", "/api/vessels", None).await;
+    assert_eq!(r.status, 405);
+    assert!(
+        r.json["message"].as_str().unwrap().contains("DELETE"),
+        "{}",
+        r.text
+    );
+    let r = app.raw("GET", "/api/vessels/%FF", None).await;
+    assert!(r.status.is_client_error(), "{}", r.status);
+
     let r = app.raw("GET", "/api/no/such/route", None).await;
     assert_eq!(r.status, 404);
     assert!(r.json["message"].is_string());

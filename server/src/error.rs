@@ -40,6 +40,9 @@ pub enum ApiError {
     /// Understood but impossible or unsafe (422).
     #[error("{0}")]
     Unprocessable(#[from] PlanError),
+    /// Route exists, method does not (405).
+    #[error("{0}")]
+    MethodNotAllowed(String),
     /// Request body over the size limit (413).
     #[error("{0}")]
     TooLarge(String),
@@ -68,6 +71,7 @@ impl ApiError {
             ApiError::BadRequest { .. } => StatusCode::BAD_REQUEST,
             ApiError::NotFound(_) => StatusCode::NOT_FOUND,
             ApiError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::MethodNotAllowed(_) => StatusCode::METHOD_NOT_ALLOWED,
             ApiError::TooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
             ApiError::UnsupportedMediaType(_) => StatusCode::UNSUPPORTED_MEDIA_TYPE,
             ApiError::Database(_) | ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,

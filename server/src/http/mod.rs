@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 use axum::Router;
 use axum::extract::DefaultBodyLimit;
-use axum::http::Uri;
+use axum::http::{Method, Uri};
 use tower_http::services::ServeDir;
 use tower_http::trace::TraceLayer;
 use utoipa::OpenApi;
@@ -72,12 +72,20 @@ async fn api_not_found(uri: Uri) -> ApiError {
     ApiError::NotFound(format!("no API route {}", uri.path()))
 }
 
+async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
+    ApiError::MethodNotAllowed(format!(
+        "{method} is not allowed on {}; see openapi.yaml for the methods of each route",
+        uri.path()
+    ))
+}
+
 /// The whole application: `/api`, and the web UI from `web_dir`
 /// (uPlot from `web_dir/node_modules`, installed by `npm ci`).
 pub fn app(db: Db, web_dir: PathBuf) -> Router {
     let (api, _) = api().split_for_parts();
     let api = api
         .route("/api/{*rest}", axum::routing::any(api_not_found))
+        .method_not_allowed_fallback(method_not_allowed)
         .layer(DefaultBodyLimit::max(json::MAX_JSON_BODY));
     api.fallback_service(ServeDir::new(web_dir).append_index_html_on_directories(true))
         .layer(TraceLayer::new_for_http())
