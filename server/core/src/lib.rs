@@ -15,3 +15,4 @@
 pub mod planning;
 pub mod signals;
 pub mod spectra;
+pub mod timeseries;
