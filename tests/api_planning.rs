@@ -210,6 +210,17 @@ async fn dp_campaign_plans_the_three_decoupled_manoeuvres() {
             .starts_with("t,thr_1,thr_2,thr_3,thr_4,thr_5,thr_6\n")
     );
 
+    // Without a seed, a random one is drawn and stored (reproducible, not 0 for all).
+    let mut seeds = Vec::new();
+    for _ in 0..2 {
+        let r = app
+            .call("POST", "/api/campaigns", &[], Some(body.clone()))
+            .await;
+        seeds.push(r.json["spec"]["seed"].as_u64().unwrap());
+    }
+    assert_ne!(seeds[0], seeds[1]);
+    assert!(seeds.iter().all(|s| *s < 1 << 53));
+
     // The parallel estimator needs N ≥ 2.
     let mut one = body.clone();
     one["repetitions"] = json!(1);

@@ -34,9 +34,10 @@ pub struct NewCampaign {
     /// Durations.
     #[serde(default)]
     pub durations: Durations,
-    /// Seed of every pseudo-random sequence.
+    /// Seed of every pseudo-random sequence (0 … 2⁵³−1). When absent a random
+    /// seed is drawn and stored, so the plan stays reproducible.
     #[serde(default)]
-    pub seed: u64,
+    pub seed: Option<u64>,
 }
 
 /// Filter of the campaign list.
@@ -74,7 +75,9 @@ pub async fn create_campaign(
         repetitions: req.repetitions,
         excitation: req.excitation,
         durations: req.durations,
-        seed: req.seed,
+        seed: req.seed.unwrap_or_else(|| {
+            (uuid::Uuid::now_v7().as_u128() as u64) & seatrial_core::planning::design::MAX_SEED
+        }),
     };
     let profile = vessel.profile.clone();
     let checked = spec.clone();

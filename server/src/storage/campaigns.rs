@@ -18,6 +18,8 @@ pub struct Campaign {
     pub grid_speeds_mps: Vec<f64>,
     /// The campaign as entered.
     pub spec: CampaignSpec,
+    /// Version of the newest plan; none before the first is generated.
+    pub plan_version: Option<i64>,
 }
 
 #[derive(sqlx::FromRow)]
@@ -26,6 +28,7 @@ struct Row {
     vessel_id: String,
     spec: String,
     created_at: String,
+    plan_version: Option<i64>,
 }
 
 impl TryFrom<Row> for Campaign {
@@ -38,9 +41,13 @@ impl TryFrom<Row> for Campaign {
             created_at: r.created_at,
             grid_speeds_mps: spec.grid.speeds_si(),
             spec,
+            plan_version: r.plan_version,
         })
     }
 }
+
+const SELECT: &str = "SELECT id, vessel_id, spec, created_at, \
+    (SELECT MAX(p.version) FROM plan p WHERE p.campaign_id = campaign.id) AS plan_version FROM campaign";
 
 /// Inserts a validated campaign.
 pub async fn insert(db: &Db, vessel_id: &str, spec: CampaignSpec) -> anyhow::Result<Campaign> {
@@ -50,6 +57,7 @@ pub async fn insert(db: &Db, vessel_id: &str, spec: CampaignSpec) -> anyhow::Res
         created_at: now(),
         grid_speeds_mps: spec.grid.speeds_si(),
         spec,
+        plan_version: None,
     };
     sqlx::query(
         "INSERT INTO campaign (id, vessel_id, name, spec, created_at) VALUES ($1, $2, $3, $4, $5)",
@@ -67,18 +75,18 @@ pub async fn insert(db: &Db, vessel_id: &str, spec: CampaignSpec) -> anyhow::Res
 /// All campaigns, oldest first, optionally of one vessel.
 pub async fn list(db: &Db, vessel_id: Option<&str>) -> anyhow::Result<Vec<Campaign>> {
     let rows = match vessel_id {
-        Some(v) => sqlx::query_as::<_, Row>(
-            "SELECT id, vessel_id, spec, created_at FROM campaign WHERE vessel_id = $1 ORDER BY id",
-        )
-        .bind(v)
-        .fetch_all(db)
-        .await?,
-        None => {
-            sqlx::query_as::<_, Row>(
-                "SELECT id, vessel_id, spec, created_at FROM campaign ORDER BY id",
-            )
+        Some(v) => {
+            sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!(
+                "{SELECT} WHERE vessel_id = $1 ORDER BY id"
+            )))
+            .bind(v)
             .fetch_all(db)
             .await?
+        }
+        None => {
+            sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!("{SELECT} ORDER BY id")))
+                .fetch_all(db)
+                .await?
         }
     };
     rows.into_iter().map(Campaign::try_from).collect()
@@ -86,7 +94,7 @@ pub async fn list(db: &Db, vessel_id: Option<&str>) -> anyhow::Result<Vec<Campai
 
 /// One campaign.
 pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Campaign>> {
-    sqlx::query_as::<_, Row>("SELECT id, vessel_id, spec, created_at FROM campaign WHERE id = $1")
+    sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!("{SELECT} WHERE id = $1")))
         .bind(id)
         .fetch_optional(db)
         .await?

@@ -23,7 +23,8 @@ pub struct ChannelAnalysis {
     pub pe_cap: usize,
     /// PE order this experiment needs (2 per identified DOF; 1 for static runs).
     pub pe_required: usize,
-    /// Usable band [low, high] in Hz (within 10 dB of the PSD peak), if any.
+    /// Usable band [low, high] in Hz (within 10 dB of the PSD peak); none for
+    /// static runs, whose single step has no band to speak of.
     pub band_hz: Option<[f64; 2]>,
     /// Fraction of the signal power above the logger's Nyquist frequency.
     pub power_above_logger_nyquist: f64,
@@ -72,7 +73,7 @@ pub fn analyse(
         .windows(2)
         .fold(0.0_f64, |m, w| m.max((w[1] - w[0]).abs() * fs));
     let (band_hz, power_above_logger_nyquist) = match schedule_spectrum(x, fs) {
-        Ok(s) if x.len() >= 8 => {
+        Ok(s) if x.len() >= 8 && pe_required > 1 => {
             let total: f64 = s.values.iter().skip(1).sum();
             let above: f64 = s
                 .freqs

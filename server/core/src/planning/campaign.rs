@@ -322,6 +322,13 @@ impl CampaignSpec {
                 ));
             }
         }
+        if self.seed > super::design::MAX_SEED {
+            return Err(PlanError::over_limit(
+                "seed",
+                "seeds are limited to 2^53 − 1 so that JSON clients read them exactly",
+                super::design::MAX_SEED as f64,
+            ));
+        }
         if self.families.is_empty() {
             return Err(PlanError::invalid(
                 "families",

@@ -28,6 +28,9 @@ pub const MAX_PRBS_ORDER: u32 = 24;
 /// A chip must last at least this many logger samples to be seen.
 pub const MIN_LOGGER_SAMPLES_PER_CHIP: f64 = 2.0;
 
+/// Largest seed: 2⁵³ − 1, so seeds survive JSON in JavaScript clients exactly.
+pub const MAX_SEED: u64 = (1 << 53) - 1;
+
 /// What the designer needs to know about the channel.
 #[derive(Debug, Clone)]
 pub struct ChannelRequest<'a> {
@@ -199,7 +202,8 @@ pub fn design_channel(req: &ChannelRequest<'_>) -> Result<ChannelDesign, PlanErr
             ChannelDesign {
                 waveform: Waveform::RandomBinary {
                     clock_period_s: tc,
-                    seed: req.seed,
+                    // Channels of one run draw independent sequences.
+                    seed: (req.seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)) & MAX_SEED,
                 },
                 duration_s: (req.min_duration_s / tc).ceil() * tc,
             }

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::analysis::{ChannelAnalysis, analyse};
 use super::campaign::{CampaignSpec, ExperimentFamily, Quantity, SignalKind, SpeedUnit};
-use super::design::{ChannelRequest, SQUARE_HOLD_TIME_CONSTANTS, design_channel};
+use super::design::{ChannelRequest, MAX_SEED, SQUARE_HOLD_TIME_CONSTANTS, design_channel};
 use super::dof::{Dof, KNOT};
 use super::error::PlanError;
 use super::vessel::{ThrusterKind, VesselKind, VesselProfile};
@@ -156,7 +156,7 @@ fn run_seed(seed: u64, family: ExperimentFamily, grid: usize, dof: usize, rep: u
     for v in [family as u64, grid as u64, dof as u64, u64::from(rep)] {
         h = mix(h ^ v);
     }
-    h
+    h & MAX_SEED
 }
 
 /// A channel before sampling.
@@ -484,7 +484,7 @@ fn assemble(
             None => raw,
         };
         let x = signals::clip(&shaped, -p.limit, p.limit);
-        if p.excited {
+        if p.excited && p.waveform != Waveform::Constant {
             let a = analyse(
                 &x,
                 p.offset,
@@ -1020,7 +1020,7 @@ fn validation(ctx: &Ctx<'_>, reps: u32, out: &mut Vec<PlannedExperiment>) -> Res
                             segment_s: segment,
                             constant_fraction: 0.4,
                             clock_period_s: ctx.vessel.limit(d).time_constant_s,
-                            seed: mix(seed ^ i as u64),
+                            seed: mix(seed ^ i as u64) & MAX_SEED,
                         };
                     }
                     channels.push(ChannelSpec {

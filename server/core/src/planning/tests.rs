@@ -379,3 +379,36 @@ fn force_schedules_use_tau_columns_and_force_limits() {
     assert_eq!(ch.limit, 6000.0);
     assert_eq!(ch.rate_limit, Some(3000.0));
 }
+
+#[test]
+fn dp_validation_drives_thruster_groups_independently() {
+    let mut c = dp_campaign();
+    c.families.push(ExperimentFamily::Validation);
+    let plan = generate_plan(&supply_vessel(), &c).unwrap();
+    let val = &plan.experiments.last().unwrap().schedule.values;
+    assert_eq!(val[0], val[1], "main propellers share a signal");
+    assert_ne!(val[0], val[2], "main and tunnel groups differ");
+    assert_ne!(val[2], val[5], "tunnel and azimuth groups differ");
+}
+
+#[test]
+fn holds_carry_no_excitation_figures_and_seeds_fit_json() {
+    let plan = generate_plan(&surveyor_rov(), &rov_campaign()).unwrap();
+    let surge_static = &plan.experiments[0].experiment;
+    assert_eq!(surge_static.code, "STA-0.5kn-surge-r1");
+    assert!(surge_static.channels.iter().all(|c| c.analysis.is_none()));
+    for p in &plan.experiments {
+        for c in &p.experiment.channels {
+            let json = serde_json::to_value(&c.waveform).unwrap();
+            if let Some(seed) = json.get("seed") {
+                assert!(seed.as_u64().unwrap() < (1 << 53));
+            }
+        }
+    }
+    let mut c = rov_campaign();
+    c.seed = 1 << 60;
+    assert_eq!(
+        generate_plan(&surveyor_rov(), &c).unwrap_err().field,
+        "seed"
+    );
+}

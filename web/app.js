@@ -1,0 +1,83 @@
+// seatrial planner: hash router and page shell.
+//   #/vessels  #/vessels/new[?from=id]  #/vessels/{id}
+//   #/campaigns  #/campaigns/new[?vessel=id]  #/campaigns/{id}[/experiments/{eid}]
+
+import { api, ApiError } from './api.js';
+import { h, fill, banner, clearBanner, showFlash } from './forms.js';
+import { vesselList, vesselPage, vesselForm } from './vessels.js';
+import { campaignList, campaignForm } from './campaigns.js';
+import { campaignPage } from './plan.js';
+import { destroyPlots } from './plots.js';
+
+const view = document.getElementById('view');
+let current = null; // controller of the page shown (campaign page), if any
+let seq = 0;
+
+function parse() {
+  const raw = location.hash.replace(/^#\/?/, '');
+  const [path, qs] = raw.split('?');
+  const parts = path.split('/').filter(Boolean).map(decodeURIComponent);
+  return { parts, query: new URLSearchParams(qs || '') };
+}
+
+async function route() {
+  const { parts, query } = parse();
+  const my = ++seq;
+  const section = parts[0] || 'campaigns';
+  document.querySelectorAll('[data-nav]').forEach((a) => a.classList.toggle('active', a.dataset.nav === section));
+
+  // Experiment routes of the campaign already shown: no reload.
+  if (section === 'campaigns' && parts[1] && parts[1] !== 'new' && current && current.key === `campaign:${parts[1]}`) {
+    await current.select(parts[2] === 'experiments' ? parts[3] : null);
+    return;
+  }
+  if (current && current.destroy) current.destroy();
+  current = null;
+  destroyPlots();
+  clearBanner();
+  fill(view, h('p', { class: 'loading' }, h('span', { class: 'spinner', 'aria-hidden': 'true' }), 'Loading…'));
+  const target = h('div');
+  try {
+    let ctl = null;
+    if (section === 'vessels') {
+      if (!parts[1]) await vesselList(target);
+      else if (parts[1] === 'new') await vesselForm(target, query);
+      else await vesselPage(target, parts[1]);
+    } else if (section === 'campaigns') {
+      if (!parts[1]) await campaignList(target);
+      else if (parts[1] === 'new') await campaignForm(target, query);
+      else ctl = await campaignPage(target, parts[1]);
+    } else {
+      target.append(h('h1', null, 'Not found'), h('p', null, h('a', { href: '#/campaigns' }, 'Campaigns')));
+    }
+    if (my !== seq) { if (ctl && ctl.destroy) ctl.destroy(); return; }
+    fill(view, ...target.childNodes);
+    current = ctl;
+    showFlash();
+    if (ctl && parts[2] === 'experiments' && parts[3]) await ctl.select(parts[3]);
+    const h1 = view.querySelector('h1');
+    document.title = `${h1 ? `${h1.firstChild.textContent} · ` : ''}seatrial planner`;
+  } catch (err) {
+    if (my !== seq) return;
+    if (!(err instanceof ApiError)) console.error(err); // a bug, not an API answer
+    fill(view, h('h1', null, 'Could not load this page'), h('p', { class: 'error-text' }, err.message));
+    banner(`${err.status ? `${err.status} · ` : ''}${err.message}`);
+  }
+}
+
+async function health() {
+  const el = document.getElementById('health');
+  try {
+    const x = await api.health();
+    el.textContent = `● ${x.status} · v${x.version}`;
+    el.className = 'health ok';
+  } catch (err) {
+    el.textContent = `● ${err.message}`;
+    el.className = 'health bad';
+  }
+}
+
+window.addEventListener('hashchange', route);
+if (!location.hash) history.replaceState(null, '', '#/campaigns');
+route();
+health();
