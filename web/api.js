@@ -1,6 +1,6 @@
 // Thin client of the seatrial HTTP API (see /openapi.yaml).
 // Every non-2xx answer becomes an ApiError carrying the server's
-// ErrorBody: {status, message, field?, limit?}.
+// ErrorBody: {status, message, field?, limit?, line?, column?, run_id?}.
 
 export class ApiError extends Error {
   constructor(body, status) {
@@ -9,6 +9,10 @@ export class ApiError extends Error {
     this.status = (body && body.status) || status;
     this.field = body && body.field != null ? body.field : null;
     this.limit = body && body.limit != null ? body.limit : null;
+    // Uploads: where in which file, and the run the rejected bytes were kept as.
+    this.line = body && body.line != null ? body.line : null;
+    this.column = body && body.column != null ? body.column : null;
+    this.runId = body && body.run_id != null ? body.run_id : null;
   }
 }
 
@@ -62,11 +66,64 @@ export const api = {
   plan: (id) => request('GET', `/api/campaigns/${enc(id)}/plan`),
   generatePlan: (id) => request('POST', `/api/campaigns/${enc(id)}/plan`),
   experiment: (id, eid) => request('GET', urls.experimentJson(id, eid)),
+  runs: (id) => request('GET', `/api/campaigns/${enc(id)}/runs`),
+  run: (rid) => request('GET', `/api/runs/${enc(rid)}`),
+  quality: (rid) => request('GET', urls.quality(rid)),
+  coverage: (id) => request('GET', `/api/campaigns/${enc(id)}/coverage`),
 };
+
+/**
+ * Upload a run (multipart/form-data) with XMLHttpRequest, the only browser
+ * API that reports upload progress. `files` is {file} or {control, nav}
+ * (File/Blob), `meta` the JSON meta part (omitted when empty).
+ *   onProgress(loaded, total)  while the bytes go out
+ *   onSent()                   all bytes sent; the server now parses and scores
+ * Resolves with the Run (201); rejects with an ApiError (422: field = file,
+ * line, column, runId). Returns {promise, abort}.
+ */
+export function uploadRun(id, { files, meta }, { onProgress, onSent } = {}) {
+  const form = new FormData();
+  if (meta && Object.keys(meta).length) form.append('meta', JSON.stringify(meta));
+  for (const role of ['file', 'control', 'nav']) {
+    const f = files[role];
+    if (f) form.append(role, f, f.name || `${role}.csv`);
+  }
+  const xhr = new XMLHttpRequest();
+  const promise = new Promise((resolve, reject) => {
+    let sent = false;
+    const markSent = () => {
+      if (sent) return;
+      sent = true;
+      if (onSent) onSent();
+    };
+    xhr.upload.addEventListener('progress', (e) => {
+      if (onProgress) onProgress(e.loaded, e.lengthComputable ? e.total : null);
+      if (e.lengthComputable && e.loaded >= e.total) markSent();
+    });
+    xhr.upload.addEventListener('load', markSent);
+    xhr.addEventListener('load', () => {
+      markSent();
+      let data = null;
+      try { data = xhr.responseText ? JSON.parse(xhr.responseText) : null; } catch { data = null; }
+      if (xhr.status >= 200 && xhr.status < 300) resolve(data);
+      else reject(new ApiError(data || { message: xhr.responseText || xhr.statusText }, xhr.status));
+    });
+    xhr.addEventListener('error', () => reject(new ApiError({ status: 0, message: 'network error: the upload did not reach the server' }, 0)));
+    xhr.addEventListener('abort', () => reject(new ApiError({ status: 0, message: 'upload cancelled' }, 0)));
+    xhr.open('POST', `/api/campaigns/${enc(id)}/runs`);
+    xhr.setRequestHeader('accept', 'application/json');
+    xhr.send(form);
+  });
+  return { promise, abort: () => xhr.abort() };
+}
 
 export const urls = {
   experimentJson: (id, eid) => `/api/campaigns/${enc(id)}/plan/experiments/${enc(eid)}`,
   scheduleCsv: (id, eid) => `/api/campaigns/${enc(id)}/plan/experiments/${enc(eid)}/schedule.csv`,
   runSheet: (id) => `/api/campaigns/${enc(id)}/plan/runsheet`,
   planJson: (id) => `/api/campaigns/${enc(id)}/plan`,
+  // Raw bytes of a run: `file` (single-file run, the default), `control` or `nav`.
+  raw: (rid, role) => `/api/runs/${enc(rid)}/raw${role && role !== 'file' ? `?file=${enc(role)}` : ''}`,
+  quality: (rid) => `/api/runs/${enc(rid)}/quality`,
+  run: (rid) => `#/runs/${enc(rid)}`,
 };

@@ -1,12 +1,14 @@
 // seatrial planner: hash router and page shell.
 //   #/vessels  #/vessels/new[?from=id]  #/vessels/{id}
 //   #/campaigns  #/campaigns/new[?vessel=id]  #/campaigns/{id}[/experiments/{eid}]
+//   #/runs/{id}
 
 import { api, ApiError } from './api.js';
 import { h, fill, banner, clearBanner, showFlash } from './forms.js';
 import { vesselList, vesselPage, vesselForm } from './vessels.js';
 import { campaignList, campaignForm } from './campaigns.js';
 import { campaignPage } from './plan.js';
+import { runPage } from './runpage.js';
 import { destroyPlots } from './plots.js';
 
 const view = document.getElementById('view');
@@ -24,7 +26,8 @@ async function route() {
   const { parts, query } = parse();
   const my = ++seq;
   const section = parts[0] || 'campaigns';
-  document.querySelectorAll('[data-nav]').forEach((a) => a.classList.toggle('active', a.dataset.nav === section));
+  const navSection = section === 'runs' ? 'campaigns' : section; // runs live in their campaign
+  document.querySelectorAll('[data-nav]').forEach((a) => a.classList.toggle('active', a.dataset.nav === navSection));
 
   // Experiment routes of the campaign already shown: no reload.
   if (section === 'campaigns' && parts[1] && parts[1] !== 'new' && current && current.key === `campaign:${parts[1]}`) {
@@ -47,6 +50,8 @@ async function route() {
       if (!parts[1]) await campaignList(target);
       else if (parts[1] === 'new') await campaignForm(target, query);
       else ctl = await campaignPage(target, parts[1]);
+    } else if (section === 'runs' && parts[1]) {
+      ctl = await runPage(target, parts[1]);
     } else {
       target.append(h('h1', null, 'Not found'), h('p', null, h('a', { href: '#/campaigns' }, 'Campaigns')));
     }
@@ -54,9 +59,10 @@ async function route() {
     fill(view, ...target.childNodes);
     current = ctl;
     showFlash();
-    if (ctl && parts[2] === 'experiments' && parts[3]) await ctl.select(parts[3]);
     const h1 = view.querySelector('h1');
     document.title = `${h1 ? `${h1.firstChild.textContent} · ` : ''}seatrial planner`;
+    if (ctl && ctl.mount) await ctl.mount(); // plots need the page in the document
+    if (ctl && parts[2] === 'experiments' && parts[3]) await ctl.select(parts[3]);
   } catch (err) {
     if (my !== seq) return;
     if (!(err instanceof ApiError)) console.error(err); // a bug, not an API answer

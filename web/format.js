@@ -133,3 +133,26 @@ export function bandText(band) {
   if (band[0] === band[1]) return `${fmt(band[0])} Hz`;
   return `${fmt(band[0])}–${fmt(band[1])} Hz`;
 }
+
+/** A file size for people, e.g. "217.6 kB" (SI units; exact bytes belong in a title). */
+export function bytes(n) {
+  if (n == null || !Number.isFinite(n)) return '–';
+  if (n < 1000) return `${n} B`;
+  const units = ['kB', 'MB', 'GB', 'TB'];
+  let x = n;
+  let i = -1;
+  do { x /= 1000; i += 1; } while (x >= 1000 && i < units.length - 1);
+  return `${x >= 100 ? x.toFixed(0) : x.toFixed(1)} ${units[i]}`;
+}
+
+/** Data-quality verdicts and coverage states. */
+export const VERDICT_ICON = { good: '✓', weak: '!', insufficient: '✗', rejected: '✗' };
+export const COVERAGE_LABEL = {
+  covered: 'covered', weak: 'weak', repeat: 'fly again', missing: 'not flown',
+};
+export const COVERAGE_HELP = {
+  covered: 'a good run in every DOF the experiment excites',
+  weak: 'its best run is weak in some excited DOF: usable, but consider flying it again',
+  repeat: 'flown, but no run is usable: fly it again',
+  missing: 'not flown yet',
+};

@@ -9,6 +9,7 @@ import {
 import { h, fill, banner, clearBanner } from './forms.js';
 import { DURATIONS, gridText } from './campaigns.js';
 import { schedulePlot, psdPlot, destroyPlots } from './plots.js';
+import { runsSection } from './runs.js';
 
 const isExcitedWithAnalysis = (c) => c.excited && c.analysis;
 
@@ -77,6 +78,8 @@ export async function campaignPage(view, id) {
   const loading = h('span', { class: 'loading', hidden: true, role: 'status', 'aria-live': 'polite', 'data-testid': 'plan-loading' }, h('span', { class: 'spinner', 'aria-hidden': 'true' }), 'Generating plan…');
   const exportLinks = h('span', { class: 'actions' });
   const planHost = h('section', { class: 'plan', 'aria-label': 'Plan' });
+  const runsHost = h('section', { class: 'runs', 'aria-label': 'Runs', 'data-testid': 'runs-section' });
+  let runs = null; // the Runs section's controller
 
   const c = campaign;
   const durs = c.durations || {};
@@ -94,6 +97,8 @@ export async function campaignPage(view, id) {
       h('dt', null, 'Excitation'), h('dd', null, excitationText(c)),
       h('dt', null, 'Durations'), h('dd', null, DURATIONS.filter((d) => durs[d.key] != null).map((d) => `${d.label.toLowerCase()} ${fmt(durs[d.key])} s`).join(' · ') || 'defaults'),
       h('dt', null, 'Seed'), h('dd', { class: 'mono' }, c.seed ?? 'default')),
+    runsHost,
+    h('h2', { class: 'section-title' }, 'Plan'),
     planHost);
 
   async function generate() {
@@ -107,6 +112,7 @@ export async function campaignPage(view, id) {
       selected = null;
       if (location.hash !== `#/campaigns/${id}`) history.replaceState(null, '', `#/campaigns/${id}`);
       renderPlan();
+      if (runs) await runs.setPlan(plan);
     } catch (err) {
       banner(`${err.status ? `${err.status} · ` : ''}${err.message}${err.field ? ` [${err.field}]` : ''}`);
     } finally {
@@ -304,10 +310,14 @@ export async function campaignPage(view, id) {
   }
 
   renderPlan();
+  runs = await runsSection(runsHost, { campaign, plan });
 
   return {
     key: `campaign:${id}`,
     select,
-    destroy: destroyPlots,
+    destroy() {
+      destroyPlots();
+      runs.destroy();
+    },
   };
 }

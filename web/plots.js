@@ -1,6 +1,6 @@
 // uPlot charts: the schedule (time plot of every reference column) and the
 // PSD of the excited columns. Every live chart is reachable for tests and
-// debugging as window.__plots.{schedule,psd}.
+// debugging as window.__plots.{schedule,psd} (run plots: see runplots.js).
 
 import uPlot from '/node_modules/uplot/dist/uPlot.esm.js';
 import { fmt, unitLabel } from './format.js';
@@ -10,7 +10,7 @@ export const PALETTE = ['#1f6fb5', '#d1495b', '#2e9e5b', '#8a5cc2', '#e08a1e', '
 window.__plots = window.__plots || {};
 
 /** Axis tick label: short, no float noise, real minus sign. */
-function tick(v) {
+export function tick(v) {
   if (v == null) return '';
   if (v === 0) return '0';
   const a = Math.abs(v);
@@ -19,18 +19,18 @@ function tick(v) {
 }
 
 /** Unit of a one-sided PSD of a signal in `u`: (m/s)²/Hz, N²/Hz, 1/Hz. */
-function psdUnit(u) {
+export function psdUnit(u) {
   if (!u || u === '1') return '1/Hz';
   return /[/·]/.test(u) ? `(${u})²/Hz` : `${u}²/Hz`;
 }
 
-function hexA(hex, a) {
+export function hexA(hex, a) {
   const n = parseInt(hex.slice(1), 16);
   return `rgba(${(n >> 16) & 255},${(n >> 8) & 255},${n & 255},${a})`;
 }
 
 /** Keep a chart as wide as its host. */
-function autoSize(u, host, height) {
+export function autoSize(u, host, height) {
   let last = 0;
   let raf = 0;
   const ro = new ResizeObserver(() => {
@@ -47,7 +47,7 @@ function autoSize(u, host, height) {
   return () => { cancelAnimationFrame(raf); ro.disconnect(); };
 }
 
-function register(name, u, stop) {
+export function register(name, u, stop) {
   const old = window.__plots[name];
   if (old && old !== u && old.__stop) old.__stop();
   u.__stop = () => {
@@ -59,7 +59,7 @@ function register(name, u, stop) {
   return u;
 }
 
-const axisBase = {
+export const axisBase = {
   stroke: '#445',
   grid: { stroke: '#e3e6ea', width: 1 },
   ticks: { stroke: '#c9ced6', width: 1 },

@@ -21,6 +21,15 @@ pub struct ErrorBody {
     /// The limit that was broken, in SI units.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub limit: Option<f64>,
+    /// Line (1-based, header = 1) of an uploaded file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub line: Option<u64>,
+    /// Column name of an uploaded file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub column: Option<String>,
+    /// The run an invalid upload was stored as (nothing is lost).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub run_id: Option<String>,
 }
 
 /// Errors of the HTTP layer.
@@ -40,6 +49,20 @@ pub enum ApiError {
     /// Understood but impossible or unsafe (422).
     #[error("{0}")]
     Unprocessable(#[from] PlanError),
+    /// An upload that was stored but fails validation (422).
+    #[error("{message}")]
+    InvalidUpload {
+        /// Message.
+        message: String,
+        /// The file: `file`, `control` or `nav`.
+        field: String,
+        /// Line in that file.
+        line: Option<u64>,
+        /// Column name.
+        column: Option<String>,
+        /// The stored run.
+        run_id: String,
+    },
     /// Route exists, method does not (405).
     #[error("{0}")]
     MethodNotAllowed(String),
@@ -70,7 +93,9 @@ impl ApiError {
         match self {
             ApiError::BadRequest { .. } => StatusCode::BAD_REQUEST,
             ApiError::NotFound(_) => StatusCode::NOT_FOUND,
-            ApiError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::Unprocessable(_) | ApiError::InvalidUpload { .. } => {
+                StatusCode::UNPROCESSABLE_ENTITY
+            }
             ApiError::MethodNotAllowed(_) => StatusCode::METHOD_NOT_ALLOWED,
             ApiError::TooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
             ApiError::UnsupportedMediaType(_) => StatusCode::UNSUPPORTED_MEDIA_TYPE,
@@ -82,9 +107,30 @@ impl ApiError {
 impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
         let status = self.status();
+        let mut body = ErrorBody {
+            status: status.as_u16(),
+            message: String::new(),
+            field: None,
+            limit: None,
+            line: None,
+            column: None,
+            run_id: None,
+        };
         let (message, field, limit) = match self {
             ApiError::BadRequest { message, field } => (message, field, None),
             ApiError::Unprocessable(e) => (e.message, Some(e.field), e.limit),
+            ApiError::InvalidUpload {
+                message,
+                field,
+                line,
+                column,
+                run_id,
+            } => {
+                body.line = line;
+                body.column = column;
+                body.run_id = Some(run_id);
+                (message, Some(field), None)
+            }
             ApiError::Database(e) => {
                 tracing::error!(error = %e, "database error");
                 (
@@ -99,12 +145,9 @@ impl IntoResponse for ApiError {
             }
             other => (other.to_string(), None, None),
         };
-        let body = ErrorBody {
-            status: status.as_u16(),
-            message,
-            field,
-            limit,
-        };
+        body.message = message;
+        body.field = field;
+        body.limit = limit;
         (status, Json(body)).into_response()
     }
 }

@@ -6,4 +6,5 @@
 pub mod demo;
 pub mod error;
 pub mod http;
+pub mod processing;
 pub mod storage;

@@ -19,6 +19,12 @@ struct Args {
     /// Folder of the web UI.
     #[arg(long, env = "SEATRIAL_WEB_DIR", default_value = "web")]
     web_dir: PathBuf,
+    /// Largest upload per run, all files together (MB); larger answers 413.
+    #[arg(long, env = "SEATRIAL_MAX_UPLOAD_MB", default_value_t = 1024)]
+    max_upload_mb: u64,
+    /// Folder of uploaded files (default: `blobs/` beside the database).
+    #[arg(long, env = "SEATRIAL_BLOB_DIR")]
+    blob_dir: Option<PathBuf>,
     /// Seed the demo vessels, campaigns and plans into an empty database.
     #[arg(long, env = "SEATRIAL_DEMO")]
     demo: bool,
@@ -43,7 +49,13 @@ async fn main() -> anyhow::Result<()> {
     if args.demo && seatrial::demo::seed_if_empty(&db).await? {
         tracing::info!("seeded the demo campaigns");
     }
-    let app = seatrial::http::app(db, args.web_dir);
+    let blob_dir = args.blob_dir.clone().unwrap_or_else(|| {
+        args.db
+            .parent()
+            .map_or_else(|| PathBuf::from("blobs"), |d| d.join("blobs"))
+    });
+    let state = seatrial::http::AppState::new(db, &blob_dir, args.max_upload_mb * 1024 * 1024)?;
+    let app = seatrial::http::app(state, args.web_dir);
     let listener = tokio::net::TcpListener::bind(args.listen).await?;
     let addr = listener.local_addr()?;
     tracing::info!("seatrial listening on http://{addr}");

@@ -4,6 +4,8 @@
 
 #![allow(dead_code)]
 
+pub mod sim;
+
 use axum::Router;
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
@@ -26,14 +28,21 @@ pub struct Resp {
 
 impl TestApp {
     pub async fn new() -> Self {
+        Self::with_upload_limit(64 << 20).await
+    }
+
+    /// An app whose uploads are limited to `max_upload_bytes`.
+    pub async fn with_upload_limit(max_upload_bytes: u64) -> Self {
         let dir = tempfile::tempdir().unwrap();
         let db = seatrial::storage::open(&dir.path().join("t.db"))
             .await
             .unwrap();
+        let state =
+            seatrial::http::AppState::new(db, &dir.path().join("blobs"), max_upload_bytes).unwrap();
         let web = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("web");
         let spec = serde_json::to_value(seatrial::http::openapi()).unwrap();
         TestApp {
-            router: seatrial::http::app(db, web),
+            router: seatrial::http::app(state, web),
             spec,
             _dir: dir,
         }

@@ -12,7 +12,10 @@
 //! - [`planning`]: vessel profiles, LPV speed grid, experiment families and the
 //!   campaign plan.
 
+pub mod alignment;
+pub mod logs;
 pub mod planning;
+pub mod quality;
 pub mod signals;
 pub mod spectra;
 pub mod timeseries;

@@ -16,6 +16,8 @@ pub struct Health {
     pub version: String,
     /// Applied schema migrations.
     pub migrations: i64,
+    /// Largest upload per run (bytes): clients can refuse bigger files before sending.
+    pub max_upload_bytes: u64,
 }
 
 /// Is the service up, and its database reachable?
@@ -30,5 +32,6 @@ pub async fn health(State(s): State<AppState>) -> ApiResult<Json<Health>> {
         status: "ok".into(),
         version: env!("CARGO_PKG_VERSION").into(),
         migrations,
+        max_upload_bytes: s.max_upload_bytes,
     }))
 }

@@ -8,6 +8,7 @@ pub mod export;
 pub mod health;
 pub mod json;
 pub mod plans;
+pub mod runs;
 pub mod vessels;
 
 use std::path::PathBuf;
@@ -15,6 +16,7 @@ use std::path::PathBuf;
 use axum::Router;
 use axum::extract::DefaultBodyLimit;
 use axum::http::{Method, Uri};
+use tower_http::compression::CompressionLayer;
 use tower_http::services::ServeDir;
 use tower_http::trace::TraceLayer;
 use utoipa::OpenApi;
@@ -23,12 +25,28 @@ use utoipa_axum::routes;
 
 use crate::error::{ApiError, ErrorBody};
 use crate::storage::Db;
+use crate::storage::blobs::BlobStore;
 
 /// Shared state of the handlers.
 #[derive(Clone)]
 pub struct AppState {
     /// Database pool.
     pub db: Db,
+    /// Uploaded files, content-addressed.
+    pub blobs: BlobStore,
+    /// Largest upload (all files of a run together), bytes.
+    pub max_upload_bytes: u64,
+}
+
+impl AppState {
+    /// State over a database whose blobs live in `blob_dir`.
+    pub fn new(db: Db, blob_dir: &std::path::Path, max_upload_bytes: u64) -> std::io::Result<Self> {
+        Ok(AppState {
+            db,
+            blobs: BlobStore::open(blob_dir)?,
+            max_upload_bytes,
+        })
+    }
 }
 
 #[derive(OpenApi)]
@@ -41,7 +59,8 @@ pub struct AppState {
     components(schemas(ErrorBody)),
     tags(
         (name = "service", description = "Service health"),
-        (name = "planning", description = "Vessels, campaigns, excitation plans and their exports")
+        (name = "planning", description = "Vessels, campaigns, excitation plans and their exports"),
+        (name = "runs", description = "Uploaded logs, their alignment and data-quality reports")
     )
 )]
 struct ApiDoc;
@@ -61,6 +80,17 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(plans::get_experiment))
         .routes(routes!(plans::schedule_csv))
         .routes(routes!(plans::run_sheet))
+        .routes(routes!(runs::list_runs))
+        .routes(routes!(runs::get_run))
+        .routes(routes!(runs::raw_run))
+        .routes(routes!(runs::run_quality))
+        .routes(routes!(runs::coverage))
+        // Uploads stream to disk under their own limit (counted in the handler).
+        .merge(
+            OpenApiRouter::new()
+                .routes(routes!(runs::upload_run))
+                .layer(DefaultBodyLimit::disable()),
+        )
 }
 
 /// The OpenAPI document of the service.
@@ -81,15 +111,17 @@ async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
 
 /// The whole application: `/api`, and the web UI from `web_dir`
 /// (uPlot from `web_dir/node_modules`, installed by `npm ci`).
-pub fn app(db: Db, web_dir: PathBuf) -> Router {
+pub fn app(state: AppState, web_dir: PathBuf) -> Router {
     let (api, _) = api().split_for_parts();
     let api = api
         .route("/api/{*rest}", axum::routing::any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
         .layer(DefaultBodyLimit::max(json::MAX_JSON_BODY));
     api.fallback_service(ServeDir::new(web_dir).append_index_html_on_directories(true))
+        // Quality reports run to megabytes of JSON; ships share satellite links.
+        .layer(CompressionLayer::new())
         .layer(TraceLayer::new_for_http())
-        .with_state(AppState { db })
+        .with_state(state)
 }
 
 /// Maps a missing row to a 404 naming what was looked for.

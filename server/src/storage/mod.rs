@@ -2,8 +2,10 @@
 //! Queries use `$N` placeholders and portable SQL so that the same code can
 //! later run on PostgreSQL (see the migration's header for the conventions).
 
+pub mod blobs;
 pub mod campaigns;
 pub mod plans;
+pub mod runs;
 pub mod vessels;
 
 use std::path::Path;

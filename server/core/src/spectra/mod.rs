@@ -32,6 +32,7 @@ mod config;
 mod cross;
 mod detrend;
 mod engine;
+pub mod multichannel;
 mod phase;
 mod transfer;
 mod welch;
@@ -46,6 +47,7 @@ use serde::{Deserialize, Serialize};
 
 pub use config::{Detrend, WelchConfig, default_nperseg};
 pub use cross::{CrossSpectra, coherence, cross_spectra, csd};
+pub use multichannel::{MultiSpectra, multi_welch};
 pub use phase::unwrap_phase;
 /// Complex number type used for cross spectra and transfer estimates
 /// (re-exported from `realfft`'s `num_complex`).

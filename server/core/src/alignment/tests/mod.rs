@@ -1,0 +1,5 @@
+//! Tests of alignment against known truth (seeded generators in
+//! `test_support.rs`).
+
+mod merge;
+mod offset;

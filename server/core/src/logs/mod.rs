@@ -1,0 +1,48 @@
+//! Trial logs: the CSV contract, parsing with exact error locations,
+//! plausibility warnings, gaps, and resampling onto a uniform grid.
+//!
+//! # The log format (the contract)
+//!
+//! CSV, comma-separated, one header row, SI units and radians, NED/body
+//! frames as in Fossen. Columns by name, in any order:
+//!
+//! | columns | meaning |
+//! |---|---|
+//! | `t` | time (s), strictly increasing |
+//! | `tau_X tau_Y tau_Z tau_K tau_M tau_N` | generalized forces (N, N·m) |
+//! | `thr_1 … thr_n` | thruster commands, instead of τ for thruster-actuated vessels |
+//! | `u v w p q r` | body velocities (m/s, rad/s) |
+//! | `x y z phi theta psi` | pose (m, rad) |
+//!
+//! A vessel's file carries the columns of its modeled DOFs only (a 3-DOF DP
+//! vessel: `tau_X tau_Y tau_N` or `thr_*`; `u v r`; `x y psi`); see
+//! [`schema::required_columns`]. Missing required columns are an error; other
+//! columns are kept when fully numeric and ignored otherwise.
+//!
+//! A run may instead come as two files from unsynchronized computers: a
+//! control log ([`LogRole::Control`]: `t`, inputs, a shared channel such as
+//! depth `z`) and a navigation log ([`LogRole::Nav`]: `t`, velocities, pose,
+//! the same shared channel).
+//!
+//! # Pipeline
+//!
+//! [`parse_log`] (a reader the caller opened → [`ParsedLog`] with warnings
+//! and gaps, or the first defect as a [`LogError`] with file, line and
+//! column), then [`to_uniform`] (→ [`UniformRecord`](crate::timeseries::UniformRecord)).
+//! Gaps up to [`MAX_BRIDGE_SAMPLES`] (5) samples are interpolated; longer
+//! gaps split the run and their samples are not used
+//! (see [`uniform`]). The warning rules are in [`checks`].
+
+pub mod checks;
+pub mod error;
+pub mod gaps;
+pub mod parse;
+pub mod schema;
+pub mod uniform;
+
+pub use checks::LogWarning;
+pub use error::{LogError, LogErrorKind};
+pub use gaps::{Gap, MAX_BRIDGE_SAMPLES};
+pub use parse::{DEFAULT_MAX_ROWS, ParseOptions, ParsedLog, parse_log};
+pub use schema::{LogRole, input_columns, output_columns, pose_columns, required_columns};
+pub use uniform::{to_uniform, zoh};

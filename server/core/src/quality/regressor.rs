@@ -1,0 +1,669 @@
+//! Identifiability of the ARX regressor Φ = (Φ_y Φ_x) (thesis eq. 1.11):
+//! how many parameters can the log determine?
+//!
+//! Row t of Φ is φ(t) = [y(t−1) … y(t−na), x(t−1) … x(t−nb)] over all
+//! outputs y and inputs x, with `na = nb = lags`; rows are taken only where
+//! every lag lies inside the same valid block. Each column is the channel's
+//! deviation from its mean over the valid samples, divided by its RMS over
+//! the rows, so that units (N against m/s) do not decide which direction
+//! looks small: the singular values then measure collinearity, not scale. A
+//! constant channel gives zero columns (left unscaled).
+//!
+//! The singular values σᵢ of Φ are the square roots of the eigenvalues of
+//! the p × p Gram matrix ΦᵀΦ, accumulated row-block by row-block in
+//! O(N·p²) (in fact O(N·C²·(2·lags − 1)) for C channels: the entries of two
+//! lagged columns of the same channel pair differ only by edge terms) and
+//! decomposed with a symmetric eigen-solver; no N × N (or N × p) matrix is
+//! ever formed.
+
+use std::ops::Range;
+
+use nalgebra::{DMatrix, SymmetricEigen};
+
+use super::record::mean_rms;
+use super::{ColumnWeight, DeficientDirection, QualityError, RegressorReport};
+
+/// Lags `na = nb` when the spec gives none: the second-order ARX structure
+/// of a mass–damper DOF with a thruster lag.
+pub const DEFAULT_REGRESSOR_LAGS: usize = 2;
+
+/// A direction of Φ counts as identifiable when `σᵢ/σ₁ > 1e-3`.
+///
+/// Why 1e-3: the least-squares error along direction i is amplified by
+/// `σ₁/σᵢ` relative to the best-determined direction, so at 1e-3 a noise
+/// of 0.1 % of the signal RMS — below any sea-trial sensor — already puts
+/// an error as large as the signal on that parameter combination; below it
+/// the data do not determine it. The threshold is also far above rounding:
+/// an exactly collinear pair of columns leaves `σᵢ/σ₁ ≈ 1e-8` (the square
+/// root of the Gram matrix's rounding, ~1e-16), so it is never counted.
+pub const SINGULAR_VALUE_THRESHOLD: f64 = 1e-3;
+
+/// Most regressor columns (`lags × channels`) accepted; the eigen-solver is
+/// cubic in it. Typical: 12 channels × 2 lags = 24.
+pub const MAX_REGRESSOR_COLUMNS: usize = 256;
+
+/// A column takes part in a group of dependent columns when at least
+/// `DIRECTION_WEIGHT² = 1 %` of it lies in the deficient subspace, and two
+/// columns are grouped when their coupling in that subspace is at least as
+/// large (see [`DeficientDirection`]).
+pub const DIRECTION_WEIGHT: f64 = 0.1;
+
+/// Rows per chunk of the Gram accumulation: the chunk of every channel
+/// (12 × 256 doubles) stays in the L1 cache while all its dot products run.
+const CHUNK: usize = 256;
+
+/// Blocks whose core (rows common to all lags) is shorter than this are
+/// summed row by row.
+const MIN_CORE: usize = 64;
+
+/// The analysis and the normalized Gram matrix (unit-RMS columns, `ΦᵀΦ /
+/// n_rows`), kept for sub-regressors.
+pub(crate) struct Analysis {
+    pub report: RegressorReport,
+    pub gram: DMatrix<f64>,
+}
+
+/// Singular values and identifiable-parameter count of the ARX regressor
+/// built from `channels` named `names` — the first `n_outputs` are the
+/// outputs, the rest the inputs, as in Φ = (Φ_y Φ_x) — with `lags` lags of
+/// each, over the valid `blocks`.
+///
+/// # Errors
+/// [`QualityError::InvalidSpec`] for `names` not matching `channels`,
+/// `lags` zero or more than [`MAX_REGRESSOR_COLUMNS`] columns;
+/// [`QualityError::InvalidRecord`] for ragged channels or a block outside
+/// them; [`QualityError::NonFinite`] for a NaN or infinite sample inside a
+/// block.
+pub fn regressor_analysis(
+    names: &[&str],
+    channels: &[&[f64]],
+    n_outputs: usize,
+    blocks: &[Range<usize>],
+    lags: usize,
+) -> Result<RegressorReport, QualityError> {
+    if names.len() != channels.len() {
+        return Err(QualityError::spec(
+            "names",
+            format!("{} names for {} channels", names.len(), channels.len()),
+        ));
+    }
+    if n_outputs > channels.len() {
+        return Err(QualityError::spec(
+            "n_outputs",
+            format!("{n_outputs} outputs among {} channels", channels.len()),
+        ));
+    }
+    if lags == 0 || lags.saturating_mul(channels.len()) > MAX_REGRESSOR_COLUMNS {
+        return Err(QualityError::spec(
+            "lags",
+            format!(
+                "must be ≥ 1 with lags × channels ≤ {MAX_REGRESSOR_COLUMNS}, got {lags} × {}",
+                channels.len()
+            ),
+        ));
+    }
+    let n = channels.first().map_or(0, |c| c.len());
+    for (i, c) in channels.iter().enumerate() {
+        if c.len() != n {
+            return Err(QualityError::record(
+                format!("channels[{i}]"),
+                format!("{} samples, channels[0] has {n}", c.len()),
+            ));
+        }
+    }
+    for (i, b) in blocks.iter().enumerate() {
+        if b.start > b.end || b.end > n {
+            return Err(QualityError::record(
+                format!("blocks[{i}]"),
+                format!("{}..{} is not within {n} samples", b.start, b.end),
+            ));
+        }
+        for (name, c) in names.iter().zip(channels) {
+            if let Some(k) = c[b.clone()].iter().position(|v| !v.is_finite()) {
+                return Err(QualityError::NonFinite {
+                    field: (*name).to_owned(),
+                    index: b.start + k,
+                    message: format!("{name}[{}] is not finite", b.start + k),
+                });
+            }
+        }
+    }
+    let stats: Vec<(f64, f64)> = channels.iter().map(|x| mean_rms(x, blocks)).collect();
+    analyse(names, channels, n_outputs, &stats, blocks, lags).map(|a| a.report)
+}
+
+/// The analysis on validated input; `stats` are each channel's mean and
+/// RMS about it over the valid samples.
+pub(crate) fn analyse(
+    names: &[&str],
+    channels: &[&[f64]],
+    n_outputs: usize,
+    stats: &[(f64, f64)],
+    blocks: &[Range<usize>],
+    lags: usize,
+) -> Result<Analysis, QualityError> {
+    let p = channels.len() * lags;
+    let columns: Vec<String> = names
+        .iter()
+        .flat_map(|n| (1..=lags).map(move |l| format!("{n}(t-{l})")))
+        .collect();
+    let gram = normalized_gram(channels, stats, blocks, lags);
+    let n_rows = blocks.iter().map(|b| b.len().saturating_sub(lags)).sum();
+
+    let (sigma, vectors) = singular_values(&gram)?;
+    let s1 = sigma.first().copied().unwrap_or(0.0);
+    let singular_values: Vec<f64> = sigma
+        .iter()
+        .map(|s| if s1 > 0.0 { s / s1 } else { 0.0 })
+        .collect();
+    let identifiable = singular_values
+        .iter()
+        .filter(|&&s| s > SINGULAR_VALUE_THRESHOLD)
+        .count();
+    let null: Vec<usize> = (0..p)
+        .filter(|&i| singular_values[i] <= SINGULAR_VALUE_THRESHOLD)
+        .collect();
+    let deficient_directions = dependency_groups(
+        &vectors,
+        &null,
+        &singular_values,
+        &columns,
+        n_outputs * lags,
+    );
+    Ok(Analysis {
+        report: RegressorReport {
+            lags,
+            columns,
+            n_rows,
+            singular_values,
+            threshold: SINGULAR_VALUE_THRESHOLD,
+            identifiable,
+            n_columns: p,
+            deficient_directions,
+        },
+        gram,
+    })
+}
+
+/// Groups of (nearly) dependent columns from the deficient directions
+/// `null` (indices into the columns of `vectors`, the unit eigenvectors).
+///
+/// Eigenvectors of a repeated (near-)zero singular value are any rotation
+/// of one another, so single directions can mix unrelated dependencies
+/// (a dead input with two collinear ones). The projector `P = V₀V₀ᵀ` onto
+/// the whole deficient subspace does not depend on that choice: column k
+/// takes part when `P_kk ≥ DIRECTION_WEIGHT²` (share of the column lying in
+/// the subspace), and columns k, l belong to the same group when
+/// `|P_kl| ≥ DIRECTION_WEIGHT²` (connected components). Each group gets the
+/// number of deficient directions it holds (its trace of `P`, rounded), the
+/// largest normalized singular value among the directions mostly inside it,
+/// and the share of its trace on input columns (index ≥ `first_input`).
+fn dependency_groups(
+    vectors: &DMatrix<f64>,
+    null: &[usize],
+    sigma: &[f64],
+    columns: &[String],
+    first_input: usize,
+) -> Vec<DeficientDirection> {
+    let p = vectors.nrows();
+    if null.is_empty() {
+        return Vec::new();
+    }
+    let proj = |k: usize, l: usize| {
+        null.iter()
+            .map(|&i| vectors[(k, i)] * vectors[(l, i)])
+            .sum::<f64>()
+    };
+    let min = DIRECTION_WEIGHT * DIRECTION_WEIGHT;
+    let members: Vec<usize> = (0..p).filter(|&k| proj(k, k) >= min).collect();
+    // Connected components over |P_kl| ≥ min.
+    let mut group = vec![usize::MAX; p];
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for &start in &members {
+        if group[start] != usize::MAX {
+            continue;
+        }
+        let g = groups.len();
+        let mut stack = vec![start];
+        let mut cols = Vec::new();
+        group[start] = g;
+        while let Some(k) = stack.pop() {
+            cols.push(k);
+            for &l in &members {
+                if group[l] == usize::MAX && proj(k, l).abs() >= min {
+                    group[l] = g;
+                    stack.push(l);
+                }
+            }
+        }
+        cols.sort_unstable();
+        groups.push(cols);
+    }
+    groups
+        .into_iter()
+        .map(|cols| {
+            let diag: Vec<f64> = cols.iter().map(|&k| proj(k, k)).collect();
+            let trace: f64 = diag.iter().sum();
+            let on_inputs: f64 = cols
+                .iter()
+                .zip(&diag)
+                .filter(|(k, _)| **k >= first_input)
+                .map(|(_, d)| d)
+                .sum();
+            let energy = |i: usize| cols.iter().map(|&k| vectors[(k, i)].powi(2)).sum::<f64>();
+            let singular_value = null
+                .iter()
+                .filter(|&&i| energy(i) >= 0.5)
+                .map(|&i| sigma[i])
+                .fold(f64::NAN, f64::max);
+            let singular_value = if singular_value.is_nan() {
+                null.iter().map(|&i| sigma[i]).fold(0.0, f64::max)
+            } else {
+                singular_value
+            };
+            let weights: Vec<ColumnWeight> = cols
+                .iter()
+                .zip(&diag)
+                .map(|(&k, &d)| ColumnWeight {
+                    column: columns[k].clone(),
+                    weight: d,
+                })
+                .collect();
+            DeficientDirection {
+                dimension: trace.round().max(1.0) as usize,
+                singular_value,
+                input_share: if trace > 0.0 { on_inputs / trace } else { 0.0 },
+                columns: weights,
+            }
+        })
+        .collect()
+}
+
+/// Identifiable parameters of the sub-regressor made of the columns `cols`
+/// (a principal submatrix of the normalized Gram matrix).
+pub(crate) fn sub_identifiable(gram: &DMatrix<f64>, cols: &[usize]) -> Result<usize, QualityError> {
+    let sub = DMatrix::from_fn(cols.len(), cols.len(), |i, j| gram[(cols[i], cols[j])]);
+    let (sigma, _) = singular_values(&sub)?;
+    let s1 = sigma.first().copied().unwrap_or(0.0);
+    Ok(if s1 > 0.0 {
+        sigma
+            .iter()
+            .filter(|&&s| s / s1 > SINGULAR_VALUE_THRESHOLD)
+            .count()
+    } else {
+        0
+    })
+}
+
+/// Singular values of Φ (square roots of the Gram eigenvalues, negatives
+/// from rounding clamped to 0), descending, with the matching eigenvectors
+/// as columns.
+fn singular_values(gram: &DMatrix<f64>) -> Result<(Vec<f64>, DMatrix<f64>), QualityError> {
+    let p = gram.nrows();
+    if p == 0 {
+        return Ok((Vec::new(), DMatrix::zeros(0, 0)));
+    }
+    let eig =
+        SymmetricEigen::try_new(gram.clone(), f64::EPSILON, 1000 * p.max(10)).ok_or_else(|| {
+            QualityError::record(
+                "data",
+                "the eigen-decomposition of the regressor's Gram matrix did not converge",
+            )
+        })?;
+    let mut order: Vec<usize> = (0..p).collect();
+    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
+    let sigma = order
+        .iter()
+        .map(|&i| eig.eigenvalues[i].max(0.0).sqrt())
+        .collect();
+    let vectors = DMatrix::from_fn(p, p, |r, c| eig.eigenvectors[(r, order[c])]);
+    Ok((sigma, vectors))
+}
+
+/// `ΦᵀΦ / n_rows` with unit-RMS columns (zero columns stay zero).
+fn normalized_gram(
+    channels: &[&[f64]],
+    stats: &[(f64, f64)],
+    blocks: &[Range<usize>],
+    lags: usize,
+) -> DMatrix<f64> {
+    let p = channels.len() * lags;
+    let centre: Vec<(f64, f64)> = stats
+        .iter()
+        .map(|&(mean, rms)| (mean, if rms > 0.0 { 1.0 / rms } else { 0.0 }))
+        .collect();
+    let mut g = vec![0.0; p * p];
+    let mut n_rows = 0usize;
+    for b in blocks {
+        if b.len() <= lags {
+            continue;
+        }
+        n_rows += b.len() - lags;
+        if b.len() < 2 * lags - 1 + MIN_CORE {
+            gram_direct(channels, &centre, b.clone(), lags, &mut g);
+        } else {
+            gram_structured(channels, &centre, b.clone(), lags, &mut g);
+        }
+    }
+    let mut m = DMatrix::<f64>::zeros(p, p);
+    if n_rows == 0 {
+        return m;
+    }
+    let d: Vec<f64> = (0..p)
+        .map(|u| {
+            let v = g[u * p + u] / n_rows as f64;
+            if v > 0.0 { v.sqrt() } else { 0.0 }
+        })
+        .collect();
+    for u in 0..p {
+        for v in u..p {
+            let val = if d[u] > 0.0 && d[v] > 0.0 {
+                g[u * p + v] / n_rows as f64 / (d[u] * d[v])
+            } else {
+                0.0
+            };
+            m[(u, v)] = val;
+            m[(v, u)] = val;
+        }
+    }
+    m
+}
+
+/// Column index of channel `c` at lag `l` (1-based).
+fn col(c: usize, l: usize, lags: usize) -> usize {
+    c * lags + l - 1
+}
+
+/// Adds the rows of block `b` to the upper triangle of `g`, row by row.
+fn gram_direct(
+    channels: &[&[f64]],
+    centre: &[(f64, f64)],
+    b: Range<usize>,
+    lags: usize,
+    g: &mut [f64],
+) {
+    let p = channels.len() * lags;
+    let mut phi = vec![0.0; p];
+    for t in b.start + lags..b.end {
+        for (c, x) in channels.iter().enumerate() {
+            let (mean, scale) = centre[c];
+            for l in 1..=lags {
+                phi[col(c, l, lags)] = (x[t - l] - mean) * scale;
+            }
+        }
+        for u in 0..p {
+            for v in u..p {
+                g[u * p + v] += phi[u] * phi[v];
+            }
+        }
+    }
+}
+
+/// Adds the rows of block `b = [a, e)` to the upper triangle of `g` using
+/// the lag structure.
+///
+/// Entry `((i, l), (j, m))` is `Σ_{t=a+L}^{e−1} z_i(t−l) z_j(t−m)`
+/// `= Σ_{s ∈ [a+L−l, e−l)} z_i(s) z_j(s+δ)` with `δ = l − m`. All windows
+/// share the core `[a+L−1, e−L)`: its sums `D_ij(δ)` are computed once per
+/// channel pair and `δ ∈ −(L−1)..=L−1` (chunked, vectorised dot products),
+/// and each entry adds its `< L` head and tail terms.
+fn gram_structured(
+    channels: &[&[f64]],
+    centre: &[(f64, f64)],
+    b: Range<usize>,
+    lags: usize,
+    g: &mut [f64],
+) {
+    let nc = channels.len();
+    let p = nc * lags;
+    let nd = 2 * lags - 1; // δ + (L − 1) ∈ 0..nd
+    let margin = lags - 1;
+    let (core_start, core_end) = (b.start + lags - 1, b.end - lags);
+    let z = |c: usize, s: usize| (channels[c][s] - centre[c].0) * centre[c].1;
+
+    // Core sums D[(i·nc + j)·nd + δ + L − 1] for i ≤ j (δ ≤ 0 when i = j).
+    let mut core = vec![0.0; nc * nc * nd];
+    // For each channel i, the (j, δ + L − 1) sums it takes part in as the
+    // left factor; y window of channel j starts at margin + δ = d.
+    let combos: Vec<Vec<(usize, usize)>> = (0..nc)
+        .map(|i| {
+            (i..nc)
+                .flat_map(|j| {
+                    let d_max = if i == j { margin } else { nd - 1 };
+                    (0..=d_max).map(move |d| (j, d))
+                })
+                .collect()
+        })
+        .collect();
+    let width = CHUNK + 2 * margin;
+    let mut buf = vec![0.0; nc * width];
+    let mut s0 = core_start;
+    while s0 < core_end {
+        let w = CHUNK.min(core_end - s0);
+        let lo = s0 - margin;
+        for (c, x) in channels.iter().enumerate() {
+            let (mean, scale) = centre[c];
+            for (dst, v) in buf[c * width..c * width + w + 2 * margin]
+                .iter_mut()
+                .zip(&x[lo..lo + w + 2 * margin])
+            {
+                *dst = (v - mean) * scale;
+            }
+        }
+        for (i, combos) in combos.iter().enumerate() {
+            let xi = &buf[i * width + margin..i * width + margin + w];
+            let y = |(j, d): (usize, usize)| &buf[j * width + d..j * width + d + w];
+            let mut groups = combos.chunks_exact(4);
+            for g in &mut groups {
+                let r = dot4(xi, [y(g[0]), y(g[1]), y(g[2]), y(g[3])]);
+                for (&(j, d), v) in g.iter().zip(r) {
+                    core[(i * nc + j) * nd + d] += v;
+                }
+            }
+            for &(j, d) in groups.remainder() {
+                core[(i * nc + j) * nd + d] += dot(xi, y((j, d)));
+            }
+        }
+        s0 += w;
+    }
+
+    for i in 0..nc {
+        for j in i..nc {
+            for l in 1..=lags {
+                for m in 1..=lags {
+                    let (u, v) = (col(i, l, lags), col(j, m, lags));
+                    if u > v {
+                        continue;
+                    }
+                    let d = l + margin - m; // δ + L − 1
+                    let mut val = core[(i * nc + j) * nd + d];
+                    let head = b.start + lags - l..core_start;
+                    let tail = core_end..b.end - l;
+                    for s in head.chain(tail) {
+                        val += z(i, s) * z(j, s + l - m);
+                    }
+                    g[u * p + v] += val;
+                }
+            }
+        }
+    }
+}
+
+/// Four dot products of `x` with `y[0..4]` in one pass (each `x` load
+/// serves four products), with four partial sums each (vectorisable).
+#[inline]
+fn dot4(x: &[f64], y: [&[f64]; 4]) -> [f64; 4] {
+    let n = y.iter().fold(x.len(), |n, s| n.min(s.len()));
+    let x = &x[..n];
+    let [y0, y1, y2, y3] = y.map(|s| &s[..n]);
+    let mut acc = [[0.0f64; 4]; 4];
+    for ((((xs, a), b), c), d) in x
+        .chunks_exact(4)
+        .zip(y0.chunks_exact(4))
+        .zip(y1.chunks_exact(4))
+        .zip(y2.chunks_exact(4))
+        .zip(y3.chunks_exact(4))
+    {
+        for e in 0..4 {
+            acc[0][e] += xs[e] * a[e];
+            acc[1][e] += xs[e] * b[e];
+            acc[2][e] += xs[e] * c[e];
+            acc[3][e] += xs[e] * d[e];
+        }
+    }
+    let tail = n - n % 4;
+    let ys = [y0, y1, y2, y3];
+    let mut out = [0.0; 4];
+    for q in 0..4 {
+        let a = &acc[q];
+        let mut s = (a[0] + a[1]) + (a[2] + a[3]);
+        for e in tail..n {
+            s += x[e] * ys[q][e];
+        }
+        out[q] = s;
+    }
+    out
+}
+
+/// Dot product with eight independent partial sums (vectorisable).
+#[inline]
+fn dot(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len().min(y.len());
+    let (x, y) = (&x[..n], &y[..n]);
+    let mut acc = [0.0f64; 8];
+    let (xc, yc) = (x.chunks_exact(8), y.chunks_exact(8));
+    let (xr, yr) = (xc.remainder(), yc.remainder());
+    for (a, b) in xc.zip(yc) {
+        for k in 0..8 {
+            acc[k] += a[k] * b[k];
+        }
+    }
+    let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+    for (a, b) in xr.iter().zip(yr) {
+        s += a * b;
+    }
+    s
+}
+
+#[cfg(test)]
+#[allow(clippy::single_range_in_vec_init)] // vectors of blocks
+mod tests {
+    use super::*;
+
+    /// Gram matrix of the explicitly built, unit-RMS Φ.
+    fn gram_reference(channels: &[&[f64]], blocks: &[Range<usize>], lags: usize) -> DMatrix<f64> {
+        let p = channels.len() * lags;
+        let mut rows = Vec::new();
+        for b in blocks {
+            for t in b.start + lags..b.end {
+                let mut r = vec![0.0; p];
+                for (c, x) in channels.iter().enumerate() {
+                    let (mean, _) = mean_rms(x, blocks);
+                    for l in 1..=lags {
+                        r[col(c, l, lags)] = x[t - l] - mean;
+                    }
+                }
+                rows.push(r);
+            }
+        }
+        let n = rows.len();
+        let phi = DMatrix::from_fn(n, p, |i, j| rows[i][j]);
+        let mut g = phi.transpose() * &phi / n as f64;
+        let d: Vec<f64> = (0..p).map(|u| g[(u, u)].sqrt()).collect();
+        for u in 0..p {
+            for v in 0..p {
+                g[(u, v)] /= d[u] * d[v];
+            }
+        }
+        g
+    }
+
+    fn signals(n: usize) -> Vec<Vec<f64>> {
+        (0..4)
+            .map(|c| {
+                (0..n)
+                    .map(|t| {
+                        let t = t as f64;
+                        100.0 * c as f64
+                            + (0.37 * t * (c + 1) as f64).sin()
+                            + 0.5 * (0.011 * t * t + c as f64).cos()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn structured_gram_matches_explicit_regressor() {
+        let chans = signals(2000);
+        let refs: Vec<&[f64]> = chans.iter().map(Vec::as_slice).collect();
+        // Long blocks (structured path), a short one (direct path) and one
+        // too short for a row.
+        let blocks = vec![0..700, 705..760, 800..802, 810..2000];
+        for lags in [1, 2, 3, 5] {
+            let stats: Vec<(f64, f64)> = refs.iter().map(|x| mean_rms(x, &blocks)).collect();
+            let got = normalized_gram(&refs, &stats, &blocks, lags);
+            let want = gram_reference(&refs, &blocks, lags);
+            let err = (&got - &want).amax();
+            assert!(err < 1e-12, "lags {lags}: max error {err:e}");
+        }
+    }
+
+    #[test]
+    fn dot_kernels_handle_remainders() {
+        let x: Vec<f64> = (0..23).map(|i| i as f64).collect();
+        let y: Vec<f64> = (0..26).map(|i| 1.0 - i as f64 * 0.5).collect();
+        for n in [0, 1, 3, 4, 5, 8, 21, 23] {
+            let want = |o: usize| -> f64 { (0..n).map(|k| x[k] * y[k + o]).sum() };
+            assert!((dot(&x[..n], &y[..n]) - want(0)).abs() < 1e-12);
+            let got = dot4(&x[..n], [&y[..n], &y[1..n + 1], &y[2..n + 2], &y[3..n + 3]]);
+            for (o, g) in got.iter().enumerate() {
+                assert!((g - want(o)).abs() < 1e-12, "n {n} offset {o}");
+            }
+        }
+    }
+
+    #[test]
+    fn validation_errors_name_fields() {
+        let x = vec![1.0, 2.0, 3.0, 4.0];
+        let field = |r: Result<RegressorReport, QualityError>| r.unwrap_err().field().to_owned();
+        assert_eq!(
+            field(regressor_analysis(&["a"], &[], 0, &[0..4], 1)),
+            "names"
+        );
+        assert_eq!(
+            field(regressor_analysis(&["a"], &[&x], 0, &[0..4], 0)),
+            "lags"
+        );
+        assert_eq!(
+            field(regressor_analysis(&["a"], &[&x], 0, &[0..4], 257)),
+            "lags"
+        );
+        assert_eq!(
+            field(regressor_analysis(
+                &["a", "b"],
+                &[&x, &x[..3]],
+                0,
+                &[0..3],
+                1
+            )),
+            "channels[1]"
+        );
+        assert_eq!(
+            field(regressor_analysis(&["a"], &[&x], 0, &[0..5], 1)),
+            "blocks[0]"
+        );
+        assert_eq!(
+            field(regressor_analysis(&["a"], &[&x], 2, &[0..4], 1)),
+            "n_outputs"
+        );
+        let bad = [1.0, f64::NAN, 3.0];
+        assert_eq!(
+            field(regressor_analysis(&["a"], &[&bad], 0, &[0..3], 1)),
+            "a"
+        );
+        // Empty data: no rows, nothing identifiable, no panic.
+        let r = regressor_analysis(&["a"], &[&x], 0, &[0..1], 2).unwrap();
+        assert_eq!((r.n_rows, r.identifiable, r.n_columns), (0, 0, 2));
+    }
+}

@@ -1,0 +1,486 @@
+//! Processing of an uploaded run, off the async runtime: parse and validate
+//! the file(s), align two-file runs, resample, score data quality — and the
+//! campaign's coverage by good runs. The numerics are all in seatrial-core;
+//! this module opens the stored files and wires the steps together.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::PathBuf;
+
+use std::collections::BTreeMap;
+
+use seatrial_core::alignment::{AlignmentReport, OffsetOptions, align_logs};
+use seatrial_core::logs::Gap;
+use seatrial_core::logs::{LogRole, ParseOptions, ParsedLog, parse_log, to_uniform};
+use seatrial_core::planning::vessel::InputChannels;
+use seatrial_core::planning::{Dof, Schedule, VesselProfile};
+use seatrial_core::quality::{Adherence, DofVerdict};
+use seatrial_core::quality::{DofChannels, PlannedReference, QualitySpec, quality_report};
+use seatrial_core::timeseries::UniformRecord;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+use crate::storage::plans::{StoredExperiment, StoredPlan};
+use crate::storage::runs::Run;
+
+/// Metadata of an upload (the `meta` part).
+#[derive(Debug, Clone, Default, Deserialize, Serialize, utoipa::ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RunMeta {
+    /// The planned experiment this run flew.
+    pub experiment_id: Option<String>,
+    /// Name (default: the experiment's code, else the file name).
+    pub name: Option<String>,
+    /// The channel both computers recorded, for two-file runs (default `z`).
+    pub shared_channel: Option<String>,
+    /// Resampling rate (Hz); default the log's own rate (the lower of the two for two-file runs).
+    pub rate_hz: Option<f64>,
+}
+
+/// A warning about a run, with the file (or step) it concerns.
+#[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
+pub struct RunWarning {
+    /// `file`, `control`, `nav`, `alignment` or `quality`.
+    pub file: String,
+    /// The column it concerns.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub column: Option<String>,
+    /// What to know, in plain words.
+    pub message: String,
+}
+
+/// What processing found: sizes, rates, gaps, warnings, alignment, verdicts.
+#[derive(Debug, Clone, Default, Serialize, utoipa::ToSchema)]
+pub struct RunSummary {
+    /// Rate of the resampled record (Hz).
+    pub sample_rate_hz: f64,
+    /// Length of the record (s).
+    pub duration_s: f64,
+    /// Length of its valid (gap-free) part (s).
+    pub valid_duration_s: f64,
+    /// Data rows per file.
+    pub rows: BTreeMap<String, usize>,
+    /// Gaps per file (up to 5 missing samples bridged; longer ones split the run).
+    pub gaps: BTreeMap<String, Vec<Gap>>,
+    /// Columns kept but ignored, per file.
+    pub ignored_columns: BTreeMap<String, Vec<String>>,
+    /// Warnings in plain words.
+    pub warnings: Vec<RunWarning>,
+    /// Clock alignment of a two-file run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alignment: Option<AlignmentReport>,
+    /// Verdict per DOF, with reason and evidence.
+    pub verdicts: Vec<DofVerdict>,
+    /// How the run followed its planned schedule.
+    pub adherence: Vec<Adherence>,
+}
+
+/// Why a run was rejected: which file, where, what.
+#[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
+
+pub struct ProcessError {
+    /// `file`, `control`, `nav` or `shared_channel`.
+    pub file: String,
+    /// Line in that file (header = 1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub line: Option<u64>,
+    /// Column name.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub column: Option<String>,
+    /// What is wrong, in plain words.
+    pub message: String,
+}
+
+impl ProcessError {
+    fn new(file: &str, message: impl Into<String>) -> Self {
+        ProcessError {
+            file: file.into(),
+            line: None,
+            column: None,
+            message: message.into(),
+        }
+    }
+}
+
+impl From<seatrial_core::logs::LogError> for ProcessError {
+    fn from(e: seatrial_core::logs::LogError) -> Self {
+        ProcessError {
+            file: e.file.clone(),
+            line: e.line,
+            column: e.column.clone(),
+            message: e.message.clone(),
+        }
+    }
+}
+
+/// The outcome of processing an accepted run.
+pub struct Processed {
+    /// Summary shown with the run.
+    pub summary: Value,
+    /// The quality report, serialized once.
+    pub quality_json: String,
+}
+
+/// Largest number of rows accepted per file.
+pub const MAX_ROWS: usize = 50_000_000;
+
+fn parse(
+    vessel: &VesselProfile,
+    path: &PathBuf,
+    role: LogRole,
+    file: &str,
+    shared: Option<&str>,
+) -> Result<ParsedLog, ProcessError> {
+    let f = File::open(path)
+        .map_err(|e| ProcessError::new(file, format!("stored file unreadable: {e}")))?;
+    let opts = ParseOptions {
+        file: file.to_string(),
+        max_rows: MAX_ROWS,
+        ..ParseOptions::for_vessel(vessel, role, shared)
+    };
+    Ok(parse_log(BufReader::with_capacity(1 << 20, f), &opts)?)
+}
+
+/// For thruster-actuated vessels the DOF's input is the normalized
+/// generalized force τ_T = T·u (K = I): its direction is known from the
+/// thruster configuration matrix even though the thrust coefficients are not.
+fn add_thruster_forces(vessel: &VesselProfile, rec: &mut UniformRecord) -> Vec<String> {
+    let InputChannels::Thrusters {
+        configuration,
+        thrusters,
+    } = &vessel.inputs
+    else {
+        return Vec::new();
+    };
+    let mut names = Vec::new();
+    for (r, &d) in vessel.dofs.iter().enumerate() {
+        let name = format!("{}_T", d.force_column());
+        let mut acc = vec![0.0; rec.len()];
+        for (i, _) in thrusters.iter().enumerate() {
+            if let Some(u) = rec.column(&format!("thr_{}", i + 1)) {
+                for (a, x) in acc.iter_mut().zip(u) {
+                    *a += configuration[r][i] * x;
+                }
+            }
+        }
+        rec.names.push(name.clone());
+        rec.data.push(acc);
+        names.push(name);
+    }
+    names
+}
+
+/// The log column a planned schedule column should be compared with.
+fn logged_column(schedule_column: &str) -> String {
+    match schedule_column.strip_suffix("_ref") {
+        Some(sym) => sym.to_string(),
+        None => schedule_column.to_string(),
+    }
+}
+
+/// Parses, aligns, resamples and scores a run.
+pub fn process_run(
+    vessel: &VesselProfile,
+    files: &[(String, PathBuf)],
+    meta: &RunMeta,
+    planned: Option<&(StoredExperiment, Schedule)>,
+) -> Result<Processed, ProcessError> {
+    if let Some(r) = meta.rate_hz
+        && !(r.is_finite() && r > 0.0 && r <= 1000.0)
+    {
+        return Err(ProcessError::new(
+            "meta.rate_hz",
+            format!("must be in (0, 1000] Hz, got {r}"),
+        ));
+    }
+    let path = |role: &str| files.iter().find(|(r, _)| r == role).map(|(_, p)| p);
+    let mut summary = RunSummary::default();
+    let note = |file: &str, p: &ParsedLog, summary: &mut RunSummary| {
+        summary
+            .warnings
+            .extend(p.warnings.iter().map(|w| RunWarning {
+                file: file.into(),
+                column: w.column.clone(),
+                message: w.message.clone(),
+            }));
+        summary.rows.insert(file.into(), p.rows);
+        summary.gaps.insert(file.into(), p.gaps.clone());
+        summary
+            .ignored_columns
+            .insert(file.into(), p.ignored_columns.clone());
+    };
+    let mut rec = if let Some(p) = path("file") {
+        let parsed = parse(vessel, p, LogRole::Single, "file", None)?;
+        let (rec, _) = to_uniform(&parsed.table, meta.rate_hz)?;
+        note("file", &parsed, &mut summary);
+        rec
+    } else {
+        let shared = meta.shared_channel.as_deref().unwrap_or("z");
+        let (Some(cp), Some(np)) = (path("control"), path("nav")) else {
+            return Err(ProcessError::new(
+                "file",
+                "a run needs 'file', or 'control' and 'nav'",
+            ));
+        };
+        let control = parse(vessel, cp, LogRole::Control, "control", Some(shared))?;
+        let nav = parse(vessel, np, LogRole::Nav, "nav", Some(shared))?;
+        note("control", &control, &mut summary);
+        note("nav", &nav, &mut summary);
+        let (rec, report) = align_logs(
+            &control.table,
+            &nav.table,
+            shared,
+            meta.rate_hz,
+            &OffsetOptions::default(),
+        )
+        .map_err(|e| ProcessError::new("shared_channel", e.to_string()))?;
+        summary
+            .warnings
+            .extend(report.warnings.iter().map(|w| RunWarning {
+                file: "alignment".into(),
+                column: None,
+                message: w.clone(),
+            }));
+        summary.alignment = Some(report);
+        rec
+    };
+    let derived = add_thruster_forces(vessel, &mut rec);
+    let dofs: Vec<DofChannels> = vessel
+        .dofs
+        .iter()
+        .enumerate()
+        .map(|(i, &d)| DofChannels {
+            dof: d,
+            input: derived
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| d.force_column().to_string()),
+            output: d.velocity_symbol().to_string(),
+        })
+        .collect();
+    let inputs: Vec<String> = match &vessel.inputs {
+        InputChannels::GeneralizedForces => vessel
+            .dofs
+            .iter()
+            .map(|d| d.force_column().to_string())
+            .collect(),
+        InputChannels::Thrusters { thrusters, .. } => {
+            (1..=thrusters.len()).map(|i| format!("thr_{i}")).collect()
+        }
+    };
+    let outputs: Vec<String> = vessel
+        .dofs
+        .iter()
+        .map(|d| Dof::velocity_symbol(*d).to_string())
+        .collect();
+    let planned_ref = planned.map(|(e, s)| PlannedReference {
+        sample_rate_hz: s.sample_rate_hz,
+        columns: e
+            .experiment
+            .channels
+            .iter()
+            .zip(&s.values)
+            .filter(|(c, _)| c.excited)
+            .map(|(c, v)| (logged_column(&c.column), c.column.clone(), v.clone()))
+            .collect(),
+    });
+    let spec = QualitySpec {
+        dofs,
+        inputs,
+        outputs,
+        nperseg: None,
+        controller_rate_hz: Some(vessel.controller_rate_hz),
+        // The identified model is first order in ν (ν̇ = Aν + Bτ, thesis eq. 2.10):
+        // one lag per channel. Two lags on first-order data are collinear by
+        // construction (y(t−1) = a·y(t−2) + b·x(t−2)) and would flag every DOF.
+        regressor_lags: 1,
+        planned: planned_ref,
+    };
+    let report =
+        quality_report(&rec, &spec).map_err(|e| ProcessError::new("file", e.to_string()))?;
+    let quality_json =
+        serde_json::to_string(&report).map_err(|e| ProcessError::new("file", e.to_string()))?;
+    summary
+        .warnings
+        .extend(report.warnings.iter().map(|m| RunWarning {
+            file: "quality".into(),
+            column: None,
+            message: m.clone(),
+        }));
+    summary.sample_rate_hz = rec.sample_rate_hz;
+    summary.duration_s = rec.len() as f64 / rec.sample_rate_hz;
+    summary.valid_duration_s = rec.valid_duration_s();
+    summary.verdicts = report.dofs;
+    summary.adherence = report.adherence;
+    let summary =
+        serde_json::to_value(&summary).map_err(|e| ProcessError::new("file", e.to_string()))?;
+    Ok(Processed {
+        summary,
+        quality_json,
+    })
+}
+
+/// Coverage state of a planned experiment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, utoipa::ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum CoverageStatus {
+    /// A run with a good verdict in every excited DOF.
+    Covered,
+    /// Best run is weak in some excited DOF.
+    Weak,
+    /// Runs exist but none is usable: fly it again.
+    Repeat,
+    /// Not flown yet.
+    Missing,
+}
+
+/// One run as seen from the coverage table.
+#[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
+pub struct CoveredRun {
+    /// Run id.
+    pub run_id: String,
+    /// Name.
+    pub name: String,
+    /// Worst verdict over the experiment's DOFs (`good`, `weak`, `insufficient`), or `rejected`.
+    pub verdict: String,
+    /// The reason of that verdict.
+    pub reason: String,
+}
+
+/// Coverage of one planned experiment.
+#[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
+pub struct ExperimentCoverage {
+    /// Experiment id.
+    pub experiment_id: String,
+    /// Run order.
+    pub seq: u32,
+    /// Code.
+    pub code: String,
+    /// Family.
+    pub family: String,
+    /// State.
+    pub status: CoverageStatus,
+    /// Runs flown for it.
+    pub runs: Vec<CoveredRun>,
+}
+
+/// Coverage of a campaign's newest plan.
+#[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
+pub struct Coverage {
+    /// Plan version.
+    pub plan_version: i64,
+    /// Experiments covered by a good run.
+    pub covered: usize,
+    /// Experiments whose best run is weak.
+    pub weak: usize,
+    /// Experiments to fly again.
+    pub repeat: usize,
+    /// Experiments not flown.
+    pub missing: usize,
+    /// Per experiment, in run order.
+    pub experiments: Vec<ExperimentCoverage>,
+    /// Runs not assigned to any experiment of this plan.
+    pub unassigned_runs: Vec<String>,
+}
+
+fn rank(v: &str) -> u8 {
+    match v {
+        "good" => 3,
+        "weak" => 2,
+        "insufficient" => 1,
+        _ => 0,
+    }
+}
+
+/// The worst verdict of a run over some DOFs, with its reason.
+fn run_verdict(run: &Run, dofs: &[Dof]) -> (String, String) {
+    if run.status != "accepted" {
+        let why = run
+            .error
+            .as_ref()
+            .and_then(|e| e["message"].as_str())
+            .unwrap_or("not processed")
+            .to_string();
+        return ("rejected".into(), why);
+    }
+    let verdicts = run
+        .summary
+        .as_ref()
+        .and_then(|s| s["verdicts"].as_array().cloned())
+        .unwrap_or_default();
+    verdicts
+        .iter()
+        .filter(|v| dofs.is_empty() || dofs.iter().any(|d| Some(d.name()) == v["dof"].as_str()))
+        .min_by_key(|v| rank(v["verdict"].as_str().unwrap_or("")))
+        .map(|v| {
+            (
+                v["verdict"].as_str().unwrap_or("insufficient").to_string(),
+                v["reason"].as_str().unwrap_or("").to_string(),
+            )
+        })
+        .unwrap_or_else(|| {
+            (
+                "insufficient".into(),
+                "no verdict for the experiment's DOFs".into(),
+            )
+        })
+}
+
+/// Coverage of a plan by runs.
+pub fn coverage(plan: &StoredPlan, runs: &[Run]) -> Coverage {
+    let mut out = Coverage {
+        plan_version: plan.version,
+        covered: 0,
+        weak: 0,
+        repeat: 0,
+        missing: 0,
+        experiments: Vec::new(),
+        unassigned_runs: Vec::new(),
+    };
+    for e in &plan.experiments {
+        let mine: Vec<CoveredRun> = runs
+            .iter()
+            .filter(|r| r.experiment_id.as_deref() == Some(e.id.as_str()))
+            .map(|r| {
+                let (verdict, reason) = run_verdict(r, &e.experiment.dofs);
+                CoveredRun {
+                    run_id: r.id.clone(),
+                    name: r.name.clone(),
+                    verdict,
+                    reason,
+                }
+            })
+            .collect();
+        let best = mine.iter().map(|r| rank(&r.verdict)).max();
+        let status = match best {
+            None => CoverageStatus::Missing,
+            Some(3) => CoverageStatus::Covered,
+            Some(2) => CoverageStatus::Weak,
+            Some(_) => CoverageStatus::Repeat,
+        };
+        match status {
+            CoverageStatus::Covered => out.covered += 1,
+            CoverageStatus::Weak => out.weak += 1,
+            CoverageStatus::Repeat => out.repeat += 1,
+            CoverageStatus::Missing => out.missing += 1,
+        }
+        out.experiments.push(ExperimentCoverage {
+            experiment_id: e.id.clone(),
+            seq: e.experiment.seq,
+            code: e.experiment.code.clone(),
+            family: e.experiment.family.name().into(),
+            status,
+            runs: mine,
+        });
+    }
+    out.unassigned_runs = runs
+        .iter()
+        .filter(|r| {
+            r.experiment_id
+                .as_ref()
+                .is_none_or(|id| !plan.experiments.iter().any(|e| &e.id == id))
+        })
+        .map(|r| r.id.clone())
+        .collect();
+    out
+}
