@@ -23,9 +23,10 @@ use nalgebra::{DMatrix, SymmetricEigen};
 use super::record::mean_rms;
 use super::{ColumnWeight, DeficientDirection, QualityError, RegressorReport};
 
-/// Lags `na = nb` when the spec gives none: the second-order ARX structure
-/// of a mass–damper DOF with a thruster lag.
-pub const DEFAULT_REGRESSOR_LAGS: usize = 2;
+/// Lags `na = nb` when the spec gives none. One lag: the identified model is first order in ν (ν̇ = Aν + Bτ, thesis
+/// eq. 2.10), so Φ = (Φ_y Φ_x) holds ν(t−1) and τ(t−1). Two lags on
+/// first-order data are collinear by construction (y(t−1) = a·y(t−2) + b·x(t−2)).
+pub const DEFAULT_REGRESSOR_LAGS: usize = 1;
 
 /// A direction of Φ counts as identifiable when `σᵢ/σ₁ > 1e-3`.
 ///

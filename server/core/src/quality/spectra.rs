@@ -2,11 +2,11 @@
 //! input → output pair, |CSD|, coherence and the H1 Bode data, from one
 //! [`multi_welch`] pass.
 
-use super::fastmath::{arg_into, log10_into};
+use super::fastmath::{arg_into, log10_into, unwrap_into};
 use super::record::Prepared;
 use super::{PairSpectra, QualityError, WelchSummary};
 use crate::spectra::multichannel::multi_welch_finite;
-use crate::spectra::{Complex, WelchConfig, unwrap_phase};
+use crate::spectra::{Complex, WelchConfig};
 
 /// The spectral part of the report.
 pub(crate) struct SpectralPart {
@@ -40,6 +40,7 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
     // Finite inside the blocks: checked by `prepare`.
     let ms = multi_welch_finite(&channels, &prep.blocks, &pairs, &cfg)?;
 
+    let mut scratch = Scratch::default();
     let pair_spectra = pairs
         .iter()
         .enumerate()
@@ -50,6 +51,7 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
                 &ms.cross[p],
                 &ms.auto[i],
                 &ms.auto[o],
+                &mut scratch,
             )
         })
         .collect();
@@ -77,14 +79,16 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
 /// [`crate::spectra::TransferEstimate`] (H1 = Pxy / Pxx, 0 where Pxx = 0;
 /// numpy's `unwrap(angle(H1))`), computed without `hypot`, with
 /// `|H1| = |Pxy| / Pxx` and `arg H1 = arg Pxy` (`Pxx > 0`), and with the
-/// vectorised `atan2`/`log10` of [`super::fastmath`] (≤ 2–3 ulp). Results
-/// may differ from those functions in the last bits.
+/// vectorised `atan2`/`log10` and the fast (bit-identical) unwrap of
+/// [`super::fastmath`]. Results may differ from those functions in the
+/// last bits (≤ 2–3 ulp before unwrapping).
 fn pair_spectra(
     input: &str,
     output: &str,
     pxy: &[Complex<f64>],
     pxx: &[f64],
     pyy: &[f64],
+    scratch: &mut Scratch,
 ) -> PairSpectra {
     let nf = pxy.len();
     let inv = |p: f64| if p == 0.0 { 0.0 } else { 1.0 / p };
@@ -102,13 +106,16 @@ fn pair_spectra(
     let mut h1_magnitude_db = vec![0.0; nf];
     log10_into(&h1_magnitude, &mut h1_magnitude_db);
     h1_magnitude_db.iter_mut().for_each(|d| *d *= 20.0);
-    let mut phase = vec![0.0; nf];
-    arg_into(pxy, &mut phase);
+    let phase = &mut scratch.phase;
+    phase.resize(nf, 0.0);
+    arg_into(pxy, &mut scratch.re, &mut scratch.im, phase);
     for (p, &a) in phase.iter_mut().zip(pxx) {
         if a == 0.0 {
             *p = 0.0;
         }
     }
+    let mut h1_phase_unwrapped_rad = Vec::with_capacity(nf);
+    unwrap_into(phase, &mut h1_phase_unwrapped_rad);
     PairSpectra {
         input: input.to_owned(),
         output: output.to_owned(),
@@ -116,6 +123,14 @@ fn pair_spectra(
         coherence,
         h1_magnitude,
         h1_magnitude_db,
-        h1_phase_unwrapped_rad: unwrap_phase(&phase),
+        h1_phase_unwrapped_rad,
     }
+}
+
+/// Buffers reused from pair to pair.
+#[derive(Default)]
+struct Scratch {
+    re: Vec<f64>,
+    im: Vec<f64>,
+    phase: Vec<f64>,
 }

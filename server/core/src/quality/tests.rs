@@ -300,7 +300,10 @@ fn constant_input_is_insufficient_and_named() {
     let x = vec![5000.0; n];
     let y = rng.white(n, 0.01);
     let rec = record(10.0, vec![("tau_Y", x), ("v", y)]);
-    let r = quality_report(&rec, &sway_spec()).unwrap();
+    // Two lags, so each dead channel removes one direction per lag.
+    let mut spec = sway_spec();
+    spec.regressor_lags = 2;
+    let r = quality_report(&rec, &spec).unwrap();
     let d = &r.dofs[0];
     assert_eq!(d.verdict, Verdict::Insufficient);
     assert!(
@@ -491,6 +494,8 @@ fn same_signal_on_two_dofs_makes_both_weak() {
     let spec = QualitySpec::new(names(&["tau_Y", "tau_N"]), names(&["v", "r"]))
         .with_dof(Dof::Sway, "tau_Y", "v")
         .with_dof(Dof::Yaw, "tau_N", "r");
+    let mut spec = spec;
+    spec.regressor_lags = 2; // one collinear direction per lag
     let rep = quality_report(&rec, &spec).unwrap();
     assert_eq!(rep.regressor.n_columns - rep.regressor.identifiable, 2);
     for d in &rep.dofs {
