@@ -16,6 +16,7 @@ pub mod alignment;
 pub mod logs;
 pub mod planning;
 pub mod quality;
+pub mod rng;
 pub mod signals;
 pub mod spectra;
 pub mod timeseries;

@@ -12,6 +12,7 @@ use super::dof::{Dof, KNOT};
 use super::error::PlanError;
 use super::vessel::{ThrusterKind, VesselKind, VesselProfile};
 use super::waveform::Waveform;
+use crate::rng::mix;
 use crate::signals;
 
 /// Most samples one run may hold per channel (4 h at 1 kHz).
@@ -141,14 +142,6 @@ pub struct Plan {
     pub experiments: Vec<PlannedExperiment>,
     /// Totals.
     pub totals: PlanTotals,
-}
-
-/// SplitMix64 mixing: independent, reproducible seeds per run.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 fn run_seed(seed: u64, family: ExperimentFamily, grid: usize, dof: usize, rep: u32) -> u64 {

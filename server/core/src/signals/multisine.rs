@@ -15,6 +15,7 @@
 //! ±1 chips held for a clock period, whose expected spectrum has the same
 //! sinc² shape as a PRBS with the same clock.
 
+use crate::rng::SplitMix64;
 use realfft::RealFftPlanner;
 use realfft::num_complex::Complex;
 
@@ -210,24 +211,9 @@ pub fn crest_factor(x: &[f64]) -> f64 {
     if rms > 0.0 { peak / rms } else { f64::NAN }
 }
 
-/// SplitMix64 (Steele, Lea & Flood 2014): a tiny, well-mixed, seedable
-/// generator; every seed (including 0) gives a full-quality stream.
-#[derive(Debug, Clone)]
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// One fair coin flip from the best-mixed (top) bit.
-    fn next_bit(&mut self) -> bool {
-        self.next_u64() >> 63 == 1
-    }
+/// One fair coin flip from the best-mixed (top) bit of a SplitMix64 stream.
+fn next_bit(rng: &mut SplitMix64) -> bool {
+    rng.next_u64() >> 63 == 1
 }
 
 /// Sample a random binary signal: i.i.d. fair chips of `offset ± amplitude`,
@@ -257,14 +243,14 @@ pub fn random_binary(
     let samples_per_chip = clock_period_s * sample_rate_hz;
     let high = offset + amplitude;
     let low = offset - amplitude;
-    let mut rng = SplitMix64(seed);
-    let mut current_bit = rng.next_bit();
+    let mut rng = SplitMix64::new(seed);
+    let mut current_bit = next_bit(&mut rng);
     let mut current_chip: u64 = 0;
     let mut out = try_vec::<f64>("duration_s", n)?;
     for k in 0..n {
         let idx = chip_index(k, samples_per_chip);
         while current_chip < idx {
-            current_bit = rng.next_bit();
+            current_bit = next_bit(&mut rng);
             current_chip += 1;
         }
         out.push(if current_bit { high } else { low });

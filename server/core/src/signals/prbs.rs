@@ -296,11 +296,9 @@ mod tests {
 
     /// Tiny SplitMix64 for picking test lags.
     fn splitmix(state: &mut u64) -> u64 {
+        let out = crate::rng::mix(*state);
         *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        out
     }
 
     fn periodic_autocorr(x: &[i8], k: usize) -> i64 {
