@@ -11,7 +11,9 @@ use std::collections::BTreeMap;
 
 use seatrial_core::alignment::{AlignmentReport, OffsetOptions, align_logs};
 use seatrial_core::logs::Gap;
-use seatrial_core::logs::{LogRole, ParseOptions, ParsedLog, parse_log, to_uniform};
+use seatrial_core::logs::{
+    LogRole, ParseOptions, ParsedLog, input_columns, output_columns, parse_log, to_uniform,
+};
 use seatrial_core::planning::vessel::InputChannels;
 use seatrial_core::planning::{Dof, Schedule, VesselProfile};
 use seatrial_core::quality::{Adherence, DofVerdict};
@@ -258,21 +260,8 @@ pub fn process_run(
             output: d.velocity_symbol().to_string(),
         })
         .collect();
-    let inputs: Vec<String> = match &vessel.inputs {
-        InputChannels::GeneralizedForces => vessel
-            .dofs
-            .iter()
-            .map(|d| d.force_column().to_string())
-            .collect(),
-        InputChannels::Thrusters { thrusters, .. } => {
-            (1..=thrusters.len()).map(|i| format!("thr_{i}")).collect()
-        }
-    };
-    let outputs: Vec<String> = vessel
-        .dofs
-        .iter()
-        .map(|d| Dof::velocity_symbol(*d).to_string())
-        .collect();
+    let inputs = input_columns(vessel);
+    let outputs = output_columns(vessel);
     let planned_ref = planned.map(|(e, s)| PlannedReference {
         sample_rate_hz: s.sample_rate_hz,
         columns: e

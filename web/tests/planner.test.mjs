@@ -12,118 +12,19 @@
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { mkdtempSync, rmSync, readFileSync, existsSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { chromium } from 'playwright-core';
+import { readFileSync } from 'node:fs';
 import { SURVEYOR_ROV } from '../templates.js';
+import { harness, tid } from './harness.mjs';
 
-const WEB = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
-const REPO = path.resolve(WEB, '..');
-const BIN = process.env.SEATRIAL_BIN || path.join(REPO, 'target/release/seatrial');
-const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
-const ARGS = [
-  '--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic',
-];
-
-let server;
-let serverLog = '';
-let base;
-let browser;
-let tmp;
-
-function stopServer() {
-  if (server && server.exitCode === null && server.signalCode === null) server.kill('SIGKILL');
-}
-process.on('exit', stopServer);
-
-function startServer() {
-  tmp = mkdtempSync(path.join(tmpdir(), 'seatrial-web-'));
-  assert.ok(existsSync(BIN), `seatrial binary not found at ${BIN} (cargo build --release, or set SEATRIAL_BIN)`);
-  server = spawn(BIN, ['--db', path.join(tmp, 'db.sqlite'), '--listen', '127.0.0.1:0', '--web-dir', WEB], {
-    stdio: ['ignore', 'pipe', 'pipe'],
-  });
-  return new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error(`server did not start in 20 s:\n${serverLog}`)), 20000);
-    let buf = '';
-    server.stdout.on('data', (d) => {
-      serverLog += d;
-      buf += d;
-      // eslint-disable-next-line no-control-regex
-      const m = buf.replace(/\x1b\[[0-9;]*m/g, '').match(/seatrial listening on (http:\/\/[^\s/]+)/);
-      if (m) { clearTimeout(timer); resolve(m[1]); }
-    });
-    server.stderr.on('data', (d) => { serverLog += d; });
-    server.on('exit', (code, sig) => { clearTimeout(timer); reject(new Error(`server exited (${code ?? sig}):\n${serverLog}`)); });
-    server.on('error', (e) => { clearTimeout(timer); reject(e); });
-  });
-}
-
-before(async () => {
-  base = await startServer();
-  browser = await chromium.launch({ executablePath: CHROMIUM, args: ARGS, headless: true });
-});
-
-after(async () => {
-  if (browser) await browser.close().catch(() => {});
-  if (server && server.exitCode === null && server.signalCode === null) {
-    const gone = new Promise((r) => server.once('exit', r));
-    server.kill('SIGTERM');
-    await Promise.race([gone, new Promise((r) => setTimeout(r, 3000))]);
-    stopServer();
-  }
-  if (tmp) rmSync(tmp, { recursive: true, force: true });
-});
-
-/**
- * A fresh page that records every page error, console error and HTTP error
- * response. `allow` lists the HTTP errors the scenario expects, e.g. the 404
- * of GET …/plan before a campaign is planned (the API has no other way to
- * tell) or the 422 of an impossible campaign. The browser's own
- * "Failed to load resource" console line for those is not an app error.
- */
-async function openPage(allow = []) {
-  const context = await browser.newContext({ viewport: { width: 1600, height: 1000 }, acceptDownloads: true });
-  const page = await context.newPage();
-  page.setDefaultTimeout(10000);
-  const problems = [];
-  page.on('pageerror', (e) => problems.push(`pageerror: ${e.message}`));
-  page.on('console', (m) => {
-    if (m.type() === 'error' && !/^Failed to load resource: the server responded with a status of/.test(m.text())) {
-      problems.push(`console.error: ${m.text()}`);
-    }
-  });
-  page.on('response', (r) => {
-    if (r.status() < 400) return;
-    const { pathname } = new URL(r.url());
-    const method = r.request().method();
-    if (!allow.some((a) => a.method === method && a.status === r.status() && a.path.test(pathname))) {
-      problems.push(`HTTP ${r.status()} ${method} ${pathname}`);
-    }
-  });
-  return { page, context, problems };
-}
-
-/** Run a scenario on a fresh page; page problems and the server log explain failures. */
-async function withPage(allow, fn) {
-  const { page, context, problems } = await openPage(allow);
-  try {
-    await fn(page);
-    assert.deepEqual(problems, [], 'no page errors, console errors or unexpected HTTP errors');
-  } catch (e) {
-    if (problems.length) e.message += `\npage problems:\n  ${problems.join('\n  ')}`;
-    e.message += `\nserver log (tail):\n${serverLog.slice(-1500)}`;
-    throw e;
-  } finally {
-    await context.close();
-  }
-}
+// Server, browser and the page-problem recorder are shared with runs.test.mjs.
+// `allow` lists the HTTP errors a scenario expects, e.g. the 404 of GET …/plan
+// before a campaign is planned or the 422 of an impossible campaign.
+const H = harness();
+before(H.start);
+after(H.stop);
+const withPage = (allow, fn) => H.withPage(allow, fn);
 
 const PLAN_404 = { method: 'GET', status: 404, path: /^\/api\/campaigns\/[^/]+\/plan$/ };
-const tid = (id) => `[data-testid="${id}"]`;
 
 async function rows(page) {
   return page.locator(tid('plan-row')).count();
@@ -134,7 +35,7 @@ async function waitRows(page, n) {
 }
 
 async function createVesselFromTemplate(page, template, name) {
-  await page.goto(`${base}/`);
+  await page.goto(`${H.base}/`);
   await page.click(tid('nav-vessels'));
   await page.click(tid('new-vessel'));
   await page.click(tid(template));
@@ -148,7 +49,7 @@ async function createVesselFromTemplate(page, template, name) {
 test('ROV: vessel from template → campaign on a filled grid → plan → experiment plot, zoom, CSV', async () => {
   await withPage([PLAN_404], async (page) => {
     // Vessel through the form, from the Surveyor template.
-    await page.goto(`${base}/`);
+    await page.goto(`${H.base}/`);
     await page.click(tid('nav-vessels'));
     await page.click(tid('new-vessel'));
     await page.click(tid('template-rov'));
@@ -260,11 +161,11 @@ test('ROV: vessel from template → campaign on a filled grid → plan → exper
 
     // The other exports answer.
     const json = await page.getAttribute(tid('download-json'), 'href');
-    const sched = await (await page.request.get(base + json)).json();
+    const sched = await (await page.request.get(H.base + json)).json();
     assert.equal(sched.t.length, samples);
     const sheet = await page.getAttribute(tid('runsheet-link'), 'href');
     assert.equal(await page.getAttribute(tid('runsheet-link'), 'target'), '_blank');
-    const res = await page.request.get(base + sheet);
+    const res = await page.request.get(H.base + sheet);
     assert.equal(res.status(), 200);
     assert.match(res.headers()['content-type'], /text\/html/);
 
@@ -302,10 +203,10 @@ test('DP: supply vessel template, three decoupled manoeuvres, N = 2 at 0 m/s →
 test('impossible grid: 5 kn above the ROV’s 4.3 kn shows the server’s 422 on that speed', async () => {
   const CAMPAIGN_422 = { method: 'POST', status: 422, path: /^\/api\/campaigns$/ };
   await withPage([CAMPAIGN_422, PLAN_404], async (page) => {
-    const res = await page.request.post(`${base}/api/vessels`, { data: { ...SURVEYOR_ROV, name: 'Surveyor ROV (422)' } });
+    const res = await page.request.post(`${H.base}/api/vessels`, { data: { ...SURVEYOR_ROV, name: 'Surveyor ROV (422)' } });
     assert.equal(res.status(), 201);
     const vessel = await res.json();
-    await page.goto(`${base}/#/campaigns/new?vessel=${vessel.id}`);
+    await page.goto(`${H.base}/#/campaigns/new?vessel=${vessel.id}`);
     await page.fill(tid('campaign-name'), 'too fast');
     await page.selectOption(tid('grid-unit'), 'kn');
     await page.fill(tid('grid-from'), '0.5');
