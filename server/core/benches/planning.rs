@@ -5,50 +5,18 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use seatrial_core::planning::analysis::schedule_spectrum;
-use seatrial_core::planning::campaign::{Durations, Excitation};
-use seatrial_core::planning::examples::{supply_vessel, surveyor_rov};
-use seatrial_core::planning::{
-    CampaignSpec, ExperimentFamily, SpeedGrid, SpeedUnit, generate_plan,
+use seatrial_core::planning::examples::{
+    supply_vessel, supply_vessel_campaign, surveyor_campaign, surveyor_rov,
 };
+use seatrial_core::planning::{CampaignSpec, generate_plan};
 use seatrial_core::signals;
 
 fn rov() -> CampaignSpec {
-    CampaignSpec {
-        name: "bench".into(),
-        grid: SpeedGrid {
-            unit: SpeedUnit::Knots,
-            speeds: vec![0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5],
-        },
-        families: vec![
-            ExperimentFamily::Static,
-            ExperimentFamily::Dynamic,
-            ExperimentFamily::Recursive,
-            ExperimentFamily::Validation,
-        ],
-        repetitions: None,
-        excitation: Excitation::default(),
-        durations: Durations::default(),
-        seed: 1,
-    }
+    surveyor_campaign(1)
 }
 
 fn dp() -> CampaignSpec {
-    CampaignSpec {
-        name: "bench".into(),
-        grid: SpeedGrid {
-            unit: SpeedUnit::MetersPerSecond,
-            speeds: vec![0.0],
-        },
-        families: vec![
-            ExperimentFamily::DpSurge,
-            ExperimentFamily::DpSwayYaw,
-            ExperimentFamily::DpAzimuth,
-        ],
-        repetitions: Some(2),
-        excitation: Excitation::default(),
-        durations: Durations::default(),
-        seed: 1,
-    }
+    supply_vessel_campaign(1)
 }
 
 fn bench(c: &mut Criterion) {

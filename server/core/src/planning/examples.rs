@@ -3,6 +3,9 @@
 
 use std::collections::BTreeMap;
 
+use super::campaign::{
+    CampaignSpec, Durations, Excitation, ExperimentFamily, SpeedGrid, SpeedUnit,
+};
 use super::dof::{Dof, KNOT};
 use super::vessel::{DofLimits, InputChannels, Thruster, ThrusterKind, VesselKind, VesselProfile};
 
@@ -92,5 +95,48 @@ pub fn supply_vessel() -> VesselProfile {
         limits,
         controller_rate_hz: 1.0,
         logger_rate_hz: 1.0,
+    }
+}
+
+/// The thesis's campaign for the Surveyor: grid {0.5, …, 3.5} kn (4.0 kn
+/// proved unsafe, thesis sec. 1.6), all four ROV families, one repetition.
+pub fn surveyor_campaign(seed: u64) -> CampaignSpec {
+    CampaignSpec {
+        name: "Surveyor ROV – LPV campaign 0.5–3.5 kn".into(),
+        grid: SpeedGrid {
+            unit: SpeedUnit::Knots,
+            speeds: vec![0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5],
+        },
+        families: vec![
+            ExperimentFamily::Static,
+            ExperimentFamily::Dynamic,
+            ExperimentFamily::Recursive,
+            ExperimentFamily::Validation,
+        ],
+        repetitions: None,
+        excitation: Excitation::default(),
+        durations: Durations::default(),
+        seed,
+    }
+}
+
+/// Fossen et al.'s three decoupled manoeuvres SI1 → SI2 → SI3 at rest,
+/// N = 2 each for the parallel EKF.
+pub fn supply_vessel_campaign(seed: u64) -> CampaignSpec {
+    CampaignSpec {
+        name: "Supply vessel – decoupled DP manoeuvres SI1→SI2→SI3".into(),
+        grid: SpeedGrid {
+            unit: SpeedUnit::MetersPerSecond,
+            speeds: vec![0.0],
+        },
+        families: vec![
+            ExperimentFamily::DpSurge,
+            ExperimentFamily::DpSwayYaw,
+            ExperimentFamily::DpAzimuth,
+        ],
+        repetitions: Some(2),
+        excitation: Excitation::default(),
+        durations: Durations::default(),
+        seed,
     }
 }

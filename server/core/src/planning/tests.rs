@@ -1,48 +1,17 @@
 //! Plan-level tests: the thesis's experiment counts, limits respected by every
 //! sample, determinism, PE and the errors that name their field.
 
-use super::campaign::{DofExcitation, Durations, Excitation};
-use super::examples::{supply_vessel, surveyor_rov};
+use super::campaign::DofExcitation;
+use super::examples::{supply_vessel, supply_vessel_campaign, surveyor_campaign, surveyor_rov};
 use super::*;
 use crate::signals;
 
 fn rov_campaign() -> CampaignSpec {
-    CampaignSpec {
-        name: "Stril Explorer".into(),
-        grid: SpeedGrid {
-            unit: SpeedUnit::Knots,
-            speeds: vec![0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5],
-        },
-        families: vec![
-            ExperimentFamily::Static,
-            ExperimentFamily::Dynamic,
-            ExperimentFamily::Recursive,
-            ExperimentFamily::Validation,
-        ],
-        repetitions: None,
-        excitation: Excitation::default(),
-        durations: Durations::default(),
-        seed: 42,
-    }
+    surveyor_campaign(42)
 }
 
 fn dp_campaign() -> CampaignSpec {
-    CampaignSpec {
-        name: "North Sea DP trial".into(),
-        grid: SpeedGrid {
-            unit: SpeedUnit::MetersPerSecond,
-            speeds: vec![0.0],
-        },
-        families: vec![
-            ExperimentFamily::DpSurge,
-            ExperimentFamily::DpSwayYaw,
-            ExperimentFamily::DpAzimuth,
-        ],
-        repetitions: Some(2),
-        excitation: Excitation::default(),
-        durations: Durations::default(),
-        seed: 7,
-    }
+    supply_vessel_campaign(7)
 }
 
 #[test]
