@@ -103,46 +103,6 @@ fn atan2_core(y: f64, x: f64) -> f64 {
     if y.is_sign_negative() { -a } else { a }
 }
 
-/// numpy's `unwrap(p)` (default `discont = π`, `period = 2π`), equal bit
-/// for bit to [`crate::spectra::unwrap_phase`]: the floor-modulo that maps
-/// a jump into `[−π, π)` is only evaluated for the rare jumps of at least
-/// π, where that function evaluates it for every sample (it is discarded
-/// below π). Written into `out` (cleared first).
-pub(crate) fn unwrap_into(phase: &[f64], out: &mut Vec<f64>) {
-    let period = 2.0 * PI;
-    let (high, low) = (PI, -PI);
-    out.clear();
-    let Some(&first) = phase.first() else {
-        return;
-    };
-    out.push(first);
-    let mut correction = 0.0;
-    for w in phase.windows(2) {
-        let dd = w[1] - w[0];
-        // Small jumps (the vast majority) need no correction; NaN goes the
-        // slow way, as numpy.
-        let small = dd.abs() < high;
-        if !small {
-            let mut ddmod = py_mod(dd - low, period) + low;
-            if ddmod == low && dd > 0.0 {
-                ddmod = high;
-            }
-            correction += ddmod - dd;
-        }
-        out.push(w[1] + correction);
-    }
-}
-
-/// Floor-division remainder with the sign of `b` (numpy's `np.mod`).
-fn py_mod(a: f64, b: f64) -> f64 {
-    let m = a % b;
-    if m != 0.0 {
-        if (b < 0.0) != (m < 0.0) { m + b } else { m }
-    } else {
-        0.0f64.copysign(b)
-    }
-}
-
 /// `out[k] = log10(v[k])` (same conventions as [`f64::log10`]).
 pub(crate) fn log10_into(v: &[f64], out: &mut [f64]) {
     for (o, &x) in out.iter_mut().zip(v) {
@@ -300,37 +260,6 @@ mod tests {
         }
         assert_eq!(out[v.len() - 12], 0.0);
         assert!((out[v.len() - 11] - 1.0).abs() <= f64::EPSILON);
-    }
-
-    #[test]
-    fn unwrap_is_bit_identical_to_spectra_unwrap_phase() {
-        let mut r = Lcg(11);
-        let mut p: Vec<f64> = Vec::new();
-        let mut acc = 0.0;
-        for k in 0..50_000 {
-            // Small steps, wraps, exact ±π jumps, huge jumps.
-            acc += match k % 7 {
-                0 => 7.0 * (r.next() - 0.5),
-                1 => PI,
-                2 => -PI,
-                3 => 40.0 * (r.next() - 0.5),
-                _ => 0.3 * (r.next() - 0.5),
-            };
-            p.push((acc + PI).rem_euclid(2.0 * PI) - PI + if k % 11 == 0 { 2.0 * PI } else { 0.0 });
-        }
-        p[777] = f64::NAN;
-        let want = crate::spectra::unwrap_phase(&p);
-        let mut got = Vec::new();
-        unwrap_into(&p, &mut got);
-        assert_eq!(got.len(), want.len());
-        for (k, (a, b)) in got.iter().zip(&want).enumerate() {
-            assert!(
-                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
-                "{k}: {a} vs {b}"
-            );
-        }
-        unwrap_into(&[], &mut got);
-        assert!(got.is_empty());
     }
 
     #[test]

@@ -2,10 +2,11 @@
 //! input → output pair, |CSD|, coherence and the H1 Bode data, from one
 //! [`multi_welch`] pass.
 
-use super::fastmath::{arg_into, log10_into, unwrap_into};
+use super::fastmath::{arg_into, log10_into};
 use super::record::Prepared;
 use super::{PairSpectra, QualityError, WelchSummary};
 use crate::spectra::multichannel::multi_welch_finite;
+use crate::spectra::unwrap_into;
 use crate::spectra::{Complex, WelchConfig};
 
 /// The spectral part of the report.

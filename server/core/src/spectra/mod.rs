@@ -48,6 +48,7 @@ use serde::{Deserialize, Serialize};
 pub use config::{Detrend, WelchConfig, default_nperseg};
 pub use cross::{CrossSpectra, coherence, cross_spectra, csd};
 pub use multichannel::{MultiSpectra, multi_welch};
+pub(crate) use phase::unwrap_into;
 pub use phase::unwrap_phase;
 /// Complex number type used for cross spectra and transfer estimates
 /// (re-exported from `realfft`'s `num_complex`).

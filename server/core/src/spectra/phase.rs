@@ -11,29 +11,35 @@ use std::f64::consts::PI;
 /// Non-finite samples propagate as in numpy (the output becomes NaN from
 /// there on).
 pub fn unwrap_phase(phase: &[f64]) -> Vec<f64> {
-    let period = 2.0 * PI;
-    let high = period / 2.0;
-    let low = -high;
     let mut out = Vec::with_capacity(phase.len());
+    unwrap_into(phase, &mut out);
+    out
+}
+
+/// [`unwrap_phase`] into `out` (cleared first), for callers that reuse a
+/// buffer. The floor-modulo that maps a jump into `[−π, π)` is evaluated
+/// only for the rare jumps of at least π: smaller ones need no correction.
+/// NaN jumps take the slow path, as in numpy.
+pub(crate) fn unwrap_into(phase: &[f64], out: &mut Vec<f64>) {
+    let period = 2.0 * PI;
+    let (high, low) = (PI, -PI);
+    out.clear();
     let Some(&first) = phase.first() else {
-        return out;
+        return;
     };
     out.push(first);
     let mut correction = 0.0;
     for w in phase.windows(2) {
         let dd = w[1] - w[0];
-        let mut ddmod = py_mod(dd - low, period) + low;
-        if ddmod == low && dd > 0.0 {
-            ddmod = high;
+        if dd.is_nan() || dd.abs() >= high {
+            let mut ddmod = py_mod(dd - low, period) + low;
+            if ddmod == low && dd > 0.0 {
+                ddmod = high;
+            }
+            correction += ddmod - dd;
         }
-        let mut ph_correct = ddmod - dd;
-        if dd.abs() < high {
-            ph_correct = 0.0;
-        }
-        correction += ph_correct;
         out.push(w[1] + correction);
     }
-    out
 }
 
 /// Floor-division remainder with the sign of `b` (numpy's `np.mod` for
@@ -50,6 +56,49 @@ fn py_mod(a: f64, b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// numpy's loop as written: the modulo for every sample, discarded below π.
+    fn unwrap_reference(phase: &[f64]) -> Vec<f64> {
+        let (period, high, low) = (2.0 * PI, PI, -PI);
+        let mut out = Vec::with_capacity(phase.len());
+        let Some(&first) = phase.first() else {
+            return out;
+        };
+        out.push(first);
+        let mut correction = 0.0;
+        for w in phase.windows(2) {
+            let dd = w[1] - w[0];
+            let mut ddmod = py_mod(dd - low, period) + low;
+            if ddmod == low && dd > 0.0 {
+                ddmod = high;
+            }
+            let mut ph_correct = ddmod - dd;
+            if dd.abs() < high {
+                ph_correct = 0.0;
+            }
+            correction += ph_correct;
+            out.push(w[1] + correction);
+        }
+        out
+    }
+
+    #[test]
+    fn fast_path_is_bit_identical_to_the_reference_loop() {
+        // Wrapped ramps, exact ±π jumps, large jumps, NaN.
+        let mut p: Vec<f64> = (0..5000)
+            .map(|i| ((i as f64) * 0.731).sin() * 4.0)
+            .collect();
+        p.extend([PI, 0.0, -PI, 0.0, 7.0, -7.0, f64::NAN, 1.0]);
+        let want = unwrap_reference(&p);
+        let got = unwrap_phase(&p);
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                g.to_bits() == w.to_bits() || (g.is_nan() && w.is_nan()),
+                "{g} vs {w}"
+            );
+        }
+    }
 
     #[test]
     fn unwraps_a_linear_ramp() {
