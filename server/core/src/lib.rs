@@ -11,12 +11,23 @@
 //!   with `scipy.signal`'s definitions.
 //! - [`planning`]: vessel profiles, LPV speed grid, experiment families and the
 //!   campaign plan.
+//! - [`models`]: state-space and Fossen-form vessel models (M, D, C(ν), g(η)),
+//!   ZOH discretization, LPV models scheduled on forward speed.
+//! - [`simulation`]: truth simulators (6-DOF ROV, 3-DOF DP ship) that the
+//!   estimators are proven against.
+//! - [`estimation`]: restoring forces, λ-filter Kalman identification,
+//!   parallel state-augmented EKF, N4SID.
+//! - [`validation`]: prediction and simulation NRMSE, residual tests.
 
 pub mod alignment;
+pub mod estimation;
 pub mod logs;
+pub mod models;
 pub mod planning;
 pub mod quality;
 pub mod rng;
 pub mod signals;
+pub mod simulation;
 pub mod spectra;
 pub mod timeseries;
+pub mod validation;

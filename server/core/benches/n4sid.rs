@@ -1,0 +1,2 @@
+//! Benchmark placeholder (work in progress).
+fn main() {}

@@ -1,0 +1,6 @@
+//! Validation of identified models on runs not used for estimation
+//! (thesis sec. 2.6): prediction and simulation NRMSE, residual tests.
+
+pub mod predictor;
+
+pub use predictor::{Predictor, ValidationRecord};
