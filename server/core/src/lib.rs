@@ -18,8 +18,11 @@
 //! - [`estimation`]: restoring forces, λ-filter Kalman identification,
 //!   parallel state-augmented EKF, N4SID.
 //! - [`validation`]: prediction and simulation NRMSE, residual tests.
+//! - [`discrepancy`]: missing-physics discovery — locate where a model and
+//!   the recordings part, name the left-out physics, model it.
 
 pub mod alignment;
+pub mod discrepancy;
 pub mod estimation;
 pub mod logs;
 pub mod models;
