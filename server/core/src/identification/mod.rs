@@ -1,7 +1,12 @@
 //! Campaign identification: from stored runs (records plus what the plan says
 //! they were) to a validated model document. Pure orchestration over the
 //! estimators of [`crate::estimation`] and [`crate::validation`].
+//!
+//! - [`dataset`]: runs → segments (one per valid block, never concatenated).
+//! - [`document`]: the stored/served model: matrices, parameters with std.
 
 pub mod dataset;
+pub mod document;
 
 pub use dataset::{DatasetError, RunInput, Segment, segments};
+pub use document::{Method, ModelDocument, ModelKind, ParameterRow};
