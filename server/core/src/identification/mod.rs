@@ -4,9 +4,11 @@
 //!
 //! - [`dataset`]: runs → segments (one per valid block, never concatenated).
 //! - [`document`]: the stored/served model: matrices, parameters with std.
+//! - [`export`]: parameter CSV and the Fossen-form parameter set.
 
 pub mod dataset;
 pub mod document;
+pub mod export;
 
 pub use dataset::{DatasetError, RunInput, Segment, segments};
 pub use document::{Method, ModelDocument, ModelKind, ParameterRow};
