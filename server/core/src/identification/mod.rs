@@ -4,9 +4,11 @@
 //!
 //! - [`dataset`]: runs → segments (one per valid block, never concatenated).
 //! - [`document`]: the stored/served model: matrices, parameters with std.
+//! - [`discrete`]: ZOH matrices at a chosen h.
 //! - [`export`]: parameter CSV and the Fossen-form parameter set.
 
 pub mod dataset;
+pub mod discrete;
 pub mod document;
 pub mod export;
 
