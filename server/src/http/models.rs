@@ -2,13 +2,15 @@
 //! a chosen h), exports (JSON, parameter CSV, Fossen-form set).
 
 use axum::Json;
-use axum::extract::{Path, Query, State};
+use axum::extract::{Path, State};
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
+use seatrial_core::identification::discrete::{DiscreteModel, discretize};
 use seatrial_core::identification::document::ModelDocument;
 use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv};
 use serde::{Deserialize, Serialize};
 
+use super::query::ApiQuery;
 use super::{AppState, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::storage::models::{self, ModelSummary, StoredModel};
@@ -27,7 +29,7 @@ pub struct ModelFilter {
     responses((status = 200, description = "Models, newest first", body = [ModelSummary])))]
 pub async fn list_models(
     State(s): State<AppState>,
-    Query(f): Query<ModelFilter>,
+    ApiQuery(f): ApiQuery<ModelFilter>,
 ) -> ApiResult<Json<Vec<ModelSummary>>> {
     Ok(Json(
         models::list(&s.db, f.campaign_id.as_deref(), f.lineage_id.as_deref()).await?,
@@ -50,6 +52,16 @@ pub struct ModelView {
     /// Validation reports per held-out run.
     #[schema(value_type = Object)]
     pub validation: serde_json::Value,
+    /// ZOH-discretized Φ, Γ at the requested `h` (only with `?h=`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub discrete: Option<DiscreteModel>,
+}
+
+/// Options of one model.
+#[derive(Debug, Deserialize, utoipa::IntoParams)]
+pub struct ModelQuery {
+    /// Sample time h (s) at which to add the ZOH-discretized Φ, Γ.
+    pub h: Option<f64>,
 }
 
 fn view(m: StoredModel) -> ApiResult<ModelView> {
@@ -62,17 +74,28 @@ fn view(m: StoredModel) -> ApiResult<ModelView> {
         validation_run_ids: m.validation_run_ids,
         document,
         validation: m.validation,
+        discrete: None,
     })
 }
 
-/// One model.
+/// One model: provenance, matrices and parameters with standard deviations,
+/// validation reports; with `?h=` also the ZOH-discretized Φ, Γ at that h.
 #[utoipa::path(get, path = "/api/models/{id}", tag = "models",
-    params(("id" = String, Path, description = "Model id")),
+    params(("id" = String, Path, description = "Model id"), ModelQuery),
     responses((status = 200, description = "The model", body = ModelView),
-              (status = 404, description = "No such model", body = ErrorBody)))]
-pub async fn get_model(State(s): State<AppState>, Path(id): Path<String>) -> ApiResult<Json<ModelView>> {
+              (status = 404, description = "No such model", body = ErrorBody),
+              (status = 422, description = "`h` unusable (not positive; a subspace model's own h differs)", body = ErrorBody)))]
+pub async fn get_model(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+    ApiQuery(q): ApiQuery<ModelQuery>,
+) -> ApiResult<Json<ModelView>> {
     let m = found(models::get(&s.db, &id).await?, "model", &id)?;
-    Ok(Json(view(m)?))
+    let mut v = view(m)?;
+    if let Some(h) = q.h {
+        v.discrete = Some(discretize(&v.document, h).map_err(|msg| ApiError::invalid("h", msg))?);
+    }
+    Ok(Json(v))
 }
 
 /// Export format.
@@ -111,7 +134,7 @@ fn attachment(body: String, content_type: &str, filename: String) -> Response {
 pub async fn export_model(
     State(s): State<AppState>,
     Path(id): Path<String>,
-    Query(q): Query<ExportQuery>,
+    ApiQuery(q): ApiQuery<ExportQuery>,
 ) -> ApiResult<Response> {
     let m = found(models::get(&s.db, &id).await?, "model", &id)?;
     let stem = format!("{}-v{}", m.summary.name.replace([' ', '/', '"'], "_"), m.summary.version);
