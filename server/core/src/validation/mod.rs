@@ -1,5 +1,13 @@
 //! Validation of identified models on runs not used for estimation
 //! (thesis sec. 2.6): prediction and simulation NRMSE, residual tests.
+//!
+//! - [`validate`] ([`report`]): per output channel the 1-step, k-step and
+//!   free-run fits (eq. 1.13), residual analysis, input–residual
+//!   cross-correlation, a verdict in plain words and plot series;
+//! - [`residuals`]: autocorrelation with 99 % bounds, Ljung–Box, zero
+//!   crossings, normal-probability plot and Jarque–Bera;
+//! - [`correlation`]: sample auto/cross-correlation (direct or FFT);
+//! - [`distributions`]: Φ, Φ⁻¹, incomplete gamma, χ² and binomial tails.
 
 pub mod correlation;
 pub mod distributions;
