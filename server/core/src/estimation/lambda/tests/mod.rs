@@ -1,1 +1,7 @@
 //! Proof tests of the λ-filter identification against known truths.
+
+mod analytic;
+mod errors;
+mod multi;
+mod rov;
+mod truth;
