@@ -10,7 +10,8 @@ use super::estimate::{LambdaEstimate, UncertaintyMethod};
 use super::experiment::{Experiment, validate_runs};
 use super::filter::LambdaFilter;
 use super::kalman::kalman_row;
-use super::posterior::{RowPosterior, residual_dof, row_posterior, rss};
+use super::posterior::{RowPosterior, apply_sandwich, residual_dof, row_posterior, rss};
+use super::robust::{LAG_IN_T, long_run_score_covariance};
 use super::regressors::RunRegressors;
 use super::settings::{LambdaSettings, MIN_T_OVER_H};
 use super::statistics::RegressionStats;
@@ -161,10 +162,9 @@ pub fn identify_with_progress(
         progress.update(0.5 * r as f64 / runs.len() as f64, "λ-filtering runs")?;
         let reg = RunRegressors::new(run, &f, settings.filter_init);
         stats.add(&reg, settings.estimate_transient);
-        if kf {
-            filtered.push(reg);
-        }
+        filtered.push(reg);
     }
+    let lag = (LAG_IN_T * settings.t_lambda / h).ceil() as usize;
     let free: Vec<Vec<usize>> = (0..n).map(|i| mask.free_of_row(i)).collect();
     if let Some(i) = (0..n).find(|&i| residual_dof(&stats, free[i].len()) < 1.0) {
         return Err(LambdaError::too_few(
@@ -188,6 +188,17 @@ pub fn identify_with_progress(
         let mut row = row_posterior(&stats, i, &free[i], &pri.theta0[i], &pri.p0[i], noise)?;
         if kf {
             row = kalman_pass(&filtered, i, &free[i], &pri, &row, &f, settings, &stats)?;
+        } else if settings.robust_covariance {
+            let theta_s = DVector::from_fn(free[i].len(), |a, _| row.theta[free[i][a]]);
+            let omega = long_run_score_covariance(
+                &filtered,
+                i,
+                &free[i],
+                &theta_s,
+                settings.estimate_transient,
+                lag,
+            );
+            apply_sandwich(&mut row, &free[i], &pri.p0[i], &omega);
         }
         rows.push(row);
     }

@@ -27,6 +27,7 @@ mod lpv;
 mod posterior;
 pub mod predict;
 mod regressors;
+mod robust;
 mod settings;
 mod statistics;
 mod structure;

@@ -70,6 +70,27 @@ fn solve(
         .then_some((theta, cov))
 }
 
+/// Replaces the posterior covariance of `post` (free set `free`, prior
+/// variances `p0`) by the sandwich Λ⁻¹(P₀⁻¹ + Ω/R²)Λ⁻¹, keeping it when the
+/// result is not a valid covariance (a non-positive diagonal).
+pub(crate) fn apply_sandwich(post: &mut RowPosterior, free: &[usize], p0: &DVector<f64>, omega: &DMatrix<f64>) {
+    let k = free.len();
+    let lam_inv = DMatrix::from_fn(k, k, |a, b| post.cov[(free[a], free[b])]);
+    let r = post.noise_variance;
+    let mut middle = omega / (r * r);
+    for (a, &j) in free.iter().enumerate() {
+        middle[(a, a)] += 1.0 / p0[j];
+    }
+    let s = &lam_inv * middle * &lam_inv;
+    if (0..k).all(|a| s[(a, a)] > 0.0 && s[(a, a)].is_finite()) {
+        for (a, &ja) in free.iter().enumerate() {
+            for (b, &jb) in free.iter().enumerate() {
+                post.cov[(ja, jb)] = 0.5 * (s[(a, b)] + s[(b, a)]);
+            }
+        }
+    }
+}
+
 /// Fixed-point iterations of R ← RSS(θ(R))/dof when R is estimated.
 const NOISE_ITERATIONS: usize = 50;
 

@@ -71,12 +71,16 @@ pub struct LambdaSettings {
     pub filter_init: FilterInit,
     /// Estimate (and marginalize) each run's initial transient a^k·e₀.
     pub estimate_transient: bool,
+    /// Report the autocorrelation-robust (Newey–West sandwich) posterior
+    /// covariance instead of the white-noise one (constant parameters only;
+    /// see `robust`): the λ regression's equation error is coloured.
+    pub robust_covariance: bool,
 }
 
 impl LambdaSettings {
     /// Settings with the defaults: noise estimated, constant parameters,
     /// exact inversion, filters started at the first sample, transients
-    /// estimated.
+    /// estimated, robust covariance.
     pub fn new(dofs: Vec<Dof>, t_lambda: f64, structure: Structure, prior: Prior) -> Self {
         LambdaSettings {
             dofs,
@@ -88,6 +92,7 @@ impl LambdaSettings {
             inversion: Inversion::Exact,
             filter_init: FilterInit::FirstSample,
             estimate_transient: true,
+            robust_covariance: true,
         }
     }
 }

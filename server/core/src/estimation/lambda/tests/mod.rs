@@ -1,6 +1,7 @@
 //! Proof tests of the λ-filter identification against known truths.
 
 mod analytic;
+mod calibration;
 mod errors;
 mod multi;
 mod rov;
