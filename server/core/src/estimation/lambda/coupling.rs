@@ -86,7 +86,10 @@ pub fn propose_coupling(
     }
     let n = runs.first().map_or(0, |r| r.nu.ncols());
     if n == 0 {
-        return Err(LambdaError::shape("runs", "no run, or runs without columns"));
+        return Err(LambdaError::shape(
+            "runs",
+            "no run, or runs without columns",
+        ));
     }
     let h = validate_runs("runs", runs, n, MIN_COHERENCE_SAMPLES)?;
     // Channels [γ_0 … γ_{n−1}, ν_0 … ν_{n−1}]; every input–input pair and
@@ -114,19 +117,28 @@ pub fn propose_coupling(
             .map(|j| &run.gamma.as_slice()[j * len..(j + 1) * len])
             .chain((0..n).map(|i| &run.nu.as_slice()[i * len..(i + 1) * len]))
             .collect();
-        let sp = multi_welch(&channels, &[0..len], &pairs, &cfg)
+        let block = std::iter::once(0..len).collect::<Vec<_>>();
+        let sp = multi_welch(&channels, &block, &pairs, &cfg)
             .map_err(|e| LambdaError::invalid(format!("runs[{r}]"), e.to_string()))?;
         let dof_left = sp.n_segments.saturating_sub(n - 1).max(1);
         floor += 1.0 / dof_left as f64 / runs.len() as f64;
         let peaks: Vec<f64> = (0..n)
             .map(|j| sp.auto[j].iter().skip(1).copied().fold(0.0, f64::max))
             .collect();
-        let in_band = |j: usize, k: usize| peaks[j] > 0.0 && sp.auto[j][k] >= BAND_FRACTION * peaks[j];
+        let in_band =
+            |j: usize, k: usize| peaks[j] > 0.0 && sp.auto[j][k] >= BAND_FRACTION * peaks[j];
         // Spectral matrix entry (a, b) of [γ, ν_i], a ≤ b in channel order.
         let entry = |a: usize, b: usize, i: usize, k: usize| -> Complex<f64> {
             let (lo, hi, conj) = if a <= b { (a, b, false) } else { (b, a, true) };
             let v = if lo == hi {
-                Complex::new(if lo == n { sp.auto[n + i][k] } else { sp.auto[lo][k] }, 0.0)
+                Complex::new(
+                    if lo == n {
+                        sp.auto[n + i][k]
+                    } else {
+                        sp.auto[lo][k]
+                    },
+                    0.0,
+                )
             } else if hi == n {
                 sp.cross[io(lo, i)][k]
             } else {
@@ -199,7 +211,11 @@ fn invert(mut a: Vec<Vec<Complex<f64>>>) -> Option<Vec<Vec<Complex<f64>>>> {
         return None;
     }
     let mut inv: Vec<Vec<Complex<f64>>> = (0..n)
-        .map(|i| (0..n).map(|j| Complex::new(f64::from(u8::from(i == j)), 0.0)).collect())
+        .map(|i| {
+            (0..n)
+                .map(|j| Complex::new(f64::from(u8::from(i == j)), 0.0))
+                .collect()
+        })
         .collect();
     for c in 0..n {
         let p = (c..n).max_by(|&x, &y| a[x][c].norm().total_cmp(&a[y][c].norm()))?;
@@ -234,6 +250,7 @@ mod tests {
     use super::*;
 
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn complex_inverse_is_an_inverse() {
         let a = vec![
             vec![Complex::new(2.0, 0.0), Complex::new(0.5, 1.0)],

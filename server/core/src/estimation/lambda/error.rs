@@ -161,10 +161,7 @@ pub(crate) fn require_positive(field: &str, v: f64) -> Result<(), LambdaError> {
         ));
     }
     if v <= 0.0 {
-        return Err(LambdaError::invalid(
-            field,
-            format!("must be > 0, got {v}"),
-        ));
+        return Err(LambdaError::invalid(field, format!("must be > 0, got {v}")));
     }
     Ok(())
 }

@@ -60,7 +60,10 @@ pub(crate) fn validate_runs(
         if (run.h - h).abs() > H_REL_TOL * h {
             return Err(LambdaError::invalid(
                 f("h"),
-                format!("sample time {} s differs from the first run's {h} s; resample the runs to one h", run.h),
+                format!(
+                    "sample time {} s differs from the first run's {h} s; resample the runs to one h",
+                    run.h
+                ),
             ));
         }
         if run.nu.ncols() != n {
@@ -72,7 +75,10 @@ pub(crate) fn validate_runs(
         if run.gamma.ncols() != n {
             return Err(LambdaError::shape(
                 f("gamma"),
-                format!("has {} columns, expected one per DOF ({n})", run.gamma.ncols()),
+                format!(
+                    "has {} columns, expected one per DOF ({n})",
+                    run.gamma.ncols()
+                ),
             ));
         }
         if run.gamma.nrows() != run.nu.nrows() {

@@ -130,7 +130,12 @@ mod tests {
             for k in 0..300 {
                 assert!((y[(k, j)] - x[0]).abs() < 1e-10, "k={k} j={j}");
                 for _ in 0..20 {
-                    rk4_step(&mut |x: &[f64], u: &[f64], dx: &mut [f64]| dx[0] = (u[0] - x[0]) / t, &mut x, &[s[(k, j)]], h / 20.0);
+                    rk4_step(
+                        &mut |x: &[f64], u: &[f64], dx: &mut [f64]| dx[0] = (u[0] - x[0]) / t,
+                        &mut x,
+                        &[s[(k, j)]],
+                        h / 20.0,
+                    );
                 }
             }
         }

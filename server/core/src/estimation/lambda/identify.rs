@@ -11,8 +11,8 @@ use super::experiment::{Experiment, validate_runs};
 use super::filter::LambdaFilter;
 use super::kalman::kalman_row;
 use super::posterior::{RowPosterior, apply_sandwich, residual_dof, row_posterior, rss};
-use super::robust::{LAG_IN_T, long_run_score_covariance};
 use super::regressors::RunRegressors;
+use super::robust::{LAG_IN_T, long_run_score_covariance};
 use super::settings::{LambdaSettings, MIN_T_OVER_H};
 use super::statistics::RegressionStats;
 use super::structure::CouplingMask;
@@ -54,7 +54,10 @@ fn validate_settings(s: &LambdaSettings, n: usize) -> Result<CouplingMask, Lambd
     super::error::require_positive("settings.t_lambda", s.t_lambda)?;
     let mask = s.structure.mask(n);
     mask.validate(n)?;
-    for (name, m) in [("settings.prior.m0", &s.prior.m0), ("settings.prior.d_bar0", &s.prior.d_bar0)] {
+    for (name, m) in [
+        ("settings.prior.m0", &s.prior.m0),
+        ("settings.prior.d_bar0", &s.prior.d_bar0),
+    ] {
         if m.shape() != (n, n) {
             return Err(LambdaError::shape(
                 name,

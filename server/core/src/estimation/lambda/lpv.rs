@@ -39,8 +39,15 @@ fn at_point(e: LambdaError, g: usize) -> LambdaError {
         }
     };
     match e {
-        LambdaError::Shape { field, message } => LambdaError::Shape { field: prefix(field), message },
-        LambdaError::NonFinite { field, index, message } => LambdaError::NonFinite {
+        LambdaError::Shape { field, message } => LambdaError::Shape {
+            field: prefix(field),
+            message,
+        },
+        LambdaError::NonFinite {
+            field,
+            index,
+            message,
+        } => LambdaError::NonFinite {
             field: prefix(field),
             index,
             message,
@@ -54,7 +61,11 @@ fn at_point(e: LambdaError, g: usize) -> LambdaError {
             message: format!("grid point {g}: {message}"),
         },
         LambdaError::Singular { field, message } => LambdaError::Singular {
-            field: if field.starts_with("runs") { prefix(field) } else { format!("points[{g}].{field}") },
+            field: if field.starts_with("runs") {
+                prefix(field)
+            } else {
+                format!("points[{g}].{field}")
+            },
             message,
         },
         LambdaError::Cancelled => LambdaError::Cancelled,

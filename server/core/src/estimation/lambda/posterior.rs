@@ -28,7 +28,12 @@ pub(crate) fn residual_dof(stats: &RegressionStats, n_free: usize) -> f64 {
 }
 
 /// Σ(y_i − φᵀθ)² from the statistics.
-pub(crate) fn rss(stats: &RegressionStats, i: usize, free: &[usize], theta_s: &DVector<f64>) -> f64 {
+pub(crate) fn rss(
+    stats: &RegressionStats,
+    i: usize,
+    free: &[usize],
+    theta_s: &DVector<f64>,
+) -> f64 {
     let mut v = stats.yy[i];
     for (a, &ja) in free.iter().enumerate() {
         v -= 2.0 * theta_s[a] * stats.cross[(ja, i)];
@@ -73,7 +78,12 @@ fn solve(
 /// Replaces the posterior covariance of `post` (free set `free`, prior
 /// variances `p0`) by the sandwich Λ⁻¹(P₀⁻¹ + Ω/R²)Λ⁻¹, keeping it when the
 /// result is not a valid covariance (a non-positive diagonal).
-pub(crate) fn apply_sandwich(post: &mut RowPosterior, free: &[usize], p0: &DVector<f64>, omega: &DMatrix<f64>) {
+pub(crate) fn apply_sandwich(
+    post: &mut RowPosterior,
+    free: &[usize],
+    p0: &DVector<f64>,
+    omega: &DMatrix<f64>,
+) {
     let k = free.len();
     let lam_inv = DMatrix::from_fn(k, k, |a, b| post.cov[(free[a], free[b])]);
     let r = post.noise_variance;
@@ -113,7 +123,9 @@ pub(crate) fn row_posterior(
     let fail = || {
         LambdaError::singular(
             "runs",
-            format!("the information on output row {i} is not positive definite: the runs do not excite its regressors"),
+            format!(
+                "the information on output row {i} is not positive definite: the runs do not excite its regressors"
+            ),
         )
     };
     // Noise variance: start from the output's mean square (an upper bound,

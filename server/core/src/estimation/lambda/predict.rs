@@ -120,7 +120,10 @@ mod tests {
         assert!(one.row(0).iter().all(|v| v.is_nan()));
         assert!((one.rows(1, 199) - nu.rows(1, 199)).amax() < 1e-9);
         assert_eq!(
-            model.one_step(&nu, &DMatrix::zeros(10, 1)).unwrap_err().field(),
+            model
+                .one_step(&nu, &DMatrix::zeros(10, 1))
+                .unwrap_err()
+                .field(),
             "gamma"
         );
     }

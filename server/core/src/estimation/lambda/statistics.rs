@@ -47,20 +47,20 @@ impl RegressionStats {
     /// Adds one run; with `transient` its e₀ is profiled out.
     pub fn add(&mut self, r: &RunRegressors<'_>, transient: bool) {
         let (n_s, p) = r.phi.shape();
-        let n = r.y.ncols();
-        // Z = [φ | ψ | y]; ZᵀZ holds every needed sum in one product.
-        let mut z = DMatrix::zeros(n_s, p + 1 + n);
-        z.columns_mut(0, p).copy_from(&r.phi);
-        z.column_mut(p).copy_from_slice(&r.psi);
-        z.columns_mut(p + 1, n).copy_from(r.y);
-        let zz = z.tr_mul(&z);
-        let mut g = zz.view((0, 0), (p, p)).into_owned();
-        let mut c = zz.view((0, p + 1), (p, n)).into_owned();
-        let mut yy: Vec<f64> = (0..n).map(|i| zz[(p + 1 + i, p + 1 + i)]).collect();
+        // X = [φ | ψ]: XᵀX and XᵀY by two matrix products (Σφφᵀ and Σφyᵀ
+        // for every row at once), Σy² by column norms.
+        let mut x = DMatrix::zeros(n_s, p + 1);
+        x.columns_mut(0, p).copy_from(&r.phi);
+        x.column_mut(p).copy_from_slice(&r.psi);
+        let xx = x.tr_mul(&x);
+        let xy = x.tr_mul(r.y);
+        let mut g = xx.view((0, 0), (p, p)).into_owned();
+        let mut c = xy.rows(0, p).into_owned();
+        let mut yy: Vec<f64> = r.y.column_iter().map(|col| col.norm_squared()).collect();
         if transient {
-            let s = zz[(p, p)];
-            let gp = zz.view((0, p), (p, 1)).into_owned();
-            let cy = zz.view((p, p + 1), (1, n)).into_owned();
+            let s = xx[(p, p)];
+            let gp = xx.view((0, p), (p, 1)).into_owned();
+            let cy = xy.rows(p, 1).into_owned();
             g -= &gp * gp.transpose() / s;
             c -= &gp * &cy / s;
             for (i, v) in yy.iter_mut().enumerate() {

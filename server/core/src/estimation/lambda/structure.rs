@@ -36,10 +36,7 @@ impl CouplingMask {
         let p = DMatrix::from_fn(pattern.nrows(), pattern.ncols(), |i, j| {
             i == j || pattern[(i, j)]
         });
-        CouplingMask {
-            a: p.clone(),
-            b: p,
-        }
+        CouplingMask { a: p.clone(), b: p }
     }
 
     /// Number of DOFs.
@@ -95,7 +92,9 @@ impl CouplingMask {
             if let Some(i) = (0..n).find(|&i| !m[(i, i)]) {
                 return Err(LambdaError::invalid(
                     name,
-                    format!("diagonal entry ({i}, {i}) must be free (a DOF without its own dynamics or input is unidentifiable and B would be singular)"),
+                    format!(
+                        "diagonal entry ({i}, {i}) must be free (a DOF without its own dynamics or input is unidentifiable and B would be singular)"
+                    ),
                 ));
             }
         }
@@ -146,7 +145,10 @@ mod tests {
         let mut m = CouplingMask::full(3);
         m.b[(1, 1)] = false;
         assert_eq!(m.validate(3).unwrap_err().field(), "structure.b");
-        assert_eq!(CouplingMask::full(2).validate(3).unwrap_err().field(), "structure.a");
+        assert_eq!(
+            CouplingMask::full(2).validate(3).unwrap_err().field(),
+            "structure.a"
+        );
         assert!(CouplingMask::diagonal(3).validate(3).is_ok());
     }
 }

@@ -164,10 +164,7 @@ pub(crate) fn to_lambda(
         Inversion::Thesis => Ok((DMatrix::identity(n, n) + a * f.t, b * f.t)),
         Inversion::Exact => {
             let (phi, gam) = zoh(a, b, f.h)?;
-            Ok((
-                (phi - DMatrix::identity(n, n) * f.a) / f.c,
-                gam / f.c,
-            ))
+            Ok(((phi - DMatrix::identity(n, n) * f.a) / f.c, gam / f.c))
         }
     }
 }
@@ -201,9 +198,10 @@ pub(crate) fn from_lambda(
             big.view_mut((0, n), (n, n))
                 .copy_from(&(DMatrix::<f64>::identity(n, n) * f.h));
             let w = expm(&big).view((0, n), (n, n)).into_owned();
-            let b = w.lu().solve(&(b_l * f.c)).ok_or_else(|| {
-                LambdaError::singular("a_lambda", "∫₀ʰ e^{As} ds is singular")
-            })?;
+            let b = w
+                .lu()
+                .solve(&(b_l * f.c))
+                .ok_or_else(|| LambdaError::singular("a_lambda", "∫₀ʰ e^{As} ds is singular"))?;
             Ok((a, b))
         }
     }
@@ -217,11 +215,15 @@ pub fn mass_damping(
     a: &DMatrix<f64>,
     b: &DMatrix<f64>,
 ) -> Result<(DMatrix<f64>, DMatrix<f64>), LambdaError> {
-    let m = b.clone().try_inverse().ok_or_else(|| {
-        LambdaError::singular("b", "B = M⁻¹ is singular, so M is undefined")
-    })?;
+    let m = b
+        .clone()
+        .try_inverse()
+        .ok_or_else(|| LambdaError::singular("b", "B = M⁻¹ is singular, so M is undefined"))?;
     if m.iter().any(|v| !v.is_finite()) {
-        return Err(LambdaError::singular("b", "B = M⁻¹ is numerically singular"));
+        return Err(LambdaError::singular(
+            "b",
+            "B = M⁻¹ is numerically singular",
+        ));
     }
     let d = -(&m * a);
     Ok((m, d))
@@ -274,7 +276,11 @@ mod tests {
 
     fn example() -> (DMatrix<f64>, DMatrix<f64>) {
         let a = DMatrix::from_row_slice(3, 3, &[-0.5, 0.2, 0.0, -0.1, -1.2, 0.3, 0.05, 0.0, -2.0]);
-        let b = DMatrix::from_row_slice(3, 3, &[2e-3, 1e-4, 0.0, 1e-4, 1e-3, -2e-4, 0.0, -2e-4, 4e-3]);
+        let b = DMatrix::from_row_slice(
+            3,
+            3,
+            &[2e-3, 1e-4, 0.0, 1e-4, 1e-3, -2e-4, 0.0, -2e-4, 4e-3],
+        );
         (a, b)
     }
 
@@ -329,7 +335,10 @@ mod tests {
             let thesis = DMatrix::identity(3, 3) + &a * t;
             gaps.push((al - thesis).amax());
         }
-        assert!(gaps[0] / gaps[1] > 8.0 && gaps[1] / gaps[2] > 8.0, "{gaps:?}");
+        assert!(
+            gaps[0] / gaps[1] > 8.0 && gaps[1] / gaps[2] > 8.0,
+            "{gaps:?}"
+        );
     }
 
     #[test]

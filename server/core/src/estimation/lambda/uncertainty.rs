@@ -60,10 +60,10 @@ pub(crate) fn delta_method(
         }
         let cov = DMatrix::from_fn(k, k, |a, b| row.cov[(free[i][a], free[i][b])]);
         let jc = &jac * cov;
-        for q in 0..4 {
-            for e in 0..n * n {
+        for (q, v) in var.iter_mut().enumerate() {
+            for (e, x) in v.iter_mut().enumerate() {
                 let r = q * n * n + e;
-                var[q][e] += jc.row(r).dot(&jac.row(r));
+                *x += jc.row(r).dot(&jac.row(r));
             }
         }
     }

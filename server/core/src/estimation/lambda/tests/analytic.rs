@@ -27,8 +27,16 @@ fn diagonal_truth() -> (DMatrix<f64>, DMatrix<f64>) {
 
 fn coupled_truth() -> (DMatrix<f64>, DMatrix<f64>) {
     (
-        DMatrix::from_row_slice(3, 3, &[500.0, 40.0, -20.0, 40.0, 800.0, 60.0, -20.0, 60.0, 120.0]),
-        DMatrix::from_row_slice(3, 3, &[100.0, 20.0, 0.0, -10.0, 300.0, 30.0, 5.0, 15.0, 60.0]),
+        DMatrix::from_row_slice(
+            3,
+            3,
+            &[500.0, 40.0, -20.0, 40.0, 800.0, 60.0, -20.0, 60.0, 120.0],
+        ),
+        DMatrix::from_row_slice(
+            3,
+            3,
+            &[100.0, 20.0, 0.0, -10.0, 300.0, 30.0, 5.0, 15.0, 60.0],
+        ),
     )
 }
 
@@ -65,7 +73,11 @@ fn settings(m: &DMatrix<f64>, d: &DMatrix<f64>, t: f64, structure: Structure) ->
 fn noise_free_diagonal_and_coupled_truths_are_recovered() {
     for (name, (m, d), structure) in [
         ("diagonal", diagonal_truth(), Structure::Diagonal),
-        ("coupled", coupled_truth(), Structure::Coupled(CouplingMask::full(3))),
+        (
+            "coupled",
+            coupled_truth(),
+            Structure::Coupled(CouplingMask::full(3)),
+        ),
     ] {
         let (a, b) = state_space(&m, &d, "m").unwrap();
         let runs = [clean_run(&m, &d, 3000, 7)];
@@ -87,7 +99,11 @@ fn the_estimate_does_not_depend_on_t_with_the_exact_inverse() {
     let (a, _) = state_space(&m, &d, "m").unwrap();
     let runs = [clean_run(&m, &d, 3000, 11)];
     for t in [0.5, 1.0, 2.0, 5.0] {
-        let est = identify(&runs, &settings(&m, &d, t, Structure::Coupled(CouplingMask::full(3)))).unwrap();
+        let est = identify(
+            &runs,
+            &settings(&m, &d, t, Structure::Coupled(CouplingMask::full(3))),
+        )
+        .unwrap();
         let e = rel_err(&est.a, &a);
         assert!(e < 1e-6, "T = {t}: {e:e}");
     }
@@ -107,10 +123,16 @@ fn the_thesis_map_has_its_predicted_first_order_bias() {
         for i in 0..3 {
             let ai = a[(i, i)];
             let closed = (H * ai).exp_m1() / (t * -(-H / t).exp_m1());
-            assert!(((est.a[(i, i)] - closed) / closed).abs() < 1e-6, "T={t} i={i}");
+            assert!(
+                ((est.a[(i, i)] - closed) / closed).abs() < 1e-6,
+                "T={t} i={i}"
+            );
             let bias = est.a[(i, i)] / ai - 1.0;
             let first_order = H * ai / 2.0 + H / (2.0 * t);
-            assert!((bias - first_order).abs() < 0.1 * first_order.abs() + 1e-3, "T={t} i={i}: {bias} vs {first_order}");
+            assert!(
+                (bias - first_order).abs() < 0.1 * first_order.abs() + 1e-3,
+                "T={t} i={i}: {bias} vs {first_order}"
+            );
         }
     }
 }
@@ -124,19 +146,40 @@ fn initial_state_handling_removes_the_transient_bias() {
     let (m, d) = coupled_truth();
     let (a, b) = state_space(&m, &d, "m").unwrap();
     let nu_mean = [1.5, 0.0, 0.0];
-    let gamma_mean: Vec<f64> = (0..3).map(|i| (0..3).map(|j| d[(i, j)] * nu_mean[j]).sum()).collect();
+    let gamma_mean: Vec<f64> = (0..3)
+        .map(|i| (0..3).map(|j| d[(i, j)] * nu_mean[j]).sum())
+        .collect();
     // Starts in steady state at the grid speed; excitation small against
     // the mean surge force, as at a grid point of an LPV campaign.
-    let r = run(&a, &b, H, 1500, &[1.5, 2.3, 3.1], &[30.0, 40.0, 5.0], &gamma_mean, &nu_mean, &[0.0; 3], 3);
+    let r = run(
+        &a,
+        &b,
+        H,
+        1500,
+        &[1.5, 2.3, 3.1],
+        &[30.0, 40.0, 5.0],
+        &gamma_mean,
+        &nu_mean,
+        &[0.0; 3],
+        3,
+    );
     let mut errs = Vec::new();
-    for (init, transient) in [(FilterInit::Zero, false), (FilterInit::FirstSample, false), (FilterInit::Zero, true), (FilterInit::FirstSample, true)] {
+    for (init, transient) in [
+        (FilterInit::Zero, false),
+        (FilterInit::FirstSample, false),
+        (FilterInit::Zero, true),
+        (FilterInit::FirstSample, true),
+    ] {
         let mut s = settings(&m, &d, 2.0, Structure::Coupled(CouplingMask::full(3)));
         s.filter_init = init;
         s.estimate_transient = transient;
         let est = identify(std::slice::from_ref(&r), &s).unwrap();
         errs.push(rel_err(&est.a, &a));
     }
-    println!("relative error of A: zero init {:.2e}, first sample {:.2e}, transient estimated {:.2e} / {:.2e}", errs[0], errs[1], errs[2], errs[3]);
+    println!(
+        "relative error of A: zero init {:.2e}, first sample {:.2e}, transient estimated {:.2e} / {:.2e}",
+        errs[0], errs[1], errs[2], errs[3]
+    );
     assert!(errs[0] > 3.0 * errs[1], "{errs:?}");
     assert!(errs[1] > 1e-4, "{errs:?}");
     assert!(errs[2] < 1e-6 && errs[3] < 1e-6, "{errs:?}");
@@ -147,10 +190,26 @@ fn covariance_form_kalman_filter_equals_the_information_form() {
     let (m, d) = coupled_truth();
     let (a, b) = state_space(&m, &d, "m").unwrap();
     let runs: Vec<Experiment> = (0..2)
-        .map(|s| run(&a, &b, H, 800, &[1.5, 2.3, 3.1], &[100.0, 200.0, 20.0], &[0.0; 3], &[0.1 * s as f64, 0.0, 0.0], &[0.01, 0.01, 0.005], 40 + s))
+        .map(|s| {
+            run(
+                &a,
+                &b,
+                H,
+                800,
+                &[1.5, 2.3, 3.1],
+                &[100.0, 200.0, 20.0],
+                &[0.0; 3],
+                &[0.1 * s as f64, 0.0, 0.0],
+                &[0.01, 0.01, 0.005],
+                40 + s,
+            )
+        })
         .collect();
     let f = LambdaFilter::new(1.0, H).unwrap();
-    let regs: Vec<RunRegressors<'_>> = runs.iter().map(|r| RunRegressors::new(r, &f, FilterInit::FirstSample)).collect();
+    let regs: Vec<RunRegressors<'_>> = runs
+        .iter()
+        .map(|r| RunRegressors::new(r, &f, FilterInit::FirstSample))
+        .collect();
     let mut stats = RegressionStats::new(3);
     for r in &regs {
         stats.add(r, true);
@@ -160,7 +219,16 @@ fn covariance_form_kalman_filter_equals_the_information_form() {
     let p0 = DVector::from_fn(6, |j, _| if j < 3 { 1.0 } else { 1e-4 });
     let r = 1e-4;
     let info = row_posterior(&stats, 1, &free, &theta0, &p0, Some(r)).unwrap();
-    let (th, p) = kalman_row(&regs, 1, &free, theta0.clone(), DMatrix::from_diagonal(&p0), r, &DVector::zeros(6), Some(f.c));
+    let (th, p) = kalman_row(
+        &regs,
+        1,
+        &free,
+        theta0.clone(),
+        DMatrix::from_diagonal(&p0),
+        r,
+        &DVector::zeros(6),
+        Some(f.c),
+    );
     let dth = (th - &info.theta).amax() / info.theta.amax();
     let dp = (p - &info.cov).amax() / info.cov.amax();
     assert!(dth < 1e-6 && dp < 1e-6, "θ {dth:e}, P {dp:e}");
@@ -175,14 +243,33 @@ fn random_walk_parameters_follow_a_drift_between_runs() {
     let d2 = DMatrix::from_element(1, 1, 120.0);
     let mk = |d: &DMatrix<f64>, seed| {
         let (a, b) = state_space(&m, d, "m").unwrap();
-        run(&a, &b, H, 2000, &[2.0], &[100.0], &[0.0], &[0.0], &[0.005], seed)
+        run(
+            &a,
+            &b,
+            H,
+            2000,
+            &[2.0],
+            &[100.0],
+            &[0.0],
+            &[0.0],
+            &[0.005],
+            seed,
+        )
     };
     let runs = [mk(&d1, 1), mk(&d2, 2)];
-    let mut s = LambdaSettings::new(vec![Dof::Surge], 1.0, Structure::Diagonal, Prior::weak(m.clone(), d1.clone()));
+    let mut s = LambdaSettings::new(
+        vec![Dof::Surge],
+        1.0,
+        Structure::Diagonal,
+        Prior::weak(m.clone(), d1.clone()),
+    );
     let constant = identify(&runs, &s).unwrap().d_bar[(0, 0)];
     s.random_walk = 1e-4;
     let walking = identify(&runs, &s).unwrap().d_bar[(0, 0)];
     println!("D̄ constant {constant:.1}, random walk {walking:.1} (truth 60 → 120)");
     assert!(constant > 70.0 && constant < 110.0, "{constant}");
-    assert!((walking - 120.0).abs() < 0.3 * (constant - 120.0).abs(), "{walking}");
+    assert!(
+        (walking - 120.0).abs() < 0.3 * (constant - 120.0).abs(),
+        "{walking}"
+    );
 }

@@ -5,7 +5,9 @@
 use nalgebra::DMatrix;
 
 use super::super::transform::state_space;
-use super::super::{CouplingMask, Experiment, LambdaEstimate, LambdaSettings, Prior, Structure, identify};
+use super::super::{
+    CouplingMask, Experiment, LambdaEstimate, LambdaSettings, Prior, Structure, identify,
+};
 use super::truth::run;
 use crate::planning::dof::Dof;
 
@@ -15,8 +17,16 @@ fn error(est: &LambdaEstimate, a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
 
 #[test]
 fn two_short_runs_beat_either_alone() {
-    let m = DMatrix::from_row_slice(3, 3, &[500.0, 40.0, -20.0, 40.0, 800.0, 60.0, -20.0, 60.0, 120.0]);
-    let d = DMatrix::from_row_slice(3, 3, &[100.0, 20.0, 0.0, -10.0, 300.0, 30.0, 5.0, 15.0, 60.0]);
+    let m = DMatrix::from_row_slice(
+        3,
+        3,
+        &[500.0, 40.0, -20.0, 40.0, 800.0, 60.0, -20.0, 60.0, 120.0],
+    );
+    let d = DMatrix::from_row_slice(
+        3,
+        3,
+        &[100.0, 20.0, 0.0, -10.0, 300.0, 30.0, 5.0, 15.0, 60.0],
+    );
     let (a, b) = state_space(&m, &d, "m").unwrap();
     let prior = Prior::weak(
         DMatrix::from_diagonal(&(m.diagonal() * 0.5)),
@@ -29,7 +39,18 @@ fn two_short_runs_beat_either_alone() {
         prior,
     );
     let short = |nu0: &[f64], seed| -> Experiment {
-        run(&a, &b, 0.1, 600, &[1.5, 2.3, 3.1], &[100.0, 200.0, 20.0], &[0.0; 3], nu0, &[0.01, 0.01, 0.005], seed)
+        run(
+            &a,
+            &b,
+            0.1,
+            600,
+            &[1.5, 2.3, 3.1],
+            &[100.0, 200.0, 20.0],
+            &[0.0; 3],
+            nu0,
+            &[0.01, 0.01, 0.005],
+            seed,
+        )
     };
     // Expected errors over independent noise/excitation draws: the combined
     // estimate must beat each single run's on average (a single draw can go

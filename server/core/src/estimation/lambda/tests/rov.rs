@@ -30,7 +30,9 @@ const CLOCK: [f64; 6] = [2.0, 2.2, 1.8, 1.6, 2.4, 2.0];
 /// of gravity lies below the centre of the body frame (surge–pitch,
 /// sway–roll) and added-mass coupling sway–yaw, roll–yaw.
 pub fn rov_mass() -> DMatrix<f64> {
-    let mut m = DMatrix::from_diagonal(&DVector::from_vec(vec![4000.0, 5000.0, 6000.0, 1500.0, 1800.0, 1200.0]));
+    let mut m = DMatrix::from_diagonal(&DVector::from_vec(vec![
+        4000.0, 5000.0, 6000.0, 1500.0, 1800.0, 1200.0,
+    ]));
     for &(i, j, v) in &[(0, 4, 600.0), (1, 3, -600.0), (1, 5, 300.0), (3, 5, 100.0)] {
         m[(i, j)] = v;
         m[(j, i)] = v;
@@ -41,9 +43,20 @@ pub fn rov_mass() -> DMatrix<f64> {
 /// D̄(U) = D₀ + U·D₁: linear damping plus speed-proportional terms
 /// (including Munk-like asymmetric sway–yaw coupling).
 pub fn rov_damping(u: f64) -> DMatrix<f64> {
-    let mut d0 = DMatrix::from_diagonal(&DVector::from_vec(vec![800.0, 1200.0, 1500.0, 600.0, 700.0, 500.0]));
-    let mut d1 = DMatrix::from_diagonal(&DVector::from_vec(vec![600.0, 900.0, 1000.0, 200.0, 300.0, 400.0]));
-    for &(i, j, v) in &[(0, 4, 100.0), (4, 0, 100.0), (1, 3, -150.0), (3, 1, -150.0), (1, 5, 200.0), (5, 1, 100.0)] {
+    let mut d0 = DMatrix::from_diagonal(&DVector::from_vec(vec![
+        800.0, 1200.0, 1500.0, 600.0, 700.0, 500.0,
+    ]));
+    let mut d1 = DMatrix::from_diagonal(&DVector::from_vec(vec![
+        600.0, 900.0, 1000.0, 200.0, 300.0, 400.0,
+    ]));
+    for &(i, j, v) in &[
+        (0, 4, 100.0),
+        (4, 0, 100.0),
+        (1, 3, -150.0),
+        (3, 1, -150.0),
+        (1, 5, 200.0),
+        (5, 1, 100.0),
+    ] {
         d0[(i, j)] = v;
     }
     for &(i, j, v) in &[(1, 5, 300.0), (5, 1, -150.0), (0, 4, 80.0), (4, 0, 40.0)] {
@@ -83,7 +96,18 @@ fn campaign() -> Vec<GridPoint> {
             nu_bar[0] = speed;
             let gamma_bar: Vec<f64> = (0..6).map(|i| d[(i, 0)] * speed).collect();
             let make = |seed: u64, nu0: &[f64]| {
-                run(&a, &b, H, RUN_SAMPLES, &CLOCK, &AMP, &gamma_bar, nu0, &SIGMA, seed)
+                run(
+                    &a,
+                    &b,
+                    H,
+                    RUN_SAMPLES,
+                    &CLOCK,
+                    &AMP,
+                    &gamma_bar,
+                    nu0,
+                    &SIGMA,
+                    seed,
+                )
             };
             let runs = (0..RUNS)
                 .map(|r| {
@@ -93,7 +117,14 @@ fn campaign() -> Vec<GridPoint> {
                 })
                 .collect();
             let validation = make(1000 * g as u64 + 999, &nu_bar);
-            GridPoint { speed, a, b, d, runs, validation }
+            GridPoint {
+                speed,
+                a,
+                b,
+                d,
+                runs,
+                validation,
+            }
         })
         .collect()
 }
@@ -121,7 +152,8 @@ fn settings(structure: Structure) -> LambdaSettings {
 }
 
 fn identify_all(points: &[GridPoint], structure: Structure) -> Vec<LambdaEstimate> {
-    let input: Vec<(f64, Vec<Experiment>)> = points.iter().map(|p| (p.speed, p.runs.clone())).collect();
+    let input: Vec<(f64, Vec<Experiment>)> =
+        points.iter().map(|p| (p.speed, p.runs.clone())).collect();
     identify_lpv(&input, &settings(structure), &mut NoProgress)
         .unwrap()
         .into_iter()
@@ -147,13 +179,20 @@ fn six_dof_rov_campaign_coupled_matches_the_truth_and_beats_diagonal() {
     println!("coherence floor ≈ {:.3}", proposal.coherence_floor);
     for i in 0..6 {
         for j in 0..6 {
-            assert_eq!(proposal.mask.a[(i, j)], truly_coupled(i, j), "mask ({i}, {j})");
+            assert_eq!(
+                proposal.mask.a[(i, j)],
+                truly_coupled(i, j),
+                "mask ({i}, {j})"
+            );
         }
     }
 
     let coupled = identify_all(&points, Structure::Coupled(proposal.mask.clone()));
     let diagonal = identify_all(&points, Structure::Diagonal);
-    let full = identify_all(&points, Structure::Coupled(super::super::CouplingMask::full(6)));
+    let full = identify_all(
+        &points,
+        Structure::Coupled(super::super::CouplingMask::full(6)),
+    );
 
     let names: Vec<&str> = Dof::ALL.iter().map(|d| d.velocity_symbol()).collect();
     println!("NRMSE fit (eq. 1.13) on validation runs: true / coupled / diagonal");
@@ -219,15 +258,33 @@ fn six_dof_rov_campaign_coupled_matches_the_truth_and_beats_diagonal() {
     println!(
         "worst true − coupled NRMSE gap {worst_gap:.4} (fully coupled mask {worst_gap_full:.4}); 1σ coverage {coverage_1:.3}; diagonal free-run loss: coupled channels mean {:.3} (min {:.3}), heave mean {:.4}; 3σ coverage {covered}/{total} = {coverage:.3}",
         mean(&diag_loss_coupled),
-        diag_loss_coupled.iter().copied().fold(f64::INFINITY, f64::min),
+        diag_loss_coupled
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min),
         mean(&diag_loss_heave)
     );
-    assert!(worst_gap < 0.02, "coupled model {worst_gap} below the truth");
-    assert!(mean(&diag_loss_coupled) > 0.05, "diagonal not measurably worse");
-    assert!(mean(&diag_loss_heave).abs() < 0.01, "heave is uncoupled: diagonal should match");
-    assert!(worst_gap_full < 0.02, "fully coupled model {worst_gap_full} below the truth");
+    assert!(
+        worst_gap < 0.02,
+        "coupled model {worst_gap} below the truth"
+    );
+    assert!(
+        mean(&diag_loss_coupled) > 0.05,
+        "diagonal not measurably worse"
+    );
+    assert!(
+        mean(&diag_loss_heave).abs() < 0.01,
+        "heave is uncoupled: diagonal should match"
+    );
+    assert!(
+        worst_gap_full < 0.02,
+        "fully coupled model {worst_gap_full} below the truth"
+    );
     // The stated σ neither understate (3σ) nor grossly overstate (1σ ≈ 68 %
     // for a calibrated Gaussian) the actual errors.
     assert!(coverage > 0.9, "3σ coverage {coverage}");
-    assert!(coverage_1 > 0.5 && coverage_1 < 0.9, "1σ coverage {coverage_1}");
+    assert!(
+        coverage_1 > 0.5 && coverage_1 < 0.9,
+        "1σ coverage {coverage_1}"
+    );
 }
