@@ -257,7 +257,7 @@ pub fn identify_lambda_campaign(
                         est.moment_correlation
                     )],
                 };
-                restoring = Some((p.clone(), doc));
+                restoring = Some((*p, doc));
             }
             Err(e) => notes.push(format!(
                 "restoring forces not estimated ({e}); γ = τ, so W − B and the tether moment end up in the fit"
