@@ -171,14 +171,20 @@ mod tests {
 
     #[test]
     fn missing_columns_nan_and_short_runs_name_the_problem() {
-        let r = run([0..100].to_vec());
+        let r = run(std::iter::once(0..100).collect());
         let e = segments(&r, &["tau_Y".into()], &["u".into()], 10).unwrap_err();
         assert_eq!(e.column.as_deref(), Some("tau_Y"));
-        let mut bad = run([0..100].to_vec());
+        let mut bad = run(std::iter::once(0..100).collect());
         bad.record.data[1][7] = f64::NAN;
         let e = segments(&bad, &["tau_X".into()], &["u".into()], 10).unwrap_err();
         assert!(e.to_string().contains("sample 7"), "{e}");
-        let e = segments(&run([0..5].to_vec()), &["tau_X".into()], &["u".into()], 10).unwrap_err();
+        let e = segments(
+            &run(std::iter::once(0..5).collect()),
+            &["tau_X".into()],
+            &["u".into()],
+            10,
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("longest is 5"), "{e}");
     }
 }

@@ -68,7 +68,7 @@ fn to_run(id: &str, family: ExperimentFamily, grid: Option<f64>, rec: &RovRecord
             t0: 0.0,
             names,
             data,
-            valid: [0..n].to_vec(),
+            valid: std::iter::once(0..n).collect(),
         },
     }
 }
