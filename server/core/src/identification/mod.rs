@@ -5,6 +5,7 @@
 //! - [`dataset`]: runs → segments (one per valid block, never concatenated).
 //! - [`roles`]: static, estimation and held-out validation runs.
 //! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method.
+//! - [`n4sid_campaign`]: black-box LTI comparison model by N4SID.
 //! - [`document`]: the stored/served model: matrices, parameters with std.
 //! - [`discrete`]: ZOH matrices at a chosen h.
 //! - [`export`]: parameter CSV and the Fossen-form parameter set.
@@ -16,6 +17,7 @@ pub mod document;
 pub mod error;
 pub mod export;
 pub mod lambda_campaign;
+pub mod n4sid_campaign;
 pub mod outcome;
 pub mod roles;
 
@@ -23,6 +25,7 @@ pub use dataset::{DatasetError, RunInput, Segment, segments};
 pub use document::{Method, ModelDocument, ModelKind, ParameterRow};
 pub use error::IdentifyError;
 pub use lambda_campaign::{LambdaCampaignSettings, identify_lambda_campaign};
+pub use n4sid_campaign::{N4sidCampaignSettings, identify_n4sid_campaign};
 pub use outcome::{Identified, RunValidation};
 
 #[cfg(test)]

@@ -222,3 +222,34 @@ fn missing_validation_and_bad_settings_name_the_field() {
         identify_lambda_campaign(&profile, &grid, &inputs, &runs, &s, &mut NoProgress).unwrap_err();
     assert_eq!(e.field(), "settings.coupling");
 }
+
+#[test]
+fn n4sid_campaign_fits_held_out_data_about_the_mean_operating_point() {
+    use super::n4sid_campaign::{N4sidCampaignSettings, identify_n4sid_campaign};
+    let (_, _, runs) = campaign();
+    let profile = surveyor_rov();
+    let inputs: Vec<String> = profile
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
+    let s = N4sidCampaignSettings {
+        order: Some(6),
+        ..Default::default()
+    };
+    let out = identify_n4sid_campaign(&profile, &inputs, &runs, &s, &mut NoProgress).unwrap();
+    let ss = out.document.state_space.as_ref().unwrap();
+    assert_eq!(ss.order, 6);
+    // The truth is first order per DOF with speed-dependent damping: an LTI
+    // model about the mean speed predicts one step ahead well.
+    for ch in &out.validation[0].report.channels {
+        assert!(
+            ch.fit_one_step.unwrap() > 0.8,
+            "{}: {:?}",
+            ch.output,
+            ch.fit_one_step
+        );
+    }
+    // Every discrete pole of a stable vessel lies inside the unit circle.
+    assert!(out.document.parameters.iter().all(|p| p.value < 1.0));
+}
