@@ -4,6 +4,7 @@
 
 pub mod blobs;
 pub mod campaigns;
+pub mod jobs;
 pub mod plans;
 pub mod runs;
 pub mod vessels;
