@@ -78,7 +78,7 @@ async fn main() -> anyhow::Result<()> {
     };
     let jobs = Jobs::new(JobRegistry::production(), config);
     let state = seatrial::http::AppState::with_jobs(
-        db,
+        db.clone(),
         &blob_dir,
         args.max_upload_mb * 1024 * 1024,
         jobs.clone(),
@@ -107,6 +107,7 @@ async fn main() -> anyhow::Result<()> {
     // Running jobs are neither cancelled nor failed: they unwind, and the
     // next start re-queues them (see seatrial::jobs, "Restarts").
     runner.shutdown(Duration::from_secs(10)).await;
+    let _ = tokio::time::timeout(Duration::from_secs(5), db.close()).await;
     // A computation that ignored the stop still holds a blocking thread,
     // which the runtime would wait for; its job is safe in the database.
     std::process::exit(0);

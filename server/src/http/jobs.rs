@@ -130,11 +130,11 @@ pub async fn cancel_job(
     Path(id): Path<String>,
 ) -> ApiResult<(StatusCode, Json<Job>)> {
     match stored::request_cancel(&s.db, &id).await? {
-        CancelOutcome::Cancelled(job) => Ok((StatusCode::OK, Json(job))),
+        CancelOutcome::Cancelled(job) => Ok((StatusCode::OK, Json(*job))),
         CancelOutcome::Requested(job) => {
             // In-process at once; another process reads the flag with its heartbeat.
             s.jobs.live().cancel(&id);
-            Ok((StatusCode::ACCEPTED, Json(fresh(&s, job))))
+            Ok((StatusCode::ACCEPTED, Json(fresh(&s, *job))))
         }
         CancelOutcome::Finished(state) => Err(ApiError::Conflict(format!(
             "job '{id}' already ended ({}); there is nothing to cancel",
@@ -159,7 +159,7 @@ pub async fn retry_job(
     match stored::retry(&s.db, &id, s.jobs.config().max_attempts).await? {
         RetryOutcome::Queued(job) => {
             s.jobs.wake();
-            Ok((StatusCode::ACCEPTED, Json(job)))
+            Ok((StatusCode::ACCEPTED, Json(*job)))
         }
         RetryOutcome::NotRetryable(state) => Err(ApiError::Conflict(format!(
             "job '{id}' is {}; only failed, cancelled or interrupted jobs can be retried{}",

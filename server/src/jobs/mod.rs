@@ -118,3 +118,6 @@ pub use registry::JobRegistry;
 pub use runner::{RunnerHandle, start};
 pub use service::{Jobs, JobsConfig};
 pub use submit::submit;
+
+#[cfg(test)]
+mod tests;

@@ -69,7 +69,7 @@ pub struct JobRequest {
     /// The campaign the runs belong to.
     #[serde(default)]
     pub campaign_id: Option<String>,
-    /// Runs to use (all of the campaign).
+    /// Runs to use; they must belong to `campaign_id` and have been accepted at upload.
     #[serde(default)]
     pub run_ids: Vec<String>,
     /// The method, as the kind defines it (e.g. `lambda`, `ekf`, `n4sid`).
@@ -418,9 +418,9 @@ pub async fn finish(
 #[derive(Debug)]
 pub enum CancelOutcome {
     /// It was queued and is now cancelled.
-    Cancelled(Job),
+    Cancelled(Box<Job>),
     /// It is running; it stops at its next progress report.
-    Requested(Job),
+    Requested(Box<Job>),
     /// It already ended in this state.
     Finished(JobState),
     /// No such job.
@@ -442,9 +442,9 @@ pub async fn request_cancel(db: &Db, id: &str) -> anyhow::Result<CancelOutcome> 
         .execute(db)
         .await?;
         if queued.rows_affected() == 1 {
-            return Ok(get(db, id)
-                .await?
-                .map_or(CancelOutcome::NotFound, CancelOutcome::Cancelled));
+            return Ok(get(db, id).await?.map_or(CancelOutcome::NotFound, |j| {
+                CancelOutcome::Cancelled(Box::new(j))
+            }));
         }
         let running = sqlx::query(
             "UPDATE job SET cancel_requested = TRUE, updated_at = $1 \
@@ -455,9 +455,9 @@ pub async fn request_cancel(db: &Db, id: &str) -> anyhow::Result<CancelOutcome> 
         .execute(db)
         .await?;
         if running.rows_affected() == 1 {
-            return Ok(get(db, id)
-                .await?
-                .map_or(CancelOutcome::NotFound, CancelOutcome::Requested));
+            return Ok(get(db, id).await?.map_or(CancelOutcome::NotFound, |j| {
+                CancelOutcome::Requested(Box::new(j))
+            }));
         }
         match get(db, id).await? {
             Some(j) if j.state.is_terminal() => return Ok(CancelOutcome::Finished(j.state)),
@@ -472,7 +472,7 @@ pub async fn request_cancel(db: &Db, id: &str) -> anyhow::Result<CancelOutcome> 
 #[derive(Debug)]
 pub enum RetryOutcome {
     /// Queued again.
-    Queued(Job),
+    Queued(Box<Job>),
     /// Not retryable in this state (queued, running or succeeded).
     NotRetryable(JobState),
     /// No such job.
@@ -495,7 +495,7 @@ pub async fn retry(db: &Db, id: &str, extra_attempts: i64) -> anyhow::Result<Ret
     .execute(db)
     .await?;
     Ok(match get(db, id).await? {
-        Some(j) if done.rows_affected() == 1 => RetryOutcome::Queued(j),
+        Some(j) if done.rows_affected() == 1 => RetryOutcome::Queued(Box::new(j)),
         Some(j) => RetryOutcome::NotRetryable(j.state),
         None => RetryOutcome::NotFound,
     })
