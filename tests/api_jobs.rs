@@ -533,3 +533,27 @@ async fn health_answers_while_two_jobs_burn_cpu() {
         assert_eq!(done["state"], "succeeded", "{done}");
     }
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn event_streams_end_at_shutdown_so_the_server_can_stop() {
+    // No workers: the job stays queued and its stream would never end by itself.
+    let app = TestApp::with_jobs(registry(), config(0)).await;
+    let j = submit(&app, json!({ "n": 10 })).await;
+    let id = j["id"].as_str().unwrap().to_string();
+    let stop = app.state.jobs.shutdown_token().clone();
+    tokio::spawn(async move {
+        tokio::time::sleep(Duration::from_millis(500)).await;
+        stop.cancel();
+    });
+    let r = tokio::time::timeout(
+        Duration::from_secs(30),
+        app.call("GET", "/api/jobs/{id}/events", &[&id], None),
+    )
+    .await
+    .expect("the stream ends at shutdown");
+    let events = sse_events(&r.text);
+    assert_eq!(events.len(), 1, "{}", r.text);
+    assert_eq!(events[0]["state"], "queued");
+    // Nothing was recorded by the shutdown.
+    assert_eq!(job(&app, &id).await["state"], "queued");
+}

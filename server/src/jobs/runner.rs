@@ -182,10 +182,19 @@ async fn recovery_loop(jobs: Jobs, cx: JobContext) {
 async fn run_one(w: &Worker, job: Job) {
     let id = job.id.clone();
     let cfg = w.jobs.config();
+    // A restart after a crash begins again: say so until the handler reports.
+    let stage = if job.attempts > 1 {
+        format!(
+            "loading inputs (attempt {}: restarted from the beginning)",
+            job.attempts
+        )
+    } else {
+        "loading inputs".to_string()
+    };
     let (events, rx) = watch::channel(JobEvent {
         state: JobState::Running,
         progress: 0.0,
-        stage: "loading inputs".into(),
+        stage,
     });
     let flags = Arc::new(StopFlags::new(job.cancel_requested));
     let stage_changed = Arc::new(Notify::new());
