@@ -6,11 +6,25 @@ mod common;
 
 use common::sim::{self, all_columns, multipart, simulate};
 use common::{TestApp, rov_profile};
-use serde_json::json;
+use serde_json::{Value, json};
 
-#[tokio::test]
+/// Submits a `sum` job.
+async fn job(app: &TestApp, settings: Value) -> String {
+    let r = app
+        .call(
+            "POST",
+            "/api/jobs",
+            &[],
+            Some(json!({ "kind": "sum", "settings": settings })),
+        )
+        .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    r.json["id"].as_str().unwrap().to_string()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn every_documented_operation_is_exercised_and_answers() {
-    let app = TestApp::new().await;
+    let app = TestApp::with_jobs(common::jobs::registry(), common::jobs::config(1)).await;
     let r = app
         .call("POST", "/api/vessels", &[], Some(rov_profile()))
         .await;
@@ -44,6 +58,16 @@ async fn every_documented_operation_is_exercised_and_answers() {
         .await;
     assert_eq!(r.status, 201, "{}", r.text);
     let rid = r.json["id"].as_str().unwrap().to_string();
+    // A finished job (its event stream ends at once).
+    let jid = job(&app, json!({ "n": 100 })).await;
+    for _ in 0..3000 {
+        let r = app.call("GET", "/api/jobs/{id}", &[&jid], None).await;
+        if r.json["state"] == "succeeded" {
+            break;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(10)).await;
+    }
+    let long = json!({ "n": 1000, "steps": 100, "step_ms": 50 });
 
     let paths = app.spec["paths"].as_object().unwrap().clone();
     let mut walked = 0;
@@ -55,6 +79,8 @@ async fn every_documented_operation_is_exercised_and_answers() {
                 vec![&vid]
             } else if template.starts_with("/api/runs/") {
                 vec![&rid]
+            } else if template.starts_with("/api/jobs/") {
+                vec![&jid]
             } else if template.contains("{id}") {
                 vec![&cid]
             } else {
@@ -70,6 +96,38 @@ async fn every_documented_operation_is_exercised_and_answers() {
                         )
                         .await;
                     app.check_contract("POST", template, &r);
+                    r
+                }
+                ("post", "/api/jobs") => {
+                    app.call(
+                        "POST",
+                        template,
+                        &args,
+                        Some(json!({ "kind": "sum", "settings": { "n": 10 } })),
+                    )
+                    .await
+                }
+                // Only a queued or running job can be cancelled.
+                ("post", "/api/jobs/{id}/cancel") => {
+                    let id = job(&app, long.clone()).await;
+                    app.call("POST", template, &[&id], None).await
+                }
+                // Only a failed, cancelled or interrupted job can be retried.
+                ("post", "/api/jobs/{id}/retry") => {
+                    let id = job(&app, long.clone()).await;
+                    app.call("POST", "/api/jobs/{id}/cancel", &[&id], None)
+                        .await;
+                    let mut r = app.call("POST", template, &[&id], None).await;
+                    // A running job is cancelled at its next progress report.
+                    for _ in 0..500 {
+                        if r.status != 409 {
+                            break;
+                        }
+                        tokio::time::sleep(std::time::Duration::from_millis(10)).await;
+                        r = app.call("POST", template, &[&id], None).await;
+                    }
+                    app.call("POST", "/api/jobs/{id}/cancel", &[&id], None)
+                        .await;
                     r
                 }
                 ("post", "/api/vessels") => {
@@ -93,5 +151,5 @@ async fn every_documented_operation_is_exercised_and_answers() {
             walked += 1;
         }
     }
-    assert!(walked >= 17, "walked {walked} operations");
+    assert!(walked >= 23, "walked {walked} operations");
 }

@@ -38,6 +38,12 @@ fn every_fixed_route_of_the_contract_is_documented() {
             "get",
             "/api/campaigns/{id}/plan/experiments/{eid}/schedule.csv",
         ),
+        ("post", "/api/jobs"),
+        ("get", "/api/jobs"),
+        ("get", "/api/jobs/{id}"),
+        ("post", "/api/jobs/{id}/cancel"),
+        ("post", "/api/jobs/{id}/retry"),
+        ("get", "/api/jobs/{id}/events"),
     ] {
         assert!(
             spec["paths"][path][method].is_object(),

@@ -46,6 +46,25 @@ pub enum ApiError {
     /// Nothing with that id (404).
     #[error("{0}")]
     NotFound(String),
+    /// A request field names something that does not exist (404).
+    #[error("{message}")]
+    Missing {
+        /// Message.
+        message: String,
+        /// The field holding the unknown id.
+        field: String,
+    },
+    /// A request field is understood but unusable (422).
+    #[error("{message}")]
+    Invalid {
+        /// Message.
+        message: String,
+        /// The offending field.
+        field: String,
+    },
+    /// The resource is not in a state that allows this (409).
+    #[error("{0}")]
+    Conflict(String),
     /// Understood but impossible or unsafe (422).
     #[error("{0}")]
     Unprocessable(#[from] PlanError),
@@ -89,13 +108,30 @@ impl ApiError {
         }
     }
 
+    /// A 404 for an unknown id given in a request field.
+    pub fn missing(field: impl Into<String>, message: impl Into<String>) -> Self {
+        ApiError::Missing {
+            message: message.into(),
+            field: field.into(),
+        }
+    }
+
+    /// A 422 naming a field.
+    pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Self {
+        ApiError::Invalid {
+            message: message.into(),
+            field: field.into(),
+        }
+    }
+
     fn status(&self) -> StatusCode {
         match self {
             ApiError::BadRequest { .. } => StatusCode::BAD_REQUEST,
-            ApiError::NotFound(_) => StatusCode::NOT_FOUND,
-            ApiError::Unprocessable(_) | ApiError::InvalidUpload { .. } => {
-                StatusCode::UNPROCESSABLE_ENTITY
-            }
+            ApiError::NotFound(_) | ApiError::Missing { .. } => StatusCode::NOT_FOUND,
+            ApiError::Unprocessable(_)
+            | ApiError::InvalidUpload { .. }
+            | ApiError::Invalid { .. } => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::Conflict(_) => StatusCode::CONFLICT,
             ApiError::MethodNotAllowed(_) => StatusCode::METHOD_NOT_ALLOWED,
             ApiError::TooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
             ApiError::UnsupportedMediaType(_) => StatusCode::UNSUPPORTED_MEDIA_TYPE,
@@ -118,6 +154,9 @@ impl IntoResponse for ApiError {
         };
         let (message, field, limit) = match self {
             ApiError::BadRequest { message, field } => (message, field, None),
+            ApiError::Missing { message, field } | ApiError::Invalid { message, field } => {
+                (message, Some(field), None)
+            }
             ApiError::Unprocessable(e) => (e.message, Some(e.field), e.limit),
             ApiError::InvalidUpload {
                 message,

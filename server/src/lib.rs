@@ -6,5 +6,6 @@
 pub mod demo;
 pub mod error;
 pub mod http;
+pub mod jobs;
 pub mod processing;
 pub mod storage;

@@ -3,7 +3,10 @@
 use std::net::SocketAddr;
 use std::path::PathBuf;
 
+use std::time::Duration;
+
 use clap::Parser;
+use seatrial::jobs::{JobRegistry, Jobs, JobsConfig};
 use tracing_subscriber::EnvFilter;
 
 /// Sea-trial system identification service.
@@ -28,6 +31,17 @@ struct Args {
     /// Seed the demo vessels, campaigns and plans into an empty database.
     #[arg(long, env = "SEATRIAL_DEMO")]
     demo: bool,
+    /// Jobs computed at once (default: one per core but one, at least one).
+    #[arg(long, env = "SEATRIAL_JOB_WORKERS")]
+    job_workers: Option<usize>,
+    /// Attempts of a job whose server stopped mid-run, before it is `interrupted`.
+    #[arg(long, env = "SEATRIAL_JOB_MAX_ATTEMPTS", default_value_t = 3,
+          value_parser = clap::value_parser!(i64).range(1..))]
+    job_max_attempts: i64,
+    /// Lease of a running job (s): after a crash, its job is queued again this long after the last heartbeat.
+    #[arg(long, env = "SEATRIAL_JOB_LEASE_SECS", default_value_t = 30,
+          value_parser = clap::value_parser!(u64).range(2..))]
+    job_lease_secs: u64,
 }
 
 #[tokio::main]
@@ -54,16 +68,49 @@ async fn main() -> anyhow::Result<()> {
             .parent()
             .map_or_else(|| PathBuf::from("blobs"), |d| d.join("blobs"))
     });
-    let state = seatrial::http::AppState::new(db, &blob_dir, args.max_upload_mb * 1024 * 1024)?;
-    let app = seatrial::http::app(state, args.web_dir);
+    let config = JobsConfig {
+        workers: args
+            .job_workers
+            .unwrap_or_else(seatrial::jobs::service::default_workers),
+        max_attempts: args.job_max_attempts,
+        lease: Duration::from_secs(args.job_lease_secs),
+        ..JobsConfig::default()
+    };
+    let jobs = Jobs::new(JobRegistry::production(), config);
+    let state = seatrial::http::AppState::with_jobs(
+        db.clone(),
+        &blob_dir,
+        args.max_upload_mb * 1024 * 1024,
+        jobs.clone(),
+    )?;
     let listener = tokio::net::TcpListener::bind(args.listen).await?;
+    // Recovers jobs a previous server left running, then starts the workers.
+    let runner = seatrial::jobs::start(jobs.clone(), state.job_context()).await?;
+    let app = seatrial::http::app(state, args.web_dir);
     let addr = listener.local_addr()?;
     tracing::info!("seatrial listening on http://{addr}");
     println!("seatrial listening on http://{addr}");
+    // One signal stops everything: the listener, the event streams (they
+    // would hold the graceful shutdown open) and the runner.
+    let stop = jobs.shutdown_token().clone();
+    tokio::spawn({
+        let stop = stop.clone();
+        async move {
+            shutdown().await;
+            tracing::info!("shutting down");
+            stop.cancel();
+        }
+    });
     axum::serve(listener, app)
-        .with_graceful_shutdown(shutdown())
+        .with_graceful_shutdown(stop.cancelled_owned())
         .await?;
-    Ok(())
+    // Running jobs are neither cancelled nor failed: they unwind, and the
+    // next start re-queues them (see seatrial::jobs, "Restarts").
+    runner.shutdown(Duration::from_secs(10)).await;
+    let _ = tokio::time::timeout(Duration::from_secs(5), db.close()).await;
+    // A computation that ignored the stop still holds a blocking thread,
+    // which the runtime would wait for; its job is safe in the database.
+    std::process::exit(0);
 }
 
 /// Ctrl-C or SIGTERM.

@@ -4,7 +4,10 @@
 
 #![allow(dead_code)]
 
+pub mod jobs;
 pub mod sim;
+
+use std::sync::Arc;
 
 use axum::Router;
 use axum::body::Body;
@@ -15,7 +18,10 @@ use tower::ServiceExt;
 pub struct TestApp {
     pub router: Router,
     pub spec: Value,
-    _dir: tempfile::TempDir,
+    pub state: seatrial::http::AppState,
+    /// The job runner, when started (`with_jobs`).
+    pub runner: Option<seatrial::jobs::RunnerHandle>,
+    dir: Arc<tempfile::TempDir>,
 }
 
 /// A response: status, content type, body text and parsed JSON (if any).
@@ -33,18 +39,69 @@ impl TestApp {
 
     /// An app whose uploads are limited to `max_upload_bytes`.
     pub async fn with_upload_limit(max_upload_bytes: u64) -> Self {
-        let dir = tempfile::tempdir().unwrap();
+        let dir = Arc::new(tempfile::tempdir().unwrap());
+        let jobs = seatrial::jobs::Jobs::new(
+            seatrial::jobs::JobRegistry::new(),
+            seatrial::jobs::JobsConfig::default(),
+        );
+        Self::build(dir, max_upload_bytes, jobs, false).await
+    }
+
+    /// An app with these job kinds and a running job runner (unless
+    /// `config.workers` is 0, when jobs stay queued).
+    pub async fn with_jobs(
+        registry: seatrial::jobs::JobRegistry,
+        config: seatrial::jobs::JobsConfig,
+    ) -> Self {
+        let dir = Arc::new(tempfile::tempdir().unwrap());
+        let jobs = seatrial::jobs::Jobs::new(registry, config);
+        Self::build(dir, 64 << 20, jobs, true).await
+    }
+
+    /// A new server over the same database file (a restart): recovery runs
+    /// as the runner starts.
+    pub async fn restart(
+        &self,
+        registry: seatrial::jobs::JobRegistry,
+        config: seatrial::jobs::JobsConfig,
+    ) -> Self {
+        let jobs = seatrial::jobs::Jobs::new(registry, config);
+        Self::build(self.dir.clone(), 64 << 20, jobs, true).await
+    }
+
+    async fn build(
+        dir: Arc<tempfile::TempDir>,
+        max_upload_bytes: u64,
+        jobs: seatrial::jobs::Jobs,
+        run: bool,
+    ) -> Self {
         let db = seatrial::storage::open(&dir.path().join("t.db"))
             .await
             .unwrap();
-        let state =
-            seatrial::http::AppState::new(db, &dir.path().join("blobs"), max_upload_bytes).unwrap();
+        let state = seatrial::http::AppState::with_jobs(
+            db,
+            &dir.path().join("blobs"),
+            max_upload_bytes,
+            jobs.clone(),
+        )
+        .unwrap();
+        let runner = if run {
+            Some(
+                seatrial::jobs::start(jobs, state.job_context())
+                    .await
+                    .unwrap(),
+            )
+        } else {
+            None
+        };
         let web = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("web");
         let spec = serde_json::to_value(seatrial::http::openapi()).unwrap();
         TestApp {
-            router: seatrial::http::app(state, web),
+            router: seatrial::http::app(state.clone(), web),
             spec,
-            _dir: dir,
+            state,
+            runner,
+            dir,
         }
     }
 

@@ -6,6 +6,7 @@
 pub mod campaigns;
 pub mod export;
 pub mod health;
+pub mod jobs;
 pub mod json;
 pub mod plans;
 pub mod query;
@@ -25,6 +26,7 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use crate::error::{ApiError, ErrorBody};
+use crate::jobs::{JobContext, JobEvent, JobRegistry, Jobs, JobsConfig};
 use crate::storage::Db;
 use crate::storage::blobs::BlobStore;
 
@@ -37,16 +39,40 @@ pub struct AppState {
     pub blobs: BlobStore,
     /// Largest upload (all files of a run together), bytes.
     pub max_upload_bytes: u64,
+    /// Background jobs: the registered kinds, the running ones, the runner's signals.
+    pub jobs: Jobs,
 }
 
 impl AppState {
-    /// State over a database whose blobs live in `blob_dir`.
+    /// State over a database whose blobs live in `blob_dir`, with no job
+    /// kinds registered.
     pub fn new(db: Db, blob_dir: &std::path::Path, max_upload_bytes: u64) -> std::io::Result<Self> {
+        let jobs = Jobs::new(JobRegistry::new(), JobsConfig::default());
+        Self::with_jobs(db, blob_dir, max_upload_bytes, jobs)
+    }
+
+    /// State with the given job machinery (start its runner with
+    /// [`crate::jobs::start`] over [`job_context`](Self::job_context)).
+    pub fn with_jobs(
+        db: Db,
+        blob_dir: &std::path::Path,
+        max_upload_bytes: u64,
+        jobs: Jobs,
+    ) -> std::io::Result<Self> {
         Ok(AppState {
             db,
             blobs: BlobStore::open(blob_dir)?,
             max_upload_bytes,
+            jobs,
         })
+    }
+
+    /// What job handlers read.
+    pub fn job_context(&self) -> JobContext {
+        JobContext {
+            db: self.db.clone(),
+            blobs: self.blobs.clone(),
+        }
     }
 }
 
@@ -57,11 +83,12 @@ impl AppState {
         description = "Sea-trial system identification of ROVs and dynamically positioned ships: plan trial campaigns, score runs, identify and validate models.",
         license(name = "MIT")
     ),
-    components(schemas(ErrorBody)),
+    components(schemas(ErrorBody, JobEvent)),
     tags(
         (name = "service", description = "Service health"),
         (name = "planning", description = "Vessels, campaigns, excitation plans and their exports"),
-        (name = "runs", description = "Uploaded logs, their alignment and data-quality reports")
+        (name = "runs", description = "Uploaded logs, their alignment and data-quality reports"),
+        (name = "jobs", description = "Background jobs (identification, discovery): submit, follow by polling or Server-Sent Events, cancel, retry")
     )
 )]
 struct ApiDoc;
@@ -86,6 +113,11 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(runs::raw_run))
         .routes(routes!(runs::run_quality))
         .routes(routes!(runs::coverage))
+        .routes(routes!(jobs::submit_job, jobs::list_jobs))
+        .routes(routes!(jobs::get_job))
+        .routes(routes!(jobs::cancel_job))
+        .routes(routes!(jobs::retry_job))
+        .routes(routes!(jobs::job_events))
         // Uploads stream to disk under their own limit (counted in the handler).
         .merge(
             OpenApiRouter::new()

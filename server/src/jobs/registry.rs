@@ -1,0 +1,55 @@
+//! The job kinds this server can run, built once at start-up.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use super::handler::JobHandler;
+
+/// Handlers by kind.
+#[derive(Clone, Default)]
+pub struct JobRegistry {
+    handlers: BTreeMap<String, Arc<dyn JobHandler>>,
+}
+
+impl JobRegistry {
+    /// No kinds.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The production kinds. Empty until the identification and discovery
+    /// handlers exist: `POST /api/jobs` then answers 422 for every kind.
+    pub fn production() -> Self {
+        Self::new()
+    }
+
+    /// Adds (or replaces) the handler of `kind`.
+    pub fn register(&mut self, kind: impl Into<String>, handler: impl JobHandler) -> &mut Self {
+        self.handlers.insert(kind.into(), Arc::new(handler));
+        self
+    }
+
+    /// Builder form of [`register`](Self::register).
+    pub fn with(mut self, kind: impl Into<String>, handler: impl JobHandler) -> Self {
+        self.register(kind, handler);
+        self
+    }
+
+    /// The handler of `kind`.
+    pub fn get(&self, kind: &str) -> Option<Arc<dyn JobHandler>> {
+        self.handlers.get(kind).cloned()
+    }
+
+    /// Registered kinds, sorted.
+    pub fn kinds(&self) -> Vec<&str> {
+        self.handlers.keys().map(String::as_str).collect()
+    }
+}
+
+impl std::fmt::Debug for JobRegistry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("JobRegistry")
+            .field("kinds", &self.kinds())
+            .finish()
+    }
+}
