@@ -17,7 +17,6 @@ use super::candidates::{Effect, TermContext};
 use super::data::{Baseline, Record};
 use super::model::{AugmentedModel, ModelTerm, actuate};
 use super::svf::{Svf, lag_zoh};
-use crate::planning::Dof;
 
 /// A hypothesis term with its shape parameter fixed (actuator effects).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,12 +68,12 @@ pub(crate) struct FitOut {
     pub sse: f64,
     /// Stacked samples.
     pub n: usize,
-    /// Parameters.
-    pub p: usize,
     /// HAC covariance over all parameters, if asked for.
     pub cov: Option<DMatrix<f64>>,
     /// Weighted residuals per (row, run) block.
     pub resid: Vec<Vec<f64>>,
+    /// D̄ the current's regressors were built with.
+    pub d_ref: DMatrix<f64>,
 }
 
 impl FitOut {
@@ -156,14 +155,6 @@ impl<'a> Prepared<'a> {
         Some(prep)
     }
 
-    pub fn ctx(&self) -> TermContext<'_> {
-        TermContext {
-            dofs: &self.baseline.dofs,
-            m_ref: &self.baseline.m,
-            d_ref: &self.baseline.d_bar,
-        }
-    }
-
     /// Rows touched by `specs` plus `extra`, sorted.
     pub fn rows_of(&self, specs: &[Spec], extra: &[usize]) -> Vec<usize> {
         let mut rows: Vec<usize> = extra.to_vec();
@@ -178,6 +169,47 @@ impl<'a> Prepared<'a> {
     /// Fits `specs` jointly with the baseline entries of their rows (and of
     /// `extra` rows) on the runs `runs`. `None` if nothing is left to fit.
     pub fn fit(&self, specs: &[Spec], extra: &[usize], runs: &[usize], hac: bool) -> Option<FitOut> {
+        if !specs.iter().any(|s| s.effect == Effect::Current) {
+            return self.fit_with(specs, extra, runs, hac, &self.baseline.d_bar);
+        }
+        // The current acts through D̄(ν − ν_c): its regressors need the D̄
+        // being fitted. A baseline identified with the current present has a
+        // biased D̄, so iterate to the fixed point (two passes suffice).
+        let mut d = self.baseline.d_bar.clone();
+        let mut f = self.fit_with(specs, extra, runs, false, &d)?;
+        for pass in 0..3 {
+            d = self.d_bar_of(specs, &f, &d);
+            f = self.fit_with(specs, extra, runs, hac && pass == 2, &d)?;
+        }
+        Some(f)
+    }
+
+    /// D̄ with the rows and coupling entries of `f` written into `d`.
+    fn d_bar_of(&self, specs: &[Spec], f: &FitOut, d: &DMatrix<f64>) -> DMatrix<f64> {
+        let mut d = d.clone();
+        for (ri, &r) in f.rows.iter().enumerate() {
+            for (k, &j) in self.structure[r].1.iter().enumerate() {
+                d[(r, j)] = f.base[ri].1[k];
+            }
+        }
+        for (si, s) in specs.iter().enumerate() {
+            if let Effect::Coupling { dof, from } = s.effect {
+                if let (Some(i), Some(j)) = (self.baseline.index_of(dof), self.baseline.index_of(from)) {
+                    d[(i, j)] = f.theta[si][1];
+                }
+            }
+        }
+        d
+    }
+
+    fn fit_with(
+        &self,
+        specs: &[Spec],
+        extra: &[usize],
+        runs: &[usize],
+        hac: bool,
+        d_ref: &DMatrix<f64>,
+    ) -> Option<FitOut> {
         let rows = self.rows_of(specs, extra);
         if rows.is_empty() {
             return None;
@@ -199,7 +231,11 @@ impl<'a> Prepared<'a> {
             theta_index.push(p);
             p += s.effect.n_linear();
         }
-        let ctx = self.ctx();
+        let ctx = TermContext {
+            dofs,
+            m_ref: &self.baseline.m,
+            d_ref,
+        };
         let mut hmat = DMatrix::<f64>::zeros(p, p);
         let mut bvec = vec![0.0; p];
         let mut blocks: Vec<(Vec<usize>, Vec<Vec<f64>>, Vec<f64>)> = Vec::new();
@@ -342,9 +378,9 @@ impl<'a> Prepared<'a> {
             theta_index,
             sse,
             n: n_tot,
-            p,
             cov,
             resid,
+            d_ref: d_ref.clone(),
         })
     }
 
@@ -389,7 +425,7 @@ impl<'a> Prepared<'a> {
             d,
             b.restoring,
             b.m.clone(),
-            b.d_bar.clone(),
+            f.d_ref.clone(),
             terms,
         )
     }
@@ -403,11 +439,6 @@ impl<'a> Prepared<'a> {
             .collect();
         v.sort_by(|a, b| a.total_cmp(b));
         v
-    }
-
-    /// The DOF of a row.
-    pub fn dof(&self, row: usize) -> Dof {
-        self.baseline.dofs[row]
     }
 }
 
@@ -454,7 +485,11 @@ impl Prepared<'_> {
             .iter()
             .filter_map(|s| s.shape.map(|v| (s.effect, v)))
             .collect();
-        let ctx = self.ctx();
+        let ctx = TermContext {
+            dofs,
+            m_ref: &self.baseline.m,
+            d_ref: &f.d_ref,
+        };
         let k = k.max(1);
         let mut sse = 0.0;
         let mut resid = Vec::new();

@@ -92,7 +92,8 @@ pub struct BandPower {
 /// Residual spectrum of one channel in octave bands.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResidualSpectrum {
-    /// Noise floor (units²/Hz): median PSD above 70 % of Nyquist.
+    /// White-noise level (units²/Hz) of the sensor noise: median of the
+    /// whitened PSD above 70 % of Nyquist.
     pub floor: f64,
     /// Octave bands from Nyquist down to the lowest resolved frequency.
     pub bands: Vec<BandPower>,
@@ -102,8 +103,14 @@ pub struct ResidualSpectrum {
 }
 
 /// Welch PSD of residual runs averaged over runs (same segment length),
-/// split into octave bands against the high-frequency floor.
-pub fn residual_spectrum(runs: &[Vec<f64>], fs: f64) -> Option<ResidualSpectrum> {
+/// split into octave bands against the noise floor.
+///
+/// The floor is shaped by the 1-step predictor: sensor noise n on ν leaves
+/// e_{k+1} = n_{k+1} − Φ n_k, whose PSD is σ²·|1 − Φe^{−iω}|² (blue for Φ
+/// near 1). σ² is taken from the part above 70 % of Nyquist, where a
+/// low-pass vessel leaves nothing but that noise; `phi` = 0 gives a flat
+/// floor.
+pub fn residual_spectrum(runs: &[Vec<f64>], fs: f64, phi: f64) -> Option<ResidualSpectrum> {
     let runs: Vec<Vec<f64>> = runs
         .iter()
         .map(|e| e.iter().copied().filter(|x| x.is_finite()).collect::<Vec<_>>())
@@ -126,6 +133,12 @@ pub fn residual_spectrum(runs: &[Vec<f64>], fs: f64) -> Option<ResidualSpectrum>
     let (freqs, mut values) = psd?;
     values.iter_mut().for_each(|v| *v /= runs.len() as f64);
     let nyq = fs / 2.0;
+    let shape = |f: f64| {
+        let w = std::f64::consts::TAU * f / fs;
+        (1.0 - 2.0 * phi * w.cos() + phi * phi).max(1e-12)
+    };
+    // Whitened PSD: the residual relative to the noise's own shape.
+    values = freqs.iter().zip(&values).map(|(f, v)| v / shape(*f)).collect();
     let mut hi: Vec<f64> = freqs
         .iter()
         .zip(&values)
@@ -201,10 +214,16 @@ mod tests {
         let w = whiteness(&[walk.clone()], 30);
         assert!(!w.white && w.lags_outside == 30);
         // The walk's spectrum rises ~20 dB/decade towards DC; white noise is flat.
-        let s = residual_spectrum(&[walk], 10.0).unwrap();
+        let s = residual_spectrum(&[walk], 10.0, 0.0).unwrap();
         assert!(s.low_slope < -1.5, "slope {}", s.low_slope);
         assert!(s.bands.first().unwrap().excess_db > 20.0);
-        let s = residual_spectrum(&[e], 10.0).unwrap();
+        let s = residual_spectrum(&[e.clone()], 10.0, 0.0).unwrap();
         assert!(s.bands.iter().all(|b| b.excess_db.abs() < 3.0), "{:?}", s.bands);
+        // Differenced noise n_{k+1} − 0.95 n_k is blue, but white once shaped.
+        let d: Vec<f64> = e.windows(2).map(|w| w[1] - 0.95 * w[0]).collect();
+        let s = residual_spectrum(&[d.clone()], 10.0, 0.95).unwrap();
+        assert!(s.bands.iter().all(|b| b.excess_db.abs() < 3.0), "{:?}", s.bands);
+        let s = residual_spectrum(&[d], 10.0, 0.0).unwrap();
+        assert!(s.bands.first().unwrap().excess_db < -10.0);
     }
 }

@@ -47,20 +47,6 @@ impl Scored {
         self.fit.theta.len() - 1
     }
 
-    /// t-statistics of its linear coefficients.
-    pub fn t_stats(&self) -> Vec<f64> {
-        let s = self.own();
-        let cov = self.fit.theta_cov(s);
-        self.fit.theta[s]
-            .iter()
-            .enumerate()
-            .map(|(i, c)| match &cov {
-                Some(cv) if cv[(i, i)] > 0.0 => c / cv[(i, i)].sqrt(),
-                _ => 0.0,
-            })
-            .collect()
-    }
-
     /// Passes the equation-error screen.
     pub fn significant(&self, c: &Criteria) -> bool {
         self.z >= c.min_z && self.delta_bic <= c.max_delta_bic
@@ -254,9 +240,4 @@ fn conflicts(e: &Effect, taken: &[Effect]) -> bool {
         | (Effect::CoriolisProduct { .. }, Effect::CoriolisFromM) => true,
         _ => t.shape().is_some() && e.shape() == t.shape() && t.dof() == e.dof(),
     })
-}
-
-/// The final fit of the chosen terms on all runs, with HAC covariances.
-pub(crate) fn final_fit(prep: &Prepared<'_>, chosen: &[Spec], runs: &[usize]) -> Option<FitOut> {
-    prep.fit(chosen, &[], runs, true)
 }

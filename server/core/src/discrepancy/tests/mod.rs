@@ -1,6 +1,7 @@
 //! The proof: concealed effects in a 6-DOF truth, a baseline identified
 //! without them, discovery run on the result.
 
+mod proof;
 mod scenario;
 mod truth;
 
@@ -39,54 +40,40 @@ fn quadratic_damping_coefficient_is_recovered_with_honest_uncertainty() {
     assert!(sd < 300.0);
 }
 
+
 #[test]
 #[ignore]
-fn debug_scores() {
-    use crate::discrepancy::candidates::{LibrarySettings, library};
-    use crate::discrepancy::select::{Criteria, step};
+fn debug_current_truth_model() {
+    use crate::discrepancy::model::{AugmentedModel, ModelTerm};
+    use nalgebra::{DMatrix, DVector};
     let p = surveyor_rov();
-    for case in ["clean", "quad", "lag", "tether", "current", "delay", "sat", "coriolis"] {
-        let mut t = Truth::from_profile(&p);
-        match case {
-            "quad" => t.quad[1] = 0.6 * t.d[1] / 0.4,
-            "lag" => t.lag[2] = Some(0.6),
-            "tether" => t.constant[4] = 400.0,
-            "current" => t.current = Some([0.15, -0.1]),
-            "delay" => t.delay[0] = 4,
-            "sat" => t.saturation[5] = Some(0.3 * p.limit(Dof::Yaw).max_force),
-            "coriolis" => t.coriolis = true,
-            _ => {}
-        }
-        let s = scenario(t, 5, 3, 1, 120.0);
-        let t0 = std::time::Instant::now();
-        let prep = Prepared::new(&s.baseline, &s.est, 0.5, 25, 30).unwrap();
-        let lib = library(&s.baseline.dofs, &s.baseline.m, &s.baseline.d_bar, &LibrarySettings::default());
-        let c = Criteria { min_z: 4.0, max_delta_bic: -10.0, min_cv_gain: 0.003, cv_candidates: 6, max_lag_s: 3.0, max_delay_samples: 10, k_step: 10 };
-        let all: Vec<usize> = (0..s.est.len()).collect();
-        let st = step(&prep, &[], &lib, &all, &c);
-        eprintln!("== {case}: kappa {:.2} winner {:?} ({:?})", prep.kappa, st.winner.map(|i| st.scored[i].spec), t0.elapsed());
-        for sc in st.scored.iter().take(8) {
-            eprintln!("  {:<50} dBIC {:>10.1} z {:>7.1} cv {:?} shape {:?}", sc.spec.effect.label(), sc.delta_bic, sc.z, sc.cv_gain, sc.spec.shape);
-        }
+    let mut t = Truth::from_profile(&p);
+    t.current = Some([0.0, -0.2]);
+    let s = scenario(t.clone(), 11, 3, 1, 120.0);
+    let m = DMatrix::from_diagonal(&DVector::from_row_slice(&t.m));
+    let d = DMatrix::from_diagonal(&DVector::from_row_slice(&t.d));
+    let term = ModelTerm { effect: Effect::Current, coefficients: vec![0.0, -0.2], covariance: vec![], shape: None, shape_std: None };
+    let model = AugmentedModel::new(Dof::ALL.to_vec(), m.clone(), d.clone(), t.restoring, m, d, vec![term]);
+    let val = &s.val[0];
+    let sim = model.simulate(val);
+    let tr = scenario::true_free_run(&s, val, 0);
+    for i in 0..6 {
+        let a = crate::validation::nrmse_fit(val.nu.column(i).as_slice(), sim.column(i).as_slice());
+        let b = crate::validation::nrmse_fit(val.nu.column(i).as_slice(), tr.column(i).as_slice());
+        eprintln!("dof {i}: model {a:?} truth {b:?}");
     }
 }
 
 #[test]
 #[ignore]
-fn debug_yaw_lag() {
-    let p = surveyor_rov();
-    let t = Truth::from_profile(&p);
-    let s = scenario(t.clone(), 5, 3, 1, 120.0);
-    eprintln!("baseline M {:?}\n D {:?}", s.baseline.m.diagonal().as_slice(), s.baseline.d_bar.diagonal().as_slice());
-    eprintln!("true M {:?}\n D {:?}", t.m, t.d);
-    let prep = Prepared::new(&s.baseline, &s.est, 0.5, 25, 30).unwrap();
-    eprintln!("weights {:?}", prep.weights);
-    let all: Vec<usize> = (0..s.est.len()).collect();
-    for tl in [0.05, 0.2, 0.5, 1.0, 1.93, 3.0] {
-        let spec = Spec { effect: Effect::ActuatorLag { dof: Dof::Yaw }, shape: Some(tl) };
-        let f = prep.fit(&[spec], &[], &all, false).unwrap();
-        eprintln!("T {tl}: sse {:.1} base {:?}", f.sse, f.base);
+fn debug_current_case() {
+    let o = proof::run_case(&[proof::Concealed::Current], 11);
+    let m = &o.report.model;
+    for i in 0..6 {
+        eprintln!("row {i}: M {:?}\n       D {:?}", m.m[i], m.d_bar[i]);
     }
-    let f = prep.fit(&[], &[5], &all, false).unwrap();
-    eprintln!("null: sse {:.1} base {:?}", f.sse, f.base);
+    eprintln!("terms {:?}", m.terms);
+    for h in o.report.hypotheses.iter().take(8) {
+        eprintln!("{} dBIC {:.0} z {:.1} cv {:?}", h.label, h.delta_bic, h.z, h.cv_gain);
+    }
 }
