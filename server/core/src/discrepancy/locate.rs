@@ -274,7 +274,9 @@ pub fn locate(model: &AugmentedModel, runs: &[&Record], k: usize, segment_s: f64
                 }
             }
         }
-        if !w.white || fits.free_run.is_some_and(|f| f < 0.9) {
+        // Whiteness alone does not flag a DOF: sensor noise on ν makes the
+        // 1-step residual n_{k+1} − Φn_k coloured even for a perfect model.
+        if fits.free_run.is_some_and(|f| f < 0.9) {
             parts = true;
         }
         rep.per_dof.push(DofLocation {

@@ -10,7 +10,6 @@ use super::candidates::{Effect, ShapeKind, TermContext};
 use super::data::{Baseline, Record, Restoring};
 use super::svf::lag_zoh;
 use crate::planning::Dof;
-use crate::simulation::integrate::rk4_step;
 use crate::validation::{Predictor, ValidationRecord};
 
 /// One term of the augmented model with its estimates.
@@ -207,30 +206,56 @@ impl AugmentedModel {
         let mut x: Vec<f64> = nu0.to_vec();
         x.extend(lag_dofs.iter().map(|&i| lag0[i]));
         let mut u = vec![0.0; n];
+        let len = rec.len();
+        let dim = x.len();
+        let (mut k1, mut k2, mut k3, mut k4, mut tmp) =
+            (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
         for k in start..end {
-            let eta = rec.eta_at(k);
-            let g = self.restoring.g(&eta);
-            let g: Vec<f64> = self.dofs.iter().map(|d| g[d.index()]).collect();
+            // η is recorded: linear between samples, so restoring and
+            // heading-dependent terms move within the step as they do at sea.
+            let e0 = rec.eta_at(k);
+            let e1 = rec.eta_at((k + 1).min(len - 1));
+            let eta_at = |frac: f64| -> [f64; 6] { std::array::from_fn(|j| e0[j] + frac * (e1[j] - e0[j])) };
+            let etas = [eta_at(0.0), eta_at(0.5), eta_at(1.0)];
+            let gs: Vec<Vec<f64>> = etas
+                .iter()
+                .map(|e| {
+                    let g = self.restoring.g(e);
+                    self.dofs.iter().map(|d| g[d.index()]).collect()
+                })
+                .collect();
             for (i, ui) in u.iter_mut().enumerate() {
                 *ui = input.held[i][k];
             }
-            let mut f = |x: &[f64], u: &[f64], dx: &mut [f64]| {
-                let mut tau_a = u.to_vec();
+            let f = |x: &[f64], stage: usize, dx: &mut [f64]| {
+                let mut tau_a = u.clone();
                 for (s, &i) in lag_dofs.iter().enumerate() {
                     let t_a = input.lag[i].unwrap_or(1.0);
                     tau_a[i] = x[n + s];
                     dx[n + s] = (u[i] - x[n + s]) / t_a;
                 }
-                self.nu_dot(&x[..n], &tau_a, &g, &eta, &mut dx[..n]);
+                self.nu_dot(&x[..n], &tau_a, &gs[stage], &etas[stage], &mut dx[..n]);
             };
-            rk4_step(&mut f, &mut x, &u, rec.h);
-            if x.iter().any(|v| !v.is_finite() || v.abs() > 1e6) {
-                // A diverging candidate: freeze rather than overflow.
-                x.iter_mut().for_each(|v| {
-                    if !v.is_finite() {
-                        *v = 0.0
-                    }
-                });
+            let h = rec.h;
+            f(&x, 0, &mut k1);
+            for i in 0..dim {
+                tmp[i] = x[i] + 0.5 * h * k1[i];
+            }
+            f(&tmp, 1, &mut k2);
+            for i in 0..dim {
+                tmp[i] = x[i] + 0.5 * h * k2[i];
+            }
+            f(&tmp, 1, &mut k3);
+            for i in 0..dim {
+                tmp[i] = x[i] + h * k3[i];
+            }
+            f(&tmp, 2, &mut k4);
+            for i in 0..dim {
+                x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+            if x.iter().any(|v| !v.is_finite()) {
+                // A diverging candidate: restart from rest rather than overflow.
+                x.iter_mut().for_each(|v| *v = 0.0);
             }
             out.push(x[..n].to_vec());
         }

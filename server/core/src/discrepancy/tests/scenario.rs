@@ -5,7 +5,9 @@ use nalgebra::DMatrix;
 
 use super::truth::{Truth, commands};
 use crate::discrepancy::data::{Baseline, Record, Restoring};
+use crate::discrepancy::candidates::Effect;
 use crate::discrepancy::fit::Prepared;
+use crate::discrepancy::model::{AugmentedModel, ModelTerm};
 use crate::planning::examples::surveyor_rov;
 use crate::planning::{Dof, VesselProfile};
 
@@ -60,8 +62,42 @@ pub fn fit_diagonal_baseline(dofs: &[Dof], restoring: Restoring, runs: &[Record]
     b
 }
 
-/// The truth's noise-free free run on a validation run's commands.
-pub fn true_free_run(s: &Scenario, rec: &Record, index: usize) -> DMatrix<f64> {
-    let psi0 = 0.7 * (s.est.len() + index) as f64;
-    s.truth.run("true", &rec.tau, H, psi0, None).nu
+/// The truth written in the model's own form (same recorded-η
+/// convention): the upper bound a discovered model can reach.
+pub fn true_model(t: &Truth) -> AugmentedModel {
+    let m = DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(&t.m));
+    let d = DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(&t.d));
+    let term = |effect, coefficients: Vec<f64>, shape: Option<f64>| ModelTerm {
+        effect,
+        coefficients,
+        covariance: vec![],
+        shape,
+        shape_std: None,
+    };
+    let mut terms = Vec::new();
+    for dof in Dof::ALL {
+        let i = dof.index();
+        if t.quad[i] != 0.0 {
+            terms.push(term(Effect::QuadraticDamping { dof }, vec![t.quad[i]], None));
+        }
+        if t.constant[i] != 0.0 {
+            terms.push(term(Effect::ConstantLoad { dof }, vec![t.constant[i]], None));
+        }
+        if let Some(l) = t.lag[i] {
+            terms.push(term(Effect::ActuatorLag { dof }, vec![], Some(l)));
+        }
+        if t.delay[i] > 0 {
+            terms.push(term(Effect::InputDelay { dof }, vec![], Some(t.delay[i] as f64)));
+        }
+        if let Some(l) = t.saturation[i] {
+            terms.push(term(Effect::Saturation { dof }, vec![], Some(l)));
+        }
+    }
+    if t.coriolis {
+        terms.push(term(Effect::CoriolisFromM, vec![1.0], None));
+    }
+    if let Some([vn, ve]) = t.current {
+        terms.push(term(Effect::Current, vec![vn, ve], None));
+    }
+    AugmentedModel::new(Dof::ALL.to_vec(), m.clone(), d.clone(), t.restoring, m, d, terms)
 }
