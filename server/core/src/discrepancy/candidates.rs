@@ -154,11 +154,20 @@ pub enum ShapeKind {
 /// Coriolis products of each DOF's equation for a diagonal M:
 /// (C(ν)ν)_i = Σ ±(m_a − m_b)·ν_a·ν_b over these pairs.
 pub const CORIOLIS_PAIRS: [(Dof, [(Dof, Dof); 2]); 6] = [
-    (Dof::Surge, [(Dof::Heave, Dof::Pitch), (Dof::Sway, Dof::Yaw)]),
+    (
+        Dof::Surge,
+        [(Dof::Heave, Dof::Pitch), (Dof::Sway, Dof::Yaw)],
+    ),
     (Dof::Sway, [(Dof::Surge, Dof::Yaw), (Dof::Heave, Dof::Roll)]),
-    (Dof::Heave, [(Dof::Sway, Dof::Roll), (Dof::Surge, Dof::Pitch)]),
+    (
+        Dof::Heave,
+        [(Dof::Sway, Dof::Roll), (Dof::Surge, Dof::Pitch)],
+    ),
     (Dof::Roll, [(Dof::Sway, Dof::Heave), (Dof::Pitch, Dof::Yaw)]),
-    (Dof::Pitch, [(Dof::Surge, Dof::Heave), (Dof::Roll, Dof::Yaw)]),
+    (
+        Dof::Pitch,
+        [(Dof::Surge, Dof::Heave), (Dof::Roll, Dof::Yaw)],
+    ),
     (Dof::Yaw, [(Dof::Surge, Dof::Sway), (Dof::Roll, Dof::Pitch)]),
 ];
 
@@ -222,7 +231,11 @@ impl Effect {
             Effect::QuadraticDamping { dof } => {
                 let s = dof.velocity_symbol();
                 let vu = dof.velocity_unit();
-                vec![format!("d_{s}|{s}| ({}·s²/{}²)", unit(dof), vu.trim_end_matches("/s"))]
+                vec![format!(
+                    "d_{s}|{s}| ({}·s²/{}²)",
+                    unit(dof),
+                    vu.trim_end_matches("/s")
+                )]
             }
             Effect::CoriolisFromM => vec!["scale of C(ν) from M (–)".into()],
             Effect::CoriolisProduct { dof, a, b } => vec![format!(
@@ -276,14 +289,16 @@ impl Effect {
                 dof.name()
             ),
             Effect::ConstantLoad { dof } => {
-                format!("constant {} in {} (tether/bias)", load_word(dof), dof.name())
+                format!(
+                    "constant {} in {} (tether/bias)",
+                    load_word(dof),
+                    dof.name()
+                )
             }
             Effect::Current => "ocean current (damping on ν − ν_c)".into(),
-            Effect::Coupling { dof, from } => format!(
-                "missing coupling from {} into {}",
-                from.name(),
-                dof.name()
-            ),
+            Effect::Coupling { dof, from } => {
+                format!("missing coupling from {} into {}", from.name(), dof.name())
+            }
             Effect::ActuatorLag { dof } => format!("actuator lag in {}", dof.name()),
             Effect::InputDelay { dof } => format!("input delay in {}", dof.name()),
             Effect::Saturation { dof } => format!("thrust saturation in {}", dof.name()),
@@ -309,7 +324,14 @@ impl Effect {
     /// φ_p for coefficient `p` in equation row `row` at (ν, η), the force
     /// it adds to the left-hand side per unit coefficient. Not used for
     /// [`Effect::Coupling`] (which enters M and D̄) nor actuator effects.
-    pub fn regressor(&self, p: usize, row: usize, ctx: &TermContext<'_>, nu: &[f64], eta: &[f64; 6]) -> f64 {
+    pub fn regressor(
+        &self,
+        p: usize,
+        row: usize,
+        ctx: &TermContext<'_>,
+        nu: &[f64],
+        eta: &[f64; 6],
+    ) -> f64 {
         let row_dof = ctx.dofs[row];
         let v = |d: Dof| ctx.dofs.iter().position(|&x| x == d).map_or(0.0, |j| nu[j]);
         match *self {
@@ -546,10 +568,20 @@ mod tests {
         m[(1, 2)] = 0.1;
         let d = DMatrix::identity(3, 3);
         let lib = library(&dofs, &m, &d, &LibrarySettings::default());
-        assert!(!lib.contains(&Effect::Coupling { dof: Dof::Sway, from: Dof::Yaw }));
-        assert!(lib.contains(&Effect::Coupling { dof: Dof::Yaw, from: Dof::Sway }));
+        assert!(!lib.contains(&Effect::Coupling {
+            dof: Dof::Sway,
+            from: Dof::Yaw
+        }));
+        assert!(lib.contains(&Effect::Coupling {
+            dof: Dof::Yaw,
+            from: Dof::Sway
+        }));
         assert!(lib.contains(&Effect::Current));
-        assert!(lib.contains(&Effect::CoriolisProduct { dof: Dof::Yaw, a: Dof::Surge, b: Dof::Sway }));
+        assert!(lib.contains(&Effect::CoriolisProduct {
+            dof: Dof::Yaw,
+            a: Dof::Surge,
+            b: Dof::Sway
+        }));
         // No attitude DOFs: no restoring shapes.
         assert!(!lib.iter().any(|e| e.family() == Family::Restoring));
     }

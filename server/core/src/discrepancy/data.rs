@@ -161,7 +161,12 @@ impl Record {
     }
 
     /// Checks shapes, sample time and finiteness; `field` prefixes messages.
-    pub fn validate(&self, n_dofs: usize, min_len: usize, field: &str) -> Result<(), DiscoveryError> {
+    pub fn validate(
+        &self,
+        n_dofs: usize,
+        min_len: usize,
+        field: &str,
+    ) -> Result<(), DiscoveryError> {
         if !(self.h.is_finite() && self.h > 0.0) {
             return Err(DiscoveryError::invalid(
                 format!("{field}.h"),

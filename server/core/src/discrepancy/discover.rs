@@ -8,7 +8,10 @@ use super::error::DiscoveryError;
 use super::evidence::{effect_text, separating_evidence};
 use super::experiment::propose;
 use super::fit::{Prepared, Spec};
-use super::locate::{BAND_EXCESS_DB, Predictions, capital, channel_fits, locate, phi_diag, predict, residual, signature_words};
+use super::locate::{
+    BAND_EXCESS_DB, Predictions, capital, channel_fits, locate, phi_diag, predict, residual,
+    signature_words,
+};
 use super::model::AugmentedModel;
 use super::report::*;
 use super::residual::{residual_spectrum, whiteness};
@@ -82,7 +85,10 @@ impl DiscoverySettings {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(DiscoveryError::invalid(format!("settings.{name}"), "must be finite and > 0"))
+                Err(DiscoveryError::invalid(
+                    format!("settings.{name}"),
+                    "must be finite and > 0",
+                ))
             }
         };
         pos("svf_time_constant_s", self.svf_time_constant_s)?;
@@ -93,16 +99,28 @@ impl DiscoverySettings {
         pos("segment_s", self.segment_s)?;
         pos("ambiguity_ratio", self.ambiguity_ratio)?;
         if !(self.min_cv_gain.is_finite() && self.max_delta_bic.is_finite()) {
-            return Err(DiscoveryError::invalid("settings.min_cv_gain", "must be finite"));
+            return Err(DiscoveryError::invalid(
+                "settings.min_cv_gain",
+                "must be finite",
+            ));
         }
         if self.k_step == 0 || self.k_step > 1000 {
-            return Err(DiscoveryError::invalid("settings.k_step", "must be in 1..=1000"));
+            return Err(DiscoveryError::invalid(
+                "settings.k_step",
+                "must be in 1..=1000",
+            ));
         }
         if self.max_terms > 20 {
-            return Err(DiscoveryError::invalid("settings.max_terms", "must be at most 20"));
+            return Err(DiscoveryError::invalid(
+                "settings.max_terms",
+                "must be at most 20",
+            ));
         }
         if self.plot_points < 2 {
-            return Err(DiscoveryError::invalid("settings.plot_points", "must be at least 2"));
+            return Err(DiscoveryError::invalid(
+                "settings.plot_points",
+                "must be at least 2",
+            ));
         }
         if let Some(v) = &self.vessel {
             v.validate()
@@ -134,14 +152,20 @@ pub fn discover(
     settings.validate()?;
     let n = baseline.n();
     let Some(first) = estimation_runs.first() else {
-        return Err(DiscoveryError::invalid("estimation_runs", "at least one run is needed"));
+        return Err(DiscoveryError::invalid(
+            "estimation_runs",
+            "at least one run is needed",
+        ));
     };
     let h = first.h;
     let skip = ((5.0 * settings.svf_time_constant_s / h).ceil() as usize)
         .max((settings.max_delay_s / h).ceil() as usize + 1)
         .max(settings.k_step);
     let min_len = skip + settings.k_step + 64;
-    for (name, runs) in [("estimation_runs", estimation_runs), ("validation_runs", validation_runs)] {
+    for (name, runs) in [
+        ("estimation_runs", estimation_runs),
+        ("validation_runs", validation_runs),
+    ] {
         for (i, r) in runs.iter().enumerate() {
             let f = format!("{name}[{i}]");
             r.validate(n, min_len, &f)?;
@@ -159,7 +183,10 @@ pub fn discover(
         if len / 2 < min_len {
             return Err(DiscoveryError::invalid(
                 "estimation_runs[0].nu",
-                format!("a single run needs {} samples to be split for cross-validation", 2 * min_len),
+                format!(
+                    "a single run needs {} samples to be split for cross-validation",
+                    2 * min_len
+                ),
             ));
         }
         vec![
@@ -178,8 +205,18 @@ pub fn discover(
     check(progress, 0.1, "filtering the runs")?;
     let hac_lags = ((settings.hac_window_s / h).ceil() as usize).max(1);
     let prep = Prepared::new(baseline, &est, settings.svf_time_constant_s, skip, hac_lags)
-        .ok_or_else(|| DiscoveryError::invalid("estimation_runs", "no samples left after the filter transient"))?;
-    let lib = library(&baseline.dofs, &baseline.m, &baseline.d_bar, &settings.library);
+        .ok_or_else(|| {
+            DiscoveryError::invalid(
+                "estimation_runs",
+                "no samples left after the filter transient",
+            )
+        })?;
+    let lib = library(
+        &baseline.dofs,
+        &baseline.m,
+        &baseline.d_bar,
+        &settings.library,
+    );
     let crit = Criteria {
         min_z: settings.min_z,
         max_delta_bic: settings.max_delta_bic,
@@ -197,7 +234,11 @@ pub fn discover(
     let mut steps: Vec<Vec<Scored>> = Vec::new();
     let mut pool = lib.clone();
     for s in 0..settings.max_terms {
-        check(progress, 0.15 + 0.6 * s as f64 / settings.max_terms.max(1) as f64, "testing hypotheses")?;
+        check(
+            progress,
+            0.15 + 0.6 * s as f64 / settings.max_terms.max(1) as f64,
+            "testing hypotheses",
+        )?;
         let st = step(&prep, &chosen, &pool, &runs, &crit);
         if s == 0 {
             // Later steps re-test only what showed at least weak evidence.
@@ -239,8 +280,16 @@ pub fn discover(
     let after: Vec<Predictions> = val.iter().map(|r| predict(&model, r, k)).collect();
     let validation: Vec<ChannelComparison> = (0..n)
         .map(|i| {
-            let rb: Vec<Vec<f64>> = val.iter().zip(&before).map(|(r, p)| residual(r, &p.one, i)).collect();
-            let ra: Vec<Vec<f64>> = val.iter().zip(&after).map(|(r, p)| residual(r, &p.one, i)).collect();
+            let rb: Vec<Vec<f64>> = val
+                .iter()
+                .zip(&before)
+                .map(|(r, p)| residual(r, &p.one, i))
+                .collect();
+            let ra: Vec<Vec<f64>> = val
+                .iter()
+                .zip(&after)
+                .map(|(r, p)| residual(r, &p.one, i))
+                .collect();
             ChannelComparison {
                 dof: baseline.dofs[i],
                 before: channel_fits(&val, &before, i),
@@ -250,7 +299,13 @@ pub fn discover(
             }
         })
         .collect();
-    let plots = plot_series(val[0], &before[0], &after[0], &baseline.dofs, settings.plot_points);
+    let plots = plot_series(
+        val[0],
+        &before[0],
+        &after[0],
+        &baseline.dofs,
+        settings.plot_points,
+    );
 
     check(progress, 0.85, "weighing look-alikes")?;
     let base_resid: Vec<Vec<Vec<f64>>> = all_runs
@@ -262,7 +317,11 @@ pub fn discover(
         .collect();
     let noise_sigma: Vec<f64> = (0..n)
         .map(|i| {
-            let v: Vec<f64> = base_resid.iter().flat_map(|r| r[i].iter().copied()).filter(|x| x.is_finite()).collect();
+            let v: Vec<f64> = base_resid
+                .iter()
+                .flat_map(|r| r[i].iter().copied())
+                .filter(|x| x.is_finite())
+                .collect();
             (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
         })
         .collect();
@@ -274,14 +333,22 @@ pub fn discover(
             .iter()
             .filter(|o| o.spec.effect.family() != w.spec.effect.family())
             .filter(|o| !chosen.iter().any(|c| c.effect == o.spec.effect))
-            .filter(|o| o.cv_gain.is_some_and(|g| g >= settings.ambiguity_ratio * wg))
-            .find(|o| prep.rows_of(&[o.spec], &[]).iter().any(|r| w_rows.contains(r)));
+            .filter(|o| {
+                o.cv_gain
+                    .is_some_and(|g| g >= settings.ambiguity_ratio * wg)
+            })
+            .find(|o| {
+                prep.rows_of(&[o.spec], &[])
+                    .iter()
+                    .any(|r| w_rows.contains(r))
+            });
         if let Some(o) = rival {
             let before_terms = &chosen[..si];
             let fit_with = |s: Spec| {
                 let mut v = before_terms.to_vec();
                 v.push(s);
-                prep.fit(&v, &[], &runs, false).map(|f| prep.model(&v, &f, &[]))
+                prep.fit(&v, &[], &runs, false)
+                    .map(|f| prep.model(&v, &f, &[]))
             };
             let labels = [w.spec.effect.label(), o.spec.effect.label()];
             let mut focus: Vec<_> = prep
@@ -291,9 +358,16 @@ pub fn discover(
                 .collect();
             focus.dedup();
             let experiment = match (&settings.vessel, fit_with(w.spec), fit_with(o.spec)) {
-                (Some(v), Some(ma), Some(mb)) => {
-                    propose(v, &ma, &mb, labels.clone(), &focus, &noise_sigma, est[0].eta[(0, 5)], h)
-                }
+                (Some(v), Some(ma), Some(mb)) => propose(
+                    v,
+                    &ma,
+                    &mb,
+                    labels.clone(),
+                    &focus,
+                    &noise_sigma,
+                    est[0].eta[(0, 5)],
+                    h,
+                ),
                 _ => None,
             };
             let og = o.cv_gain.unwrap_or(0.0);
@@ -337,7 +411,11 @@ pub fn discover(
                 .then(a.delta_bic.total_cmp(&b.delta_bic))
         });
         for s in rest.into_iter().take(20) {
-            let v = if s.significant(&crit) { Verdict::NotConfirmed } else { Verdict::NotSignificant };
+            let v = if s.significant(&crit) {
+                Verdict::NotConfirmed
+            } else {
+                Verdict::NotSignificant
+            };
             hypotheses.push(hypothesis(s, 1, v, &crit));
         }
     }
@@ -389,7 +467,13 @@ pub fn discover(
         })
         .collect();
 
-    let summary = summary(&location, &findings, &validation, &ambiguities, &unexplained);
+    let summary = summary(
+        &location,
+        &findings,
+        &validation,
+        &ambiguities,
+        &unexplained,
+    );
     check(progress, 1.0, "done")?;
     Ok(DiscoveryReport {
         dofs: baseline.dofs.clone(),
@@ -412,7 +496,9 @@ pub fn discover(
 }
 
 fn rows_of(m: &nalgebra::DMatrix<f64>) -> Vec<Vec<f64>> {
-    (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect()
+    (0..m.nrows())
+        .map(|i| m.row(i).iter().copied().collect())
+        .collect()
 }
 
 fn hypothesis(s: &Scored, step: usize, verdict: Verdict, _c: &Criteria) -> HypothesisReport {
@@ -453,7 +539,13 @@ fn hypothesis(s: &Scored, step: usize, verdict: Verdict, _c: &Criteria) -> Hypot
     }
 }
 
-fn plot_series(rec: &Record, before: &Predictions, after: &Predictions, dofs: &[crate::planning::Dof], points: usize) -> Vec<PlotSeries> {
+fn plot_series(
+    rec: &Record,
+    before: &Predictions,
+    after: &Predictions,
+    dofs: &[crate::planning::Dof],
+    points: usize,
+) -> Vec<PlotSeries> {
     let step = rec.len().div_ceil(points).max(1);
     let idx: Vec<usize> = (0..rec.len()).step_by(step).collect();
     dofs.iter()
@@ -476,7 +568,11 @@ fn unexplained(model: &AugmentedModel, runs: &[&Record], chosen: &[Spec]) -> Vec
     let preds: Vec<_> = runs.iter().map(|r| model.predict_k_step(r, 1)).collect();
     let mut out = Vec::new();
     for (i, &dof) in model.dofs.iter().enumerate() {
-        let e: Vec<Vec<f64>> = runs.iter().zip(&preds).map(|(r, p)| residual(r, p, i)).collect();
+        let e: Vec<Vec<f64>> = runs
+            .iter()
+            .zip(&preds)
+            .map(|(r, p)| residual(r, p, i))
+            .collect();
         let Some(spec) = residual_spectrum(&e, 1.0 / h, phi[i]) else {
             continue;
         };
@@ -488,7 +584,9 @@ fn unexplained(model: &AugmentedModel, runs: &[&Record], chosen: &[Spec]) -> Vec
         else {
             continue;
         };
-        let signature = signature_words(spec.low_slope, b).trim_start_matches(", ").to_string();
+        let signature = signature_words(spec.low_slope, b)
+            .trim_start_matches(", ")
+            .to_string();
         let explained_here = chosen.iter().any(|c| c.effect.dof() == Some(dof));
         out.push(Unexplained {
             dof,
@@ -516,25 +614,36 @@ fn summary(
     unexplained: &[Unexplained],
 ) -> Vec<String> {
     let mut out = Vec::new();
-    let parting: Vec<&str> = loc.per_dof.iter().filter(|d| d.parts).map(|d| d.dof.name()).collect();
+    let parting: Vec<&str> = loc
+        .per_dof
+        .iter()
+        .filter(|d| d.parts)
+        .map(|d| d.dof.name())
+        .collect();
     if parting.is_empty() && findings.is_empty() {
-        out.push("The baseline explains the recordings: no candidate term improves held-out runs.".into());
+        out.push(
+            "The baseline explains the recordings: no candidate term improves held-out runs."
+                .into(),
+        );
     } else if !parting.is_empty() {
-        out.push(format!("The baseline parts from the recordings in {}.", parting.join(", ")));
+        out.push(format!(
+            "The baseline parts from the recordings in {}.",
+            parting.join(", ")
+        ));
     }
     for f in findings {
         out.push(f.effect_text.clone());
     }
     for c in validation {
-        if let (Some(b), Some(a)) = (c.before.free_run, c.after.free_run) {
-            if (a - b).abs() >= 0.01 {
-                out.push(format!(
-                    "{}: validation free-run fit {:.2} → {:.2}.",
-                    capital(c.dof.name()),
-                    b,
-                    a
-                ));
-            }
+        if let (Some(b), Some(a)) = (c.before.free_run, c.after.free_run)
+            && (a - b).abs() >= 0.01
+        {
+            out.push(format!(
+                "{}: validation free-run fit {:.2} → {:.2}.",
+                capital(c.dof.name()),
+                b,
+                a
+            ));
         }
     }
     out.extend(ambiguities.iter().map(|a| a.text.clone()));

@@ -25,7 +25,10 @@ fn sig(v: f64) -> String {
 }
 
 fn std_of(t: &ModelTerm, i: usize) -> Option<f64> {
-    t.covariance.get(i).and_then(|r| r.get(i)).map(|v| v.max(0.0).sqrt())
+    t.covariance
+        .get(i)
+        .and_then(|r| r.get(i))
+        .map(|v| v.max(0.0).sqrt())
 }
 
 /// What a chosen term does, in one sentence.
@@ -119,7 +122,12 @@ pub(crate) fn effect_text(t: &ModelTerm, h: f64) -> String {
 /// Lag (samples) of the peak cross-correlation between the input changes
 /// Δτ_i and the residual e_i, over 0..=max_lag: a delay d puts it at d,
 /// a first-order lag at 0–1 samples with a slow tail.
-pub(crate) fn xcorr_peak(runs: &[&Record], resid: &[Vec<f64>], row: usize, max_lag: usize) -> Option<(usize, f64)> {
+pub(crate) fn xcorr_peak(
+    runs: &[&Record],
+    resid: &[Vec<f64>],
+    row: usize,
+    max_lag: usize,
+) -> Option<(usize, f64)> {
     let mut acc = vec![0.0; max_lag + 1];
     let (mut ee, mut tt) = (0.0, 0.0);
     for (rec, e) in runs.iter().zip(resid) {
@@ -154,7 +162,8 @@ pub(crate) fn heading_coverage(runs: &[&Record]) -> f64 {
     let mut sectors = [false; 8];
     for r in runs {
         for k in 0..r.len() {
-            let s = (r.eta[(k, 5)].rem_euclid(std::f64::consts::TAU) / (std::f64::consts::TAU / 8.0)) as usize;
+            let s = (r.eta[(k, 5)].rem_euclid(std::f64::consts::TAU)
+                / (std::f64::consts::TAU / 8.0)) as usize;
             sectors[s.min(7)] = true;
         }
     }
@@ -177,11 +186,21 @@ pub(crate) fn speed_thrust_correlation(runs: &[&Record], row: usize) -> f64 {
     let sxy: f64 = pairs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
     let sxx: f64 = pairs.iter().map(|p| (p.0 - mx).powi(2)).sum();
     let syy: f64 = pairs.iter().map(|p| (p.1 - my).powi(2)).sum();
-    if sxx > 0.0 && syy > 0.0 { sxy / (sxx * syy).sqrt() } else { f64::NAN }
+    if sxx > 0.0 && syy > 0.0 {
+        sxy / (sxx * syy).sqrt()
+    } else {
+        f64::NAN
+    }
 }
 
 /// Sentences specific to the look-alike pairs of `e`.
-pub(crate) fn separating_evidence(e: Effect, runs: &[&Record], baseline_resid: &[Vec<Vec<f64>>], dofs: &[Dof], h: f64) -> Vec<String> {
+pub(crate) fn separating_evidence(
+    e: Effect,
+    runs: &[&Record],
+    baseline_resid: &[Vec<Vec<f64>>],
+    dofs: &[Dof],
+    h: f64,
+) -> Vec<String> {
     let row = e.dof().and_then(|d| dofs.iter().position(|&x| x == d));
     let mut out = Vec::new();
     match (e, row) {
@@ -208,13 +227,23 @@ pub(crate) fn separating_evidence(e: Effect, runs: &[&Record], baseline_resid: &
                 100.0 * heading_coverage(runs)
             ));
         }
-        (Effect::ConstantLoad { dof }, _) if matches!(dof, Dof::Surge | Dof::Sway) => {
+        (
+            Effect::ConstantLoad {
+                dof: Dof::Surge | Dof::Sway,
+            },
+            _,
+        ) => {
             out.push(format!(
                 "The runs cover {:.0} % of the compass and the load stays fixed in the body frame, which a current would not.",
                 100.0 * heading_coverage(runs)
             ));
         }
-        (Effect::QuadraticDamping { dof } | Effect::Saturation { dof } | Effect::DeadZone { dof }, Some(r)) => {
+        (
+            Effect::QuadraticDamping { dof }
+            | Effect::Saturation { dof }
+            | Effect::DeadZone { dof },
+            Some(r),
+        ) => {
             let c = speed_thrust_correlation(runs, r);
             out.push(format!(
                 "|{}| and |{}| correlate at {:.2} in these runs, {}.",

@@ -57,13 +57,23 @@ struct Design {
 }
 
 /// Samples of a design's force columns (n × DOFs) for one leg.
-fn forces(p: &VesselProfile, dofs: &[Dof], d: &Design, fs: f64, n: usize) -> Option<(DMatrix<f64>, Vec<ChannelPlan>)> {
+fn forces(
+    p: &VesselProfile,
+    dofs: &[Dof],
+    d: &Design,
+    fs: f64,
+    n: usize,
+) -> Option<(DMatrix<f64>, Vec<ChannelPlan>)> {
     let mut tau = DMatrix::zeros(n, dofs.len());
     let mut channels = Vec::new();
     for (i, &dof) in dofs.iter().enumerate() {
         let l = p.limits.get(&dof)?;
         let excited = dof == d.dof;
-        let offset = if dof == Dof::Surge { d.surge_offset * l.max_force } else { 0.0 };
+        let offset = if dof == Dof::Surge {
+            d.surge_offset * l.max_force
+        } else {
+            0.0
+        };
         let (waveform, amplitude) = if excited {
             let w = match d.signal {
                 Shape::Square => Waveform::Square {
@@ -134,8 +144,9 @@ pub(crate) fn propose(
                         continue;
                     }
                     for legs in [1usize, 4] {
-                        let headings: Vec<f64> =
-                            (0..legs).map(|q| heading0 + q as f64 * std::f64::consts::FRAC_PI_2).collect();
+                        let headings: Vec<f64> = (0..legs)
+                            .map(|q| heading0 + q as f64 * std::f64::consts::FRAC_PI_2)
+                            .collect();
                         let d = Design {
                             dof,
                             signal,
@@ -163,10 +174,15 @@ pub(crate) fn propose(
                             let ya = a.simulate(&rec);
                             let yb = b.simulate(&rec);
                             for (i, dd) in dofs.iter().enumerate() {
-                                let vmax = profile.limits.get(dd).map_or(f64::INFINITY, |l| l.max_velocity);
+                                let vmax = profile
+                                    .limits
+                                    .get(dd)
+                                    .map_or(f64::INFINITY, |l| l.max_velocity);
                                 let s = noise_sigma.get(i).copied().unwrap_or(1.0).max(1e-12);
                                 for k in 0..n {
-                                    if ya[(k, i)].abs() > 1.2 * vmax || yb[(k, i)].abs() > 1.2 * vmax {
+                                    if ya[(k, i)].abs() > 1.2 * vmax
+                                        || yb[(k, i)].abs() > 1.2 * vmax
+                                    {
                                         feasible = false;
                                     }
                                     let e = (ya[(k, i)] - yb[(k, i)]) / s;
@@ -193,13 +209,21 @@ pub(crate) fn propose(
         }
     }
     let (score, d, channels, speed) = best?;
-    let sep = if d.headings.len() > 1 { score * 1.25 } else { score };
+    let sep = if d.headings.len() > 1 {
+        score * 1.25
+    } else {
+        score
+    };
     let (family, signal) = match d.signal {
         Shape::Step => (ExperimentFamily::Static, SignalKind::Square),
         Shape::Square => (ExperimentFamily::Dynamic, SignalKind::Square),
         Shape::Multisine => (ExperimentFamily::Dynamic, SignalKind::Multisine),
     };
-    let headings_deg: Vec<f64> = d.headings.iter().map(|x| x.to_degrees().rem_euclid(360.0)).collect();
+    let headings_deg: Vec<f64> = d
+        .headings
+        .iter()
+        .map(|x| x.to_degrees().rem_euclid(360.0))
+        .collect();
     let lim = profile.limits.get(&d.dof).map_or(0.0, |l| l.max_force);
     let what = if family == ExperimentFamily::Static {
         format!(
@@ -212,7 +236,11 @@ pub(crate) fn propose(
         format!(
             "excite {} with a {} of amplitude {:.0} {}",
             d.dof.name(),
-            if d.signal == Shape::Square { "square wave" } else { "multisine" },
+            if d.signal == Shape::Square {
+                "square wave"
+            } else {
+                "multisine"
+            },
             d.amplitude * lim,
             d.dof.force_unit()
         )
@@ -224,7 +252,11 @@ pub(crate) fn propose(
         if headings_deg.len() > 1 {
             format!(
                 " at each of the headings {} °",
-                headings_deg.iter().map(|h| format!("{h:.0}")).collect::<Vec<_>>().join(", ")
+                headings_deg
+                    .iter()
+                    .map(|h| format!("{h:.0}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
             )
         } else {
             format!(" at heading {:.0} °", headings_deg[0])

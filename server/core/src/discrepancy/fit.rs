@@ -54,6 +54,10 @@ pub(crate) struct Prepared<'a> {
     pub hac_lags: usize,
 }
 
+/// One (row, run) block of the stacked regression: global parameter
+/// indices, their weighted columns, the weighted target.
+type Block = (Vec<usize>, Vec<Vec<f64>>, Vec<f64>);
+
 /// A fitted hypothesis.
 #[derive(Debug, Clone)]
 pub(crate) struct FitOut {
@@ -109,7 +113,8 @@ impl<'a> Prepared<'a> {
                     lam_tau: vec![],
                     lam_g: vec![],
                 };
-                let gs: Vec<Vec<f64>> = (0..rec.len()).map(|k| baseline.g(&rec.eta_at(k))).collect();
+                let gs: Vec<Vec<f64>> =
+                    (0..rec.len()).map(|k| baseline.g(&rec.eta_at(k))).collect();
                 for i in 0..n {
                     let nu = rec.nu.column(i);
                     let l = svf.foh(nu.as_slice());
@@ -125,8 +130,12 @@ impl<'a> Prepared<'a> {
             .collect();
         let structure = (0..n)
             .map(|i| {
-                let mf = (0..n).filter(|&j| baseline.m[(i, j)] != 0.0 || i == j).collect();
-                let df = (0..n).filter(|&j| baseline.d_bar[(i, j)] != 0.0 || i == j).collect();
+                let mf = (0..n)
+                    .filter(|&j| baseline.m[(i, j)] != 0.0 || i == j)
+                    .collect();
+                let df = (0..n)
+                    .filter(|&j| baseline.d_bar[(i, j)] != 0.0 || i == j)
+                    .collect();
                 (mf, df)
             })
             .collect();
@@ -146,7 +155,11 @@ impl<'a> Prepared<'a> {
         for (i, w) in weights.iter_mut().enumerate() {
             let f = prep.fit(&[], &[i], &all, false)?;
             let s = (f.sse / f.n.max(1) as f64).sqrt();
-            *w = if s > 0.0 && s.is_finite() { 1.0 / s } else { 1.0 };
+            *w = if s > 0.0 && s.is_finite() {
+                1.0 / s
+            } else {
+                1.0
+            };
         }
         prep.weights = weights;
         let all_rows: Vec<usize> = (0..n).collect();
@@ -168,7 +181,13 @@ impl<'a> Prepared<'a> {
 
     /// Fits `specs` jointly with the baseline entries of their rows (and of
     /// `extra` rows) on the runs `runs`. `None` if nothing is left to fit.
-    pub fn fit(&self, specs: &[Spec], extra: &[usize], runs: &[usize], hac: bool) -> Option<FitOut> {
+    pub fn fit(
+        &self,
+        specs: &[Spec],
+        extra: &[usize],
+        runs: &[usize],
+        hac: bool,
+    ) -> Option<FitOut> {
         if !specs.iter().any(|s| s.effect == Effect::Current) {
             return self.fit_with(specs, extra, runs, hac, &self.baseline.d_bar);
         }
@@ -193,10 +212,11 @@ impl<'a> Prepared<'a> {
             }
         }
         for (si, s) in specs.iter().enumerate() {
-            if let Effect::Coupling { dof, from } = s.effect {
-                if let (Some(i), Some(j)) = (self.baseline.index_of(dof), self.baseline.index_of(from)) {
-                    d[(i, j)] = f.theta[si][1];
-                }
+            if let Effect::Coupling { dof, from } = s.effect
+                && let (Some(i), Some(j)) =
+                    (self.baseline.index_of(dof), self.baseline.index_of(from))
+            {
+                d[(i, j)] = f.theta[si][1];
             }
         }
         d
@@ -238,7 +258,7 @@ impl<'a> Prepared<'a> {
         };
         let mut hmat = DMatrix::<f64>::zeros(p, p);
         let mut bvec = vec![0.0; p];
-        let mut blocks: Vec<(Vec<usize>, Vec<Vec<f64>>, Vec<f64>)> = Vec::new();
+        let mut blocks: Vec<Block> = Vec::new();
         let mut n_tot = 0;
         for &run in runs {
             let rec = &self.records[run];
@@ -325,7 +345,13 @@ impl<'a> Prepared<'a> {
         let mut resid = Vec::with_capacity(blocks.len());
         for (idx, cols, y) in &blocks {
             let e: Vec<f64> = (0..y.len())
-                .map(|k| y[k] - idx.iter().zip(cols).map(|(&i, c)| theta_all[i] * c[k]).sum::<f64>())
+                .map(|k| {
+                    y[k] - idx
+                        .iter()
+                        .zip(cols)
+                        .map(|(&i, c)| theta_all[i] * c[k])
+                        .sum::<f64>()
+                })
                 .collect();
             sse += dot(&e, &e);
             resid.push(e);
@@ -401,15 +427,19 @@ impl<'a> Prepared<'a> {
         }
         let mut terms = Vec::with_capacity(specs.len());
         for (si, s) in specs.iter().enumerate() {
-            if let Effect::Coupling { dof, from } = s.effect {
-                if let (Some(i), Some(j)) = (b.index_of(dof), b.index_of(from)) {
-                    m[(i, j)] = f.theta[si][0];
-                    d[(i, j)] = f.theta[si][1];
-                }
+            if let Effect::Coupling { dof, from } = s.effect
+                && let (Some(i), Some(j)) = (b.index_of(dof), b.index_of(from))
+            {
+                m[(i, j)] = f.theta[si][0];
+                d[(i, j)] = f.theta[si][1];
             }
             let covariance = f
                 .theta_cov(si)
-                .map(|c| (0..c.nrows()).map(|i| c.row(i).iter().copied().collect()).collect())
+                .map(|c| {
+                    (0..c.nrows())
+                        .map(|i| c.row(i).iter().copied().collect())
+                        .collect()
+                })
                 .unwrap_or_default();
             terms.push(ModelTerm {
                 effect: s.effect,
@@ -434,7 +464,14 @@ impl<'a> Prepared<'a> {
     pub fn abs_tau_sorted(&self, row: usize, runs: &[usize]) -> Vec<f64> {
         let mut v: Vec<f64> = runs
             .iter()
-            .flat_map(|&r| self.records[r].tau.column(row).iter().map(|x| x.abs()).collect::<Vec<_>>())
+            .flat_map(|&r| {
+                self.records[r]
+                    .tau
+                    .column(row)
+                    .iter()
+                    .map(|x| x.abs())
+                    .collect::<Vec<_>>()
+            })
             .filter(|x| x.is_finite())
             .collect();
         v.sort_by(|a, b| a.total_cmp(b));
@@ -452,7 +489,14 @@ impl Prepared<'_> {
     /// first-order DOF exactly, and the equation error prefers it because
     /// it drops the noisy [sλν] regressor. Prediction error carries no such
     /// bias, so shape parameters are profiled on it.
-    pub fn kstep_row(&self, specs: &[Spec], f: &FitOut, r: usize, runs: &[usize], k: usize) -> Option<(f64, Vec<Vec<f64>>)> {
+    pub fn kstep_row(
+        &self,
+        specs: &[Spec],
+        f: &FitOut,
+        r: usize,
+        runs: &[usize],
+        k: usize,
+    ) -> Option<(f64, Vec<Vec<f64>>)> {
         let ri = f.rows.iter().position(|&x| x == r)?;
         let dofs = &self.baseline.dofs;
         let n = dofs.len();
@@ -473,12 +517,14 @@ impl Prepared<'_> {
                     m_row[j] = f.theta[si][0];
                     d_row[j] = f.theta[si][1];
                 }
-            } else if s.effect.n_linear() > 0 && s.effect.rows(dofs, &self.baseline.d_bar).contains(&r) {
+            } else if s.effect.n_linear() > 0
+                && s.effect.rows(dofs, &self.baseline.d_bar).contains(&r)
+            {
                 terms.push((s.effect, f.theta[si].clone()));
             }
         }
         let mrr = m_row[r];
-        if !(mrr > 0.0) {
+        if mrr.is_nan() || mrr <= 0.0 {
             return None;
         }
         let shapes: Vec<(Effect, f64)> = specs
@@ -544,8 +590,7 @@ impl Prepared<'_> {
                 let s0 = t - k;
                 let mut x = rec.nu[(s0, r)];
                 let mut a = lag_states.as_ref().map_or(0.0, |l| l[s0]);
-                for step in s0..t {
-                    let u = held[step];
+                for (step, &u) in held.iter().enumerate().take(t).skip(s0) {
                     let ta = lag.unwrap_or(1.0);
                     let da = |a: f64| if lag.is_some() { (u - a) / ta } else { 0.0 };
                     let tau = |a: f64| if lag.is_some() { a } else { u };
@@ -645,6 +690,7 @@ pub(crate) struct Profile {
     pub n: usize,
 }
 
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn profile(
     prep: &Prepared<'_>,
     chosen: &[Spec],
@@ -707,7 +753,11 @@ pub(crate) fn profile(
     }
     let fit = eval(best)?;
     let (s0, resid) = prep.kstep_row(&specs_at(best), &fit, row, runs, k)?;
-    let delta = if continuous { 0.03 * best.abs().max(1e-9) } else { 1.0 };
+    let delta = if continuous {
+        0.03 * best.abs().max(1e-9)
+    } else {
+        1.0
+    };
     let (sm, sp) = (sse(best - delta), sse(best + delta));
     let curv = (sp - 2.0 * s0 + sm) / (delta * delta);
     let n: usize = resid.iter().map(Vec::len).sum();

@@ -39,7 +39,9 @@ pub(crate) fn predict(model: &AugmentedModel, rec: &Record, k: usize) -> Predict
 
 /// Residual of column `i`: measured − predicted (NaN where no prediction).
 pub(crate) fn residual(rec: &Record, pred: &DMatrix<f64>, i: usize) -> Vec<f64> {
-    (0..rec.len()).map(|k| rec.nu[(k, i)] - pred[(k, i)]).collect()
+    (0..rec.len())
+        .map(|k| rec.nu[(k, i)] - pred[(k, i)])
+        .collect()
 }
 
 /// Mean of the defined fits.
@@ -71,7 +73,9 @@ pub(crate) fn phi_diag(model: &AugmentedModel, h: f64) -> Vec<f64> {
         Some(mi) => mi * &model.d_bar,
         None => return vec![0.0; model.dofs.len()],
     };
-    (0..model.dofs.len()).map(|i| (-h * a[(i, i)]).exp().clamp(0.0, 1.0)).collect()
+    (0..model.dofs.len())
+        .map(|i| (-h * a[(i, i)]).exp().clamp(0.0, 1.0))
+        .collect()
 }
 
 /// One DOF's overall picture.
@@ -182,7 +186,12 @@ pub struct LocationReport {
 }
 
 /// Locates the model's misfit on `runs`.
-pub fn locate(model: &AugmentedModel, runs: &[&Record], k: usize, segment_s: f64) -> LocationReport {
+pub fn locate(
+    model: &AugmentedModel,
+    runs: &[&Record],
+    k: usize,
+    segment_s: f64,
+) -> LocationReport {
     let preds: Vec<Predictions> = runs.iter().map(|r| predict(model, r, k)).collect();
     let n = model.dofs.len();
     let h = runs.first().map_or(0.1, |r| r.h);
@@ -196,18 +205,30 @@ pub fn locate(model: &AugmentedModel, runs: &[&Record], k: usize, segment_s: f64
         sentences: vec![],
     };
     let iu = model.dofs.iter().position(|&d| d == Dof::Surge);
-    for i in 0..n {
+    for (i, &phi_i) in phi.iter().enumerate().take(n) {
         let dof = model.dofs[i];
-        let one: Vec<Vec<f64>> = runs.iter().zip(&preds).map(|(r, p)| residual(r, &p.one, i)).collect();
-        let kst: Vec<Vec<f64>> = runs.iter().zip(&preds).map(|(r, p)| residual(r, &p.k, i)).collect();
-        let free: Vec<Vec<f64>> = runs.iter().zip(&preds).map(|(r, p)| residual(r, &p.free, i)).collect();
+        let one: Vec<Vec<f64>> = runs
+            .iter()
+            .zip(&preds)
+            .map(|(r, p)| residual(r, &p.one, i))
+            .collect();
+        let kst: Vec<Vec<f64>> = runs
+            .iter()
+            .zip(&preds)
+            .map(|(r, p)| residual(r, &p.k, i))
+            .collect();
+        let free: Vec<Vec<f64>> = runs
+            .iter()
+            .zip(&preds)
+            .map(|(r, p)| residual(r, &p.free, i))
+            .collect();
         let fits = channel_fits(runs, &preds, i);
         let w = whiteness(&one, 30);
         let nf: usize = free.iter().map(Vec::len).sum();
         let bias = free.iter().flatten().sum::<f64>() / nf.max(1) as f64;
         let mut parts = false;
         // Frequency bands.
-        if let Some(spec) = residual_spectrum(&one, 1.0 / h, phi[i]) {
+        if let Some(spec) = residual_spectrum(&one, 1.0 / h, phi_i) {
             for b in spec.bands.iter().filter(|b| b.excess_db > BAND_EXCESS_DB) {
                 parts = true;
                 rep.bands.push(BandFinding {
@@ -233,17 +254,18 @@ pub fn locate(model: &AugmentedModel, runs: &[&Record], k: usize, segment_s: f64
         let mut sorted: Vec<f64> = segs.iter().map(|s| s.2).collect();
         sorted.sort_by(|a, b| a.total_cmp(b));
         let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
-        if let Some(worst) = segs.iter().max_by(|a, b| a.2.total_cmp(&b.2)) {
-            if median > 0.0 && worst.2 > SEGMENT_RATIO * median {
-                rep.segments.push(SegmentFinding {
-                    run: runs[worst.0].name.clone(),
-                    dof,
-                    start_s: worst.1 as f64 * h,
-                    end_s: ((worst.1 + seg).min(free[worst.0].len())) as f64 * h,
-                    error_rms: worst.2,
-                    ratio_to_median: worst.2 / median,
-                });
-            }
+        if let Some(worst) = segs.iter().max_by(|a, b| a.2.total_cmp(&b.2))
+            && median > 0.0
+            && worst.2 > SEGMENT_RATIO * median
+        {
+            rep.segments.push(SegmentFinding {
+                run: runs[worst.0].name.clone(),
+                dof,
+                start_s: worst.1 as f64 * h,
+                end_s: ((worst.1 + seg).min(free[worst.0].len())) as f64 * h,
+                error_rms: worst.2,
+                ratio_to_median: worst.2 / median,
+            });
         }
         // Operating conditions, on the k-step residual.
         let mut conds: Vec<(Condition, Vec<(f64, f64)>)> = Vec::new();
@@ -265,13 +287,16 @@ pub fn locate(model: &AugmentedModel, runs: &[&Record], k: usize, segment_s: f64
             Condition::Heading,
             pairs(&|r, t| r.eta[(t, 5)].rem_euclid(std::f64::consts::TAU)),
         ));
-        conds.push((Condition::InputAmplitude, pairs(&|r, t| r.tau[(t, i)].abs())));
+        conds.push((
+            Condition::InputAmplitude,
+            pairs(&|r, t| r.tau[(t, i)].abs()),
+        ));
         for (c, v) in conds {
-            if let Some(f) = bin_condition(dof, c, v) {
-                if f.spread_ratio > CONDITION_RATIO {
-                    parts = true;
-                    rep.conditions.push(f);
-                }
+            if let Some(f) = bin_condition(dof, c, v)
+                && f.spread_ratio > CONDITION_RATIO
+            {
+                parts = true;
+                rep.conditions.push(f);
             }
         }
         // Whiteness alone does not flag a DOF: sensor noise on ν makes the
@@ -297,7 +322,9 @@ fn bin_condition(dof: Dof, c: Condition, mut v: Vec<(f64, f64)>) -> Option<Condi
         return None;
     }
     let edges: Vec<f64> = if c == Condition::Heading {
-        (0..=4).map(|q| q as f64 * std::f64::consts::FRAC_PI_2).collect()
+        (0..=4)
+            .map(|q| q as f64 * std::f64::consts::FRAC_PI_2)
+            .collect()
     } else {
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
         let q = |p: f64| v[((v.len() - 1) as f64 * p) as usize].0;
@@ -362,7 +389,10 @@ fn sentences(rep: &LocationReport) -> Vec<String> {
         } else {
             s.push_str(&format!(
                 "; residuals not white ({} of {} lags outside ±{:.3}, {} zero crossings).",
-                d.whiteness.lags_outside, d.whiteness.lags, d.whiteness.bound, d.whiteness.zero_crossings
+                d.whiteness.lags_outside,
+                d.whiteness.lags,
+                d.whiteness.bound,
+                d.whiteness.zero_crossings
             ));
         }
         if d.parts {
@@ -412,7 +442,10 @@ fn sentences(rep: &LocationReport) -> Vec<String> {
         ));
     }
     if out.is_empty() {
-        out.push("The model follows the recordings in every DOF: residuals are at the noise floor.".into());
+        out.push(
+            "The model follows the recordings in every DOF: residuals are at the noise floor."
+                .into(),
+        );
     }
     out
 }
@@ -420,7 +453,9 @@ fn sentences(rep: &LocationReport) -> Vec<String> {
 /// The spectral signature of residual structure, in words.
 pub(crate) fn signature_words(low_slope: f64, band: &BandPower) -> String {
     if band.f_hi_hz <= 0.05 && low_slope < -1.0 {
-        format!(", drift-like (PSD slope {low_slope:.1}, as a random walk or a slowly varying load)")
+        format!(
+            ", drift-like (PSD slope {low_slope:.1}, as a random walk or a slowly varying load)"
+        )
     } else if band.f_lo_hz >= 1.0 {
         ", high-frequency (fast actuator or sampling effects)".into()
     } else {

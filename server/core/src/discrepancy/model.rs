@@ -58,11 +58,7 @@ pub(crate) struct AppliedInput {
 
 /// Applies the static actuator effects (delay → saturation → dead zone)
 /// of `terms` to the command `tau` of DOF `dof`; returns the lag, if any.
-pub(crate) fn actuate(
-    tau: &[f64],
-    dof: Dof,
-    shapes: &[(Effect, f64)],
-) -> (Vec<f64>, Option<f64>) {
+pub(crate) fn actuate(tau: &[f64], dof: Dof, shapes: &[(Effect, f64)]) -> (Vec<f64>, Option<f64>) {
     let mut x = tau.to_vec();
     let mut lag = None;
     let mine = shapes.iter().filter(|(e, _)| e.dof() == Some(dof));
@@ -89,7 +85,11 @@ pub(crate) fn actuate(
     }
     if let Some(w) = dz {
         x.iter_mut().for_each(|v| {
-            *v = if v.abs() <= w { 0.0 } else { *v - w * v.signum() };
+            *v = if v.abs() <= w {
+                0.0
+            } else {
+                *v - w * v.signum()
+            };
         });
     }
     (x, lag)
@@ -166,14 +166,16 @@ impl AugmentedModel {
     fn nu_dot(&self, nu: &[f64], tau_a: &[f64], g: &[f64], eta: &[f64; 6], out: &mut [f64]) {
         let n = self.dofs.len();
         let ctx = self.ctx();
-        let mut f = vec![0.0; n];
-        for i in 0..n {
-            let mut s = tau_a[i] - g[i];
-            for j in 0..n {
-                s -= self.d_bar[(i, j)] * nu[j];
-            }
-            f[i] = s;
-        }
+        let mut f: Vec<f64> = (0..n)
+            .map(|i| {
+                let damping: f64 = nu
+                    .iter()
+                    .enumerate()
+                    .map(|(j, v)| self.d_bar[(i, j)] * v)
+                    .sum();
+                tau_a[i] - g[i] - damping
+            })
+            .collect();
         for t in &self.terms {
             if matches!(t.effect, Effect::Coupling { .. }) || t.coefficients.is_empty() {
                 continue;
@@ -184,13 +186,18 @@ impl AugmentedModel {
                 }
             }
         }
-        for i in 0..n {
-            out[i] = (0..n).map(|j| self.m_inv[(i, j)] * f[j]).sum();
+        for (i, o) in out.iter_mut().enumerate().take(n) {
+            *o = f
+                .iter()
+                .enumerate()
+                .map(|(j, fj)| self.m_inv[(i, j)] * fj)
+                .sum();
         }
     }
 
     /// Runs the model from `nu0` (and lag states `lag0`) over samples
     /// `start..end` of the record; returns ν at samples start+1..=end.
+    #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
         rec: &Record,
@@ -208,14 +215,20 @@ impl AugmentedModel {
         let mut u = vec![0.0; n];
         let len = rec.len();
         let dim = x.len();
-        let (mut k1, mut k2, mut k3, mut k4, mut tmp) =
-            (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
+        let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (
+            vec![0.0; dim],
+            vec![0.0; dim],
+            vec![0.0; dim],
+            vec![0.0; dim],
+            vec![0.0; dim],
+        );
         for k in start..end {
             // η is recorded: linear between samples, so restoring and
             // heading-dependent terms move within the step as they do at sea.
             let e0 = rec.eta_at(k);
             let e1 = rec.eta_at((k + 1).min(len - 1));
-            let eta_at = |frac: f64| -> [f64; 6] { std::array::from_fn(|j| e0[j] + frac * (e1[j] - e0[j])) };
+            let eta_at =
+                |frac: f64| -> [f64; 6] { std::array::from_fn(|j| e0[j] + frac * (e1[j] - e0[j])) };
             let etas = [eta_at(0.0), eta_at(0.5), eta_at(1.0)];
             let gs: Vec<Vec<f64>> = etas
                 .iter()
@@ -316,7 +329,10 @@ impl AugmentedModel {
 /// (n + 6 columns), `y` holds ν.
 impl Predictor for AugmentedModel {
     fn output_names(&self) -> Vec<String> {
-        self.dofs.iter().map(|d| d.velocity_symbol().to_string()).collect()
+        self.dofs
+            .iter()
+            .map(|d| d.velocity_symbol().to_string())
+            .collect()
     }
 
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {

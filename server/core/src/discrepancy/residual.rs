@@ -37,7 +37,10 @@ pub fn whiteness(runs: &[Vec<f64>], lags: usize) -> Whiteness {
         .collect();
     let n: usize = runs.iter().map(Vec::len).sum();
     let mean = runs.iter().flatten().sum::<f64>() / n.max(1) as f64;
-    let c: Vec<Vec<f64>> = runs.iter().map(|e| e.iter().map(|x| x - mean).collect()).collect();
+    let c: Vec<Vec<f64>> = runs
+        .iter()
+        .map(|e| e.iter().map(|x| x - mean).collect())
+        .collect();
     let r0: f64 = c.iter().flatten().map(|x| x * x).sum();
     let bound = 2.576 / (n.max(1) as f64).sqrt();
     let mut outside = 0;
@@ -56,10 +59,17 @@ pub fn whiteness(runs: &[Vec<f64>], lags: usize) -> Whiteness {
     }
     let zc: usize = runs
         .iter()
-        .map(|e| e.windows(2).filter(|w| (w[0] - mean) * (w[1] - mean) < 0.0).count())
+        .map(|e| {
+            e.windows(2)
+                .filter(|w| (w[0] - mean) * (w[1] - mean) < 0.0)
+                .count()
+        })
         .sum();
     let m = n.saturating_sub(runs.len()).max(1) as f64;
-    let expected = [m / 2.0 - 2.576 * m.sqrt() / 2.0, m / 2.0 + 2.576 * m.sqrt() / 2.0];
+    let expected = [
+        m / 2.0 - 2.576 * m.sqrt() / 2.0,
+        m / 2.0 + 2.576 * m.sqrt() / 2.0,
+    ];
     let white = (outside as f64) <= 0.05 * lags as f64
         && (zc as f64) >= expected[0]
         && (zc as f64) <= expected[1];
@@ -113,7 +123,12 @@ pub struct ResidualSpectrum {
 pub fn residual_spectrum(runs: &[Vec<f64>], fs: f64, phi: f64) -> Option<ResidualSpectrum> {
     let runs: Vec<Vec<f64>> = runs
         .iter()
-        .map(|e| e.iter().copied().filter(|x| x.is_finite()).collect::<Vec<_>>())
+        .map(|e| {
+            e.iter()
+                .copied()
+                .filter(|x| x.is_finite())
+                .collect::<Vec<_>>()
+        })
         .filter(|e| e.len() >= 64)
         .collect();
     let shortest = runs.iter().map(Vec::len).min()?;
@@ -138,7 +153,11 @@ pub fn residual_spectrum(runs: &[Vec<f64>], fs: f64, phi: f64) -> Option<Residua
         (1.0 - 2.0 * phi * w.cos() + phi * phi).max(1e-12)
     };
     // Whitened PSD: the residual relative to the noise's own shape.
-    values = freqs.iter().zip(&values).map(|(f, v)| v / shape(*f)).collect();
+    values = freqs
+        .iter()
+        .zip(&values)
+        .map(|(f, v)| v / shape(*f))
+        .collect();
     let mut hi: Vec<f64> = freqs
         .iter()
         .zip(&values)
@@ -160,7 +179,10 @@ pub fn residual_spectrum(runs: &[Vec<f64>], fs: f64, phi: f64) -> Option<Residua
             .collect();
         if !inband.is_empty() && floor > 0.0 {
             let mean = inband.iter().map(|x| x.1).sum::<f64>() / inband.len() as f64;
-            let peak = inband.iter().max_by(|a, b| a.1.total_cmp(&b.1)).map_or(f_lo, |x| x.0);
+            let peak = inband
+                .iter()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .map_or(f_lo, |x| x.0);
             bands.push(BandPower {
                 f_lo_hz: f_lo,
                 f_hi_hz: f_hi,
@@ -207,22 +229,33 @@ mod tests {
         let w = whiteness(std::slice::from_ref(&e), 30);
         assert!(w.white, "{w:?}");
         let mut acc = 0.0;
-        let walk: Vec<f64> = e.iter().map(|x| {
-            acc += x;
-            acc
-        }).collect();
-        let w = whiteness(&[walk.clone()], 30);
+        let walk: Vec<f64> = e
+            .iter()
+            .map(|x| {
+                acc += x;
+                acc
+            })
+            .collect();
+        let w = whiteness(std::slice::from_ref(&walk), 30);
         assert!(!w.white && w.lags_outside == 30);
         // The walk's spectrum rises ~20 dB/decade towards DC; white noise is flat.
         let s = residual_spectrum(&[walk], 10.0, 0.0).unwrap();
         assert!(s.low_slope < -1.5, "slope {}", s.low_slope);
         assert!(s.bands.first().unwrap().excess_db > 20.0);
-        let s = residual_spectrum(&[e.clone()], 10.0, 0.0).unwrap();
-        assert!(s.bands.iter().all(|b| b.excess_db.abs() < 3.0), "{:?}", s.bands);
+        let s = residual_spectrum(std::slice::from_ref(&e), 10.0, 0.0).unwrap();
+        assert!(
+            s.bands.iter().all(|b| b.excess_db.abs() < 3.0),
+            "{:?}",
+            s.bands
+        );
         // Differenced noise n_{k+1} − 0.95 n_k is blue, but white once shaped.
         let d: Vec<f64> = e.windows(2).map(|w| w[1] - 0.95 * w[0]).collect();
-        let s = residual_spectrum(&[d.clone()], 10.0, 0.95).unwrap();
-        assert!(s.bands.iter().all(|b| b.excess_db.abs() < 3.0), "{:?}", s.bands);
+        let s = residual_spectrum(std::slice::from_ref(&d), 10.0, 0.95).unwrap();
+        assert!(
+            s.bands.iter().all(|b| b.excess_db.abs() < 3.0),
+            "{:?}",
+            s.bands
+        );
         let s = residual_spectrum(&[d], 10.0, 0.0).unwrap();
         assert!(s.bands.first().unwrap().excess_db < -10.0);
     }

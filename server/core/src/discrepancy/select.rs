@@ -158,7 +158,11 @@ pub(crate) fn score(
 }
 
 /// Free-run NRMSE fits of `model` on `rec` for the channels `rows`.
-pub(crate) fn free_run_fits(model: &super::model::AugmentedModel, rec: &Record, rows: &[usize]) -> Vec<f64> {
+pub(crate) fn free_run_fits(
+    model: &super::model::AugmentedModel,
+    rec: &Record,
+    rows: &[usize],
+) -> Vec<f64> {
     let sim = model.simulate(rec);
     rows.iter()
         .map(|&r| nrmse_fit(rec.nu.column(r).as_slice(), sim.column(r).as_slice()).unwrap_or(0.0))
@@ -169,7 +173,12 @@ pub(crate) fn free_run_fits(model: &super::model::AugmentedModel, rec: &Record, 
 /// (leave-one-run-out over `runs`): the sum over all channels of the fit
 /// gained, averaged over folds — a term that helps several DOFs at once
 /// counts for all of them. Both models are refitted on each training set.
-pub(crate) fn cv_gain(prep: &Prepared<'_>, chosen: &[Spec], cand: &Scored, runs: &[usize]) -> Option<f64> {
+pub(crate) fn cv_gain(
+    prep: &Prepared<'_>,
+    chosen: &[Spec],
+    cand: &Scored,
+    runs: &[usize],
+) -> Option<f64> {
     let rows = prep.rows_of(&[cand.spec], &[]);
     let all_rows = prep.rows_of(chosen, &rows);
     let channels: Vec<usize> = (0..prep.baseline.n()).collect();
@@ -227,7 +236,11 @@ pub(crate) fn step(
         .iter()
         .enumerate()
         .filter(|(_, s)| s.cv_gain.is_some_and(|g| g >= c.min_cv_gain))
-        .max_by(|a, b| a.1.cv_gain.unwrap_or(0.0).total_cmp(&b.1.cv_gain.unwrap_or(0.0)))
+        .max_by(|a, b| {
+            a.1.cv_gain
+                .unwrap_or(0.0)
+                .total_cmp(&b.1.cv_gain.unwrap_or(0.0))
+        })
         .map(|(i, _)| i);
     Step { scored, winner }
 }

@@ -102,7 +102,12 @@ mod tests {
         // First-order hold: O(ω²h²) of linear interpolation, well below the
         // half-sample shift of a zero-order hold.
         assert!(worst.0 < 1.5e-3, "FOH error {}", worst.0);
-        assert!(worst.1 > 10.0 * worst.0, "ZOH {} vs FOH {}", worst.1, worst.0);
+        assert!(
+            worst.1 > 10.0 * worst.0,
+            "ZOH {} vs FOH {}",
+            worst.1,
+            worst.0
+        );
     }
 
     #[test]

@@ -88,8 +88,15 @@ impl Concealed {
             }
             Concealed::Saturation => {
                 let d = pick(&Dof::ALL);
-                // Commands reach 0.8 of the limit (1.15 for surge with its offset).
-                t.saturation[d.index()] = Some(rng.uniform_in(0.3, 0.45) * p.limit(d).max_force);
+                // Clip at 60–80 % of the largest command of the campaign
+                // (`truth::commands`), so the effect is material.
+                let reach = match d {
+                    Dof::Surge => 0.9,
+                    Dof::Yaw => 0.47,
+                    _ => 0.45,
+                };
+                t.saturation[d.index()] =
+                    Some(rng.uniform_in(0.6, 0.8) * reach * p.limit(d).max_force);
                 vec![d]
             }
         }
@@ -123,7 +130,8 @@ pub fn run_case(effects: &[Concealed], seed: u64) -> Outcome {
         ..DiscoverySettings::default()
     };
     let t0 = Instant::now();
-    let report = discover(&s.baseline, &s.est, &s.val, &settings, &mut NoProgress).expect("discovery runs");
+    let report =
+        discover(&s.baseline, &s.est, &s.val, &settings, &mut NoProgress).expect("discovery runs");
     let seconds = t0.elapsed().as_secs_f64();
     // Gap on the channels the truth's free run fits clearly better.
     let val = &s.val[0];
@@ -131,11 +139,11 @@ pub fn run_case(effects: &[Concealed], seed: u64) -> Outcome {
     let (mut closed, mut gap) = (0.0, 0.0);
     for (i, c) in report.validation.iter().enumerate() {
         let t_fit = nrmse_fit(val.nu.column(i).as_slice(), truth_sim.column(i).as_slice());
-        if let (Some(b), Some(a), Some(tf)) = (c.before.free_run, c.after.free_run, t_fit) {
-            if tf - b > 0.02 {
-                gap += tf - b;
-                closed += a - b;
-            }
+        if let (Some(b), Some(a), Some(tf)) = (c.before.free_run, c.after.free_run, t_fit)
+            && tf - b > 0.02
+        {
+            gap += tf - b;
+            closed += a - b;
         }
     }
     Outcome {
@@ -151,7 +159,10 @@ pub fn judge(o: &Outcome) -> Result<(), String> {
     let f = &o.report.findings;
     if o.expected.is_empty() {
         if !f.is_empty() {
-            return Err(format!("clean case named {:?}", f.iter().map(|x| &x.label).collect::<Vec<_>>()));
+            return Err(format!(
+                "clean case named {:?}",
+                f.iter().map(|x| &x.label).collect::<Vec<_>>()
+            ));
         }
         return Ok(());
     }
@@ -161,11 +172,17 @@ pub fn judge(o: &Outcome) -> Result<(), String> {
     };
     let first = f.first().ok_or("nothing named")?;
     if !o.expected.iter().any(|e| matches(first, e)) {
-        return Err(format!("first named {} (expected {:?})", first.label, o.expected));
+        return Err(format!(
+            "first named {} (expected {:?})",
+            first.label, o.expected
+        ));
     }
     for e in &o.expected {
         if !f.iter().any(|fi| matches(fi, e)) {
-            return Err(format!("{e:?} not named; named {:?}", f.iter().map(|x| &x.label).collect::<Vec<_>>()));
+            return Err(format!(
+                "{e:?} not named; named {:?}",
+                f.iter().map(|x| &x.label).collect::<Vec<_>>()
+            ));
         }
     }
     match o.gap_closed {
@@ -176,19 +193,31 @@ pub fn judge(o: &Outcome) -> Result<(), String> {
 
 fn table(cases: &[(&str, Vec<Concealed>)], seeds: &[u64]) {
     let mut failures = Vec::new();
-    eprintln!("{:<22} {:>5}  {:<48} {:>8} {:>7}", "case", "seed", "named first (DOFs)", "gap", "time s");
+    eprintln!(
+        "{:<22} {:>5}  {:<48} {:>8} {:>7}",
+        "case", "seed", "named first (DOFs)", "gap", "time s"
+    );
     for (name, effects) in cases {
         for &seed in seeds {
             let o = run_case(effects, seed);
             let first = o.report.findings.first().map_or("—".to_string(), |f| {
-                format!("{} ({})", f.label, f.dofs.iter().map(|d| d.name()).collect::<Vec<_>>().join(","))
+                format!(
+                    "{} ({})",
+                    f.label,
+                    f.dofs
+                        .iter()
+                        .map(|d| d.name())
+                        .collect::<Vec<_>>()
+                        .join(",")
+                )
             });
             eprintln!(
                 "{:<22} {:>5}  {:<48} {:>8} {:>7.2}",
                 name,
                 seed,
                 first,
-                o.gap_closed.map_or("–".into(), |g| format!("{:.0} %", 100.0 * g)),
+                o.gap_closed
+                    .map_or("–".into(), |g| format!("{:.0} %", 100.0 * g)),
                 o.seconds
             );
             if let Err(e) = judge(&o) {

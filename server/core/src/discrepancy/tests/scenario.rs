@@ -4,8 +4,8 @@
 use nalgebra::DMatrix;
 
 use super::truth::{Truth, commands};
-use crate::discrepancy::data::{Baseline, Record, Restoring};
 use crate::discrepancy::candidates::Effect;
+use crate::discrepancy::data::{Baseline, Record, Restoring};
 use crate::discrepancy::fit::Prepared;
 use crate::discrepancy::model::{AugmentedModel, ModelTerm};
 use crate::planning::examples::surveyor_rov;
@@ -33,13 +33,36 @@ pub fn scenario(truth: Truth, seed: u64, n_est: usize, n_val: usize, duration_s:
     for r in 0..n_est + n_val {
         let tau = commands(&profile, n, H, r, seed);
         let psi0 = 0.7 * r as f64;
-        let name = if r < n_est { format!("est{r}") } else { format!("val{}", r - n_est) };
-        let rec = truth.run(&name, &tau, H, psi0, Some(crate::rng::mix(seed ^ (1000 + r as u64))));
-        if r < n_est { est.push(rec) } else { val.push(rec) }
+        let name = if r < n_est {
+            format!("est{r}")
+        } else {
+            format!("val{}", r - n_est)
+        };
+        let rec = truth.run(
+            &name,
+            &tau,
+            H,
+            psi0,
+            Some(crate::rng::mix(seed ^ (1000 + r as u64))),
+        );
+        if r < n_est {
+            est.push(rec)
+        } else {
+            val.push(rec)
+        }
     }
-    let restoring = Restoring { tether_pitch_moment: 0.0, ..truth.restoring };
+    let restoring = Restoring {
+        tether_pitch_moment: 0.0,
+        ..truth.restoring
+    };
     let baseline = fit_diagonal_baseline(&Dof::ALL, restoring, &est);
-    Scenario { profile, truth, est, val, baseline }
+    Scenario {
+        profile,
+        truth,
+        est,
+        val,
+        baseline,
+    }
 }
 
 /// Least-squares λ-filter baseline, diagonal M and D̄ per DOF row.
@@ -53,7 +76,9 @@ pub fn fit_diagonal_baseline(dofs: &[Dof], restoring: Restoring, runs: &[Record]
     };
     let prep = Prepared::new(&start, runs, 0.5, 25, 30).expect("runs long enough");
     let all: Vec<usize> = (0..runs.len()).collect();
-    let f = prep.fit(&[], &(0..n).collect::<Vec<_>>(), &all, false).expect("fit");
+    let f = prep
+        .fit(&[], &(0..n).collect::<Vec<_>>(), &all, false)
+        .expect("fit");
     let mut b = start.clone();
     for (ri, &r) in f.rows.iter().enumerate() {
         b.m[(r, r)] = f.base[ri].0[0];
@@ -78,16 +103,28 @@ pub fn true_model(t: &Truth) -> AugmentedModel {
     for dof in Dof::ALL {
         let i = dof.index();
         if t.quad[i] != 0.0 {
-            terms.push(term(Effect::QuadraticDamping { dof }, vec![t.quad[i]], None));
+            terms.push(term(
+                Effect::QuadraticDamping { dof },
+                vec![t.quad[i]],
+                None,
+            ));
         }
         if t.constant[i] != 0.0 {
-            terms.push(term(Effect::ConstantLoad { dof }, vec![t.constant[i]], None));
+            terms.push(term(
+                Effect::ConstantLoad { dof },
+                vec![t.constant[i]],
+                None,
+            ));
         }
         if let Some(l) = t.lag[i] {
             terms.push(term(Effect::ActuatorLag { dof }, vec![], Some(l)));
         }
         if t.delay[i] > 0 {
-            terms.push(term(Effect::InputDelay { dof }, vec![], Some(t.delay[i] as f64)));
+            terms.push(term(
+                Effect::InputDelay { dof },
+                vec![],
+                Some(t.delay[i] as f64),
+            ));
         }
         if let Some(l) = t.saturation[i] {
             terms.push(term(Effect::Saturation { dof }, vec![], Some(l)));
@@ -99,5 +136,13 @@ pub fn true_model(t: &Truth) -> AugmentedModel {
     if let Some([vn, ve]) = t.current {
         terms.push(term(Effect::Current, vec![vn, ve], None));
     }
-    AugmentedModel::new(Dof::ALL.to_vec(), m.clone(), d.clone(), t.restoring, m, d, terms)
+    AugmentedModel::new(
+        Dof::ALL.to_vec(),
+        m.clone(),
+        d.clone(),
+        t.restoring,
+        m,
+        d,
+        terms,
+    )
 }

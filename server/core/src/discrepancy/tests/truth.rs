@@ -68,7 +68,9 @@ impl Truth {
             nu_r[0] -= vn * cpsi + ve * spsi;
             nu_r[1] -= -vn * spsi + ve * cpsi;
         }
-        let g = self.restoring.g(&[eta[0], eta[1], eta[2], eta[3], eta[4], eta[5]]);
+        let g = self
+            .restoring
+            .g(&[eta[0], eta[1], eta[2], eta[3], eta[4], eta[5]]);
         let cor = if self.coriolis {
             let mm = DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(&self.m));
             coriolis_force(&Dof::ALL, &mm, nu)
@@ -76,7 +78,11 @@ impl Truth {
             vec![0.0; 6]
         };
         for i in 0..6 {
-            let tau_a = if self.lag[i].is_some() { x[12 + i] } else { u[i] };
+            let tau_a = if self.lag[i].is_some() {
+                x[12 + i]
+            } else {
+                u[i]
+            };
             let f = tau_a
                 - g[i]
                 - self.d[i] * nu_r[i]
@@ -91,9 +97,11 @@ impl Truth {
         }
         // η̇ = J(η)ν: R(φ,θ,ψ)·[u v w], T(φ,θ)·[p q r].
         let (u_, v_, w_, p_, q_, r_) = (nu[0], nu[1], nu[2], nu[3], nu[4], nu[5]);
-        dx[6] = cpsi * cth * u_ + (-spsi * cphi + cpsi * sth * sphi) * v_
+        dx[6] = cpsi * cth * u_
+            + (-spsi * cphi + cpsi * sth * sphi) * v_
             + (spsi * sphi + cpsi * cphi * sth) * w_;
-        dx[7] = spsi * cth * u_ + (cpsi * cphi + sphi * sth * spsi) * v_
+        dx[7] = spsi * cth * u_
+            + (cpsi * cphi + sphi * sth * spsi) * v_
             + (-cpsi * sphi + sth * spsi * cphi) * w_;
         dx[8] = -sth * u_ + cth * sphi * v_ + cth * cphi * w_;
         dx[9] = p_ + sphi * sth / cth * q_ + cphi * sth / cth * r_;
@@ -103,7 +111,14 @@ impl Truth {
 
     /// Runs the truth on commands `tau` (N × 6, held over each step h);
     /// with `noise`, ν and η get measurement noise. Heading starts at `psi0`.
-    pub fn run(&self, name: &str, tau: &DMatrix<f64>, h: f64, psi0: f64, seed: Option<u64>) -> Record {
+    pub fn run(
+        &self,
+        name: &str,
+        tau: &DMatrix<f64>,
+        h: f64,
+        psi0: f64,
+        seed: Option<u64>,
+    ) -> Record {
         let n = tau.nrows();
         // The applied command after delay and saturation, still held.
         let applied = DMatrix::from_fn(n, 6, |k, i| {
@@ -151,7 +166,14 @@ impl Truth {
 
 /// Random-level excitation: levels uniform in offset ± amplitude, held for a
 /// clock period (amplitude variety separates ν- from τ-dependent effects).
-pub fn random_levels(n: usize, h: f64, clock_s: f64, offset: f64, amplitude: f64, rng: &mut SplitMix64) -> Vec<f64> {
+pub fn random_levels(
+    n: usize,
+    h: f64,
+    clock_s: f64,
+    offset: f64,
+    amplitude: f64,
+    rng: &mut SplitMix64,
+) -> Vec<f64> {
     let per = (clock_s / h).round().max(1.0) as usize;
     let mut out = Vec::with_capacity(n);
     let mut level = 0.0;
