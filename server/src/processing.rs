@@ -146,17 +146,21 @@ fn parse(
 /// For thruster-actuated vessels the DOF's input is the normalized
 /// generalized force τ_T = T·u (K = I): its direction is known from the
 /// thruster configuration matrix even though the thrust coefficients are not.
-fn add_thruster_forces(vessel: &VesselProfile, rec: &mut UniformRecord) -> Vec<String> {
+fn add_thruster_forces(vessel: &VesselProfile, rec: &mut UniformRecord) {
     let InputChannels::Thrusters {
         configuration,
         thrusters,
     } = &vessel.inputs
     else {
-        return Vec::new();
+        return;
     };
-    let mut names = Vec::new();
-    for (r, &d) in vessel.dofs.iter().enumerate() {
-        let name = format!("{}_T", d.force_column());
+    for ((r, &d), name) in vessel
+        .dofs
+        .iter()
+        .enumerate()
+        .zip(thruster_force_columns(vessel))
+    {
+        debug_assert_eq!(name, format!("{}_T", d.force_column()));
         let mut acc = vec![0.0; rec.len()];
         for (i, _) in thrusters.iter().enumerate() {
             if let Some(u) = rec.column(&format!("thr_{}", i + 1)) {
@@ -165,11 +169,21 @@ fn add_thruster_forces(vessel: &VesselProfile, rec: &mut UniformRecord) -> Vec<S
                 }
             }
         }
-        rec.names.push(name.clone());
+        rec.names.push(name);
         rec.data.push(acc);
-        names.push(name);
     }
-    names
+}
+
+/// Names of the derived τ_T = T·u columns (empty unless thruster-actuated).
+pub fn thruster_force_columns(vessel: &VesselProfile) -> Vec<String> {
+    match vessel.inputs {
+        InputChannels::Thrusters { .. } => vessel
+            .dofs
+            .iter()
+            .map(|d| format!("{}_T", d.force_column()))
+            .collect(),
+        _ => Vec::new(),
+    }
 }
 
 /// The log column a planned schedule column should be compared with.
@@ -180,13 +194,16 @@ fn logged_column(schedule_column: &str) -> String {
     }
 }
 
-/// Parses, aligns, resamples and scores a run.
-pub fn process_run(
+/// Parses, aligns (two-file runs) and resamples a stored run into one
+/// uniform record; what was found (rows, gaps, warnings, alignment) goes into
+/// `summary`. Identification jobs load accepted runs through this too, so the
+/// record they fit is the one the quality report scored.
+pub fn load_record(
     vessel: &VesselProfile,
     files: &[(String, PathBuf)],
     meta: &RunMeta,
-    planned: Option<&(StoredExperiment, Schedule)>,
-) -> Result<Processed, ProcessError> {
+    summary: &mut RunSummary,
+) -> Result<UniformRecord, ProcessError> {
     if let Some(r) = meta.rate_hz
         && !(r.is_finite() && r > 0.0 && r <= 1000.0)
     {
@@ -196,7 +213,6 @@ pub fn process_run(
         ));
     }
     let path = |role: &str| files.iter().find(|(r, _)| r == role).map(|(_, p)| p);
-    let mut summary = RunSummary::default();
     let note = |file: &str, p: &ParsedLog, summary: &mut RunSummary| {
         summary
             .warnings
@@ -214,7 +230,7 @@ pub fn process_run(
     let mut rec = if let Some(p) = path("file") {
         let parsed = parse(vessel, p, LogRole::Single, "file", None)?;
         let (rec, _) = to_uniform(&parsed.table, meta.rate_hz)?;
-        note("file", &parsed, &mut summary);
+        note("file", &parsed, summary);
         rec
     } else {
         let shared = meta.shared_channel.as_deref().unwrap_or("z");
@@ -226,8 +242,8 @@ pub fn process_run(
         };
         let control = parse(vessel, cp, LogRole::Control, "control", Some(shared))?;
         let nav = parse(vessel, np, LogRole::Nav, "nav", Some(shared))?;
-        note("control", &control, &mut summary);
-        note("nav", &nav, &mut summary);
+        note("control", &control, summary);
+        note("nav", &nav, summary);
         let (rec, report) = align_logs(
             &control.table,
             &nav.table,
@@ -246,7 +262,20 @@ pub fn process_run(
         summary.alignment = Some(report);
         rec
     };
-    let derived = add_thruster_forces(vessel, &mut rec);
+    add_thruster_forces(vessel, &mut rec);
+    Ok(rec)
+}
+
+/// Parses, aligns, resamples and scores a run.
+pub fn process_run(
+    vessel: &VesselProfile,
+    files: &[(String, PathBuf)],
+    meta: &RunMeta,
+    planned: Option<&(StoredExperiment, Schedule)>,
+) -> Result<Processed, ProcessError> {
+    let mut summary = RunSummary::default();
+    let rec = load_record(vessel, files, meta, &mut summary)?;
+    let derived = thruster_force_columns(vessel);
     let dofs: Vec<DofChannels> = vessel
         .dofs
         .iter()

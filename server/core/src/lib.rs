@@ -24,6 +24,7 @@
 pub mod alignment;
 pub mod discrepancy;
 pub mod estimation;
+pub mod identification;
 pub mod logs;
 pub mod models;
 pub mod planning;

@@ -8,6 +8,7 @@ pub mod export;
 pub mod health;
 pub mod json;
 pub mod plans;
+pub mod query;
 pub mod runs;
 pub mod vessels;
 

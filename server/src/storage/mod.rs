@@ -4,6 +4,7 @@
 
 pub mod blobs;
 pub mod campaigns;
+pub mod models;
 pub mod plans;
 pub mod runs;
 pub mod vessels;

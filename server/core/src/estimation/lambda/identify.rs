@@ -1,0 +1,284 @@
+//! The λ-filter Kalman identification of one operating point (thesis
+//! sec. 2.5): filter ν and γ through λ, estimate [A_λ B_λ] row by row with
+//! a Kalman filter over the parameters started at the rigid-body prior, map
+//! back to A, B and to M, D̄, and propagate the uncertainty.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::error::{LambdaError, require_finite_matrix};
+use super::estimate::{LambdaEstimate, UncertaintyMethod};
+use super::experiment::{Experiment, validate_runs};
+use super::filter::LambdaFilter;
+use super::kalman::kalman_row;
+use super::posterior::{RowPosterior, apply_sandwich, residual_dof, row_posterior, rss};
+use super::regressors::RunRegressors;
+use super::robust::{LAG_IN_T, long_run_score_covariance};
+use super::settings::{LambdaSettings, MIN_T_OVER_H};
+use super::statistics::RegressionStats;
+use super::structure::CouplingMask;
+use super::transform::{physical, state_space, to_lambda};
+use super::uncertainty::delta_method;
+use crate::estimation::{NoProgress, Progress};
+
+/// Identifies M ν̇ + D̄ ν = γ from a multi-experiment set of runs at one
+/// operating point. See [`identify_with_progress`].
+///
+/// # Errors
+/// As [`identify_with_progress`] (never [`LambdaError::Cancelled`]).
+pub fn identify(
+    runs: &[Experiment],
+    settings: &LambdaSettings,
+) -> Result<LambdaEstimate, LambdaError> {
+    identify_with_progress(runs, settings, &mut NoProgress)
+}
+
+/// Prior mean θ₀ and variances of every row (full 2n regressor order).
+struct RowPriors {
+    theta0: Vec<DVector<f64>>,
+    p0: Vec<DVector<f64>>,
+}
+
+/// Validates the settings for n DOFs and a sample time h.
+fn validate_settings(s: &LambdaSettings, n: usize) -> Result<CouplingMask, LambdaError> {
+    if n == 0 {
+        return Err(LambdaError::shape("settings.dofs", "no DOF given"));
+    }
+    for (i, d) in s.dofs.iter().enumerate() {
+        if s.dofs[..i].contains(d) {
+            return Err(LambdaError::invalid(
+                format!("settings.dofs[{i}]"),
+                format!("{} appears twice", d.name()),
+            ));
+        }
+    }
+    super::error::require_positive("settings.t_lambda", s.t_lambda)?;
+    let mask = s.structure.mask(n);
+    mask.validate(n)?;
+    for (name, m) in [
+        ("settings.prior.m0", &s.prior.m0),
+        ("settings.prior.d_bar0", &s.prior.d_bar0),
+    ] {
+        if m.shape() != (n, n) {
+            return Err(LambdaError::shape(
+                name,
+                format!("is {}×{}, expected {n}×{n}", m.nrows(), m.ncols()),
+            ));
+        }
+        require_finite_matrix(name, m)?;
+    }
+    super::error::require_positive("settings.prior.a_lambda_std", s.prior.a_lambda_std)?;
+    super::error::require_positive("settings.prior.b_lambda_rel_std", s.prior.b_lambda_rel_std)?;
+    if let Some(r) = &s.noise_variance {
+        if r.len() != n {
+            return Err(LambdaError::shape(
+                "settings.noise_variance",
+                format!("has {} entries, expected one per DOF ({n})", r.len()),
+            ));
+        }
+        for (i, &v) in r.iter().enumerate() {
+            super::error::require_positive(&format!("settings.noise_variance[{i}]"), v)?;
+        }
+    }
+    if !(s.random_walk.is_finite() && s.random_walk >= 0.0) {
+        return Err(LambdaError::invalid(
+            "settings.random_walk",
+            format!("must be finite and ≥ 0, got {}", s.random_walk),
+        ));
+    }
+    Ok(mask)
+}
+
+/// θ₀ = [A_λ0 B_λ0] from (M₀, D̄₀) and the dimensionally scaled stds.
+fn priors(s: &LambdaSettings, f: &LambdaFilter) -> Result<RowPriors, LambdaError> {
+    let n = s.dofs.len();
+    let (a0, b0) = state_space(&s.prior.m0, &s.prior.d_bar0, "settings.prior.m0")?;
+    if let Some(i) = (0..n).find(|&i| b0[(i, i)] <= 0.0 || !b0[(i, i)].is_finite()) {
+        return Err(LambdaError::invalid(
+            "settings.prior.m0",
+            format!("diagonal entry {i} of M₀⁻¹ is not positive: M₀ is not a mass matrix"),
+        ));
+    }
+    let (al0, bl0) = to_lambda(&a0, &b0, f, s.inversion)?;
+    let sa = s.prior.a_lambda_std;
+    let sb = s.prior.b_lambda_rel_std * s.t_lambda;
+    let mut theta0 = Vec::with_capacity(n);
+    let mut p0 = Vec::with_capacity(n);
+    for i in 0..n {
+        theta0.push(DVector::from_fn(2 * n, |j, _| {
+            if j < n { al0[(i, j)] } else { bl0[(i, j - n)] }
+        }));
+        p0.push(DVector::from_fn(2 * n, |j, _| {
+            let sd = if j < n {
+                sa * (b0[(i, i)] / b0[(j, j)]).sqrt()
+            } else {
+                let j = j - n;
+                sb * (b0[(i, i)] * b0[(j, j)]).sqrt()
+            };
+            sd * sd
+        }));
+    }
+    Ok(RowPriors { theta0, p0 })
+}
+
+/// Identifies M ν̇ + D̄ ν = γ from a multi-experiment set of runs at one
+/// operating point, reporting progress per DOF and honouring cancellation.
+///
+/// Each run is filtered through λ from its own initial state; the
+/// parameter posterior is carried across runs (never concatenating the
+/// signals). With `random_walk = 0` the Kalman filter's end state is
+/// computed in information form from statistics shared by all rows; with
+/// `random_walk > 0` the covariance-form filter runs sample by sample.
+///
+/// # Errors
+/// Typed, naming the field: shapes (`runs[i].nu`, `runs[i].gamma`,
+/// `settings.prior.m0`, `structure.a` …), NaN (`runs[i].nu` with the row),
+/// too few samples, T ≤ 0 or T < [`MIN_T_OVER_H`]·h (`settings.t_lambda`),
+/// singular prior mass (`settings.prior.m0`), singular estimated B (`b`),
+/// an estimate that is no sampled continuous model (`a_lambda`), and
+/// [`LambdaError::Cancelled`].
+pub fn identify_with_progress(
+    runs: &[Experiment],
+    settings: &LambdaSettings,
+    progress: &mut dyn Progress,
+) -> Result<LambdaEstimate, LambdaError> {
+    let n = settings.dofs.len();
+    let mask = validate_settings(settings, n)?;
+    let p = 2 * n;
+    // Each run must at least outnumber the regressors plus its transient.
+    let h = validate_runs("runs", runs, n, p + 2)?;
+    if settings.t_lambda < MIN_T_OVER_H * h {
+        return Err(LambdaError::invalid(
+            "settings.t_lambda",
+            format!(
+                "T = {} s is not ≫ h = {h} s (need T ≥ {MIN_T_OVER_H}·h)",
+                settings.t_lambda
+            ),
+        ));
+    }
+    let f = LambdaFilter::new(settings.t_lambda, h)?;
+    let pri = priors(settings, &f)?;
+
+    let mut stats = RegressionStats::new(n);
+    let mut filtered = Vec::with_capacity(runs.len());
+    let kf = settings.random_walk > 0.0;
+    for (r, run) in runs.iter().enumerate() {
+        progress.update(0.5 * r as f64 / runs.len() as f64, "λ-filtering runs")?;
+        let reg = RunRegressors::new(run, &f, settings.filter_init);
+        stats.add(&reg, settings.estimate_transient);
+        filtered.push(reg);
+    }
+    let lag = (LAG_IN_T * settings.t_lambda / h).ceil() as usize;
+    let free: Vec<Vec<usize>> = (0..n).map(|i| mask.free_of_row(i)).collect();
+    if let Some(i) = (0..n).find(|&i| residual_dof(&stats, free[i].len()) < 1.0) {
+        return Err(LambdaError::too_few(
+            "runs",
+            format!(
+                "{} samples over {} runs leave no residual degree of freedom for the {} parameters of row {i}",
+                stats.n_samples,
+                runs.len(),
+                free[i].len()
+            ),
+        ));
+    }
+
+    let mut rows: Vec<RowPosterior> = Vec::with_capacity(n);
+    for i in 0..n {
+        progress.update(
+            0.5 + 0.4 * i as f64 / n as f64,
+            &format!("estimating {}", settings.dofs[i].name()),
+        )?;
+        let noise = settings.noise_variance.as_ref().map(|r| r[i]);
+        let mut row = row_posterior(&stats, i, &free[i], &pri.theta0[i], &pri.p0[i], noise)?;
+        if kf {
+            row = kalman_pass(&filtered, i, &free[i], &pri, &row, &f, settings, &stats)?;
+        } else if settings.robust_covariance {
+            let theta_s = DVector::from_fn(free[i].len(), |a, _| row.theta[free[i][a]]);
+            let omega = long_run_score_covariance(
+                &filtered,
+                i,
+                &free[i],
+                &theta_s,
+                settings.estimate_transient,
+                lag,
+            );
+            apply_sandwich(&mut row, &free[i], &pri.p0[i], &omega);
+        }
+        rows.push(row);
+    }
+    progress.update(0.9, "mapping to M, D̄")?;
+
+    let a_lambda = DMatrix::from_fn(n, n, |i, j| rows[i].theta[j]);
+    let b_lambda = DMatrix::from_fn(n, n, |i, j| rows[i].theta[n + j]);
+    let blocks = mask.blocks();
+    let [a, b, m, d_bar] = physical(&a_lambda, &b_lambda, &f, settings.inversion, &blocks)?;
+    let [std_a, std_b, std_m, std_d_bar] =
+        delta_method(&rows, &free, &f, settings.inversion, &blocks);
+    progress.update(1.0, "done")?;
+    Ok(LambdaEstimate {
+        dofs: settings.dofs.clone(),
+        t_lambda: settings.t_lambda,
+        h,
+        inversion: settings.inversion,
+        mask,
+        a_lambda,
+        b_lambda,
+        a,
+        b,
+        m,
+        d_bar,
+        param_cov: rows.iter().map(|r| r.cov.clone()).collect(),
+        std_a,
+        std_b,
+        std_m,
+        std_d_bar,
+        uncertainty: UncertaintyMethod::DeltaMethod,
+        residual_variance: rows.iter().map(|r| r.residual_variance).collect(),
+        noise_variance: rows.iter().map(|r| r.noise_variance).collect(),
+        n_samples: stats.n_samples,
+        n_runs: runs.len(),
+    })
+}
+
+/// The covariance-form Kalman filter with random-walk parameters for row
+/// `i`, using the noise variance of the constant-parameter posterior.
+#[allow(clippy::too_many_arguments)]
+fn kalman_pass(
+    filtered: &[RunRegressors<'_>],
+    i: usize,
+    free: &[usize],
+    pri: &RowPriors,
+    constant: &RowPosterior,
+    f: &LambdaFilter,
+    settings: &LambdaSettings,
+    stats: &RegressionStats,
+) -> Result<RowPosterior, LambdaError> {
+    let k = free.len();
+    let theta0 = DVector::from_fn(k, |a, _| pri.theta0[i][free[a]]);
+    let p0 = DMatrix::from_fn(k, k, |a, b| if a == b { pri.p0[i][free[a]] } else { 0.0 });
+    let q = DVector::from_fn(k, |a, _| settings.random_walk * pri.p0[i][free[a]]);
+    let r = constant.noise_variance;
+    let transient = settings.estimate_transient.then_some(f.c);
+    let (theta_s, cov_s) = kalman_row(filtered, i, free, theta0, p0, r, &q, transient);
+    if theta_s.iter().chain(cov_s.iter()).any(|v| !v.is_finite()) {
+        return Err(LambdaError::singular(
+            "settings.random_walk",
+            format!("the parameter Kalman filter of row {i} diverged"),
+        ));
+    }
+    let p = 2 * settings.dofs.len();
+    let mut theta = DVector::zeros(p);
+    let mut cov = DMatrix::zeros(p, p);
+    for (a, &ja) in free.iter().enumerate() {
+        theta[ja] = theta_s[a];
+        for (b, &jb) in free.iter().enumerate() {
+            cov[(ja, jb)] = 0.5 * (cov_s[(a, b)] + cov_s[(b, a)]);
+        }
+    }
+    let residual_variance = rss(stats, i, free, &theta_s) / residual_dof(stats, k).max(1.0);
+    Ok(RowPosterior {
+        theta,
+        cov,
+        noise_variance: r,
+        residual_variance,
+    })
+}

@@ -1,0 +1,98 @@
+//! Settings of the λ-filter identification and the rigid-body prior.
+
+use nalgebra::DMatrix;
+
+use super::filter::FilterInit;
+use super::structure::Structure;
+use super::transform::Inversion;
+use crate::planning::dof::Dof;
+
+/// T must exceed this many sample times: the state-variable filter has to
+/// be resolved by the sampling ("T ≫ h"), and the thesis map eq. 2.14–2.15
+/// is only first-order accurate in h/T.
+pub const MIN_T_OVER_H: f64 = 5.0;
+
+/// The prior of the parameter Kalman filter: a rigid-body guess M₀, D̄₀
+/// (e.g. mass and inertia from the CAD model plus strip-theory added mass,
+/// and a rough linear damping), mapped to A_λ0, B_λ0, with independent
+/// Gaussian uncertainty on every entry.
+///
+/// Prior standard deviations, dimensionally consistent across DOFs (with
+/// B₀ = M₀⁻¹, whose entries satisfy |B_ij| ≤ √(B_ii·B_jj) when M₀ is SPD):
+/// σ(A_λ,ij) = `a_lambda_std`·√(B₀_ii / B₀_jj) and
+/// σ(B_λ,ij) = `b_lambda_rel_std`·T·√(B₀_ii·B₀_jj).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Prior {
+    /// Rigid-body (plus added) mass guess M₀, n × n, invertible with a
+    /// positive-diagonal inverse.
+    pub m0: DMatrix<f64>,
+    /// Damping guess D̄₀, n × n.
+    pub d_bar0: DMatrix<f64>,
+    /// Dimensionless prior std of A_λ = I + T·A entries (1 ≈ "within the
+    /// order of the identity").
+    pub a_lambda_std: f64,
+    /// Prior std of B_λ entries relative to T·√(B₀_ii·B₀_jj).
+    pub b_lambda_rel_std: f64,
+}
+
+impl Prior {
+    /// A weakly informative prior around (M₀, D̄₀): both stds 1.
+    pub fn weak(m0: DMatrix<f64>, d_bar0: DMatrix<f64>) -> Self {
+        Prior {
+            m0,
+            d_bar0,
+            a_lambda_std: 1.0,
+            b_lambda_rel_std: 1.0,
+        }
+    }
+}
+
+/// Everything [`super::identify`] needs besides the runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LambdaSettings {
+    /// The DOFs of the columns of ν and γ, in order.
+    pub dofs: Vec<Dof>,
+    /// Filter time constant T (s) of λ(s) = 1/(1+sT); of the order of the
+    /// vessel's time constants and ≥ [`MIN_T_OVER_H`]·h.
+    pub t_lambda: f64,
+    /// Diagonal or coupled (masked) model.
+    pub structure: Structure,
+    /// Rigid-body prior of the parameter Kalman filter.
+    pub prior: Prior,
+    /// Measurement-noise variance of ν per DOF; `None` estimates it from the
+    /// residuals.
+    pub noise_variance: Option<Vec<f64>>,
+    /// Random-walk variance per sample of every parameter, as a fraction of
+    /// its prior variance (0: constant parameters, the fast exact path).
+    pub random_walk: f64,
+    /// Map from A_λ, B_λ back to A, B.
+    pub inversion: Inversion,
+    /// Initial state of the λ filters of each run.
+    pub filter_init: FilterInit,
+    /// Estimate (and marginalize) each run's initial transient a^k·e₀.
+    pub estimate_transient: bool,
+    /// Report the autocorrelation-robust (Newey–West sandwich) posterior
+    /// covariance instead of the white-noise one (constant parameters only;
+    /// see `robust`): the λ regression's equation error is coloured.
+    pub robust_covariance: bool,
+}
+
+impl LambdaSettings {
+    /// Settings with the defaults: noise estimated, constant parameters,
+    /// exact inversion, filters started at the first sample, transients
+    /// estimated, robust covariance.
+    pub fn new(dofs: Vec<Dof>, t_lambda: f64, structure: Structure, prior: Prior) -> Self {
+        LambdaSettings {
+            dofs,
+            t_lambda,
+            structure,
+            prior,
+            noise_variance: None,
+            random_walk: 0.0,
+            inversion: Inversion::Exact,
+            filter_init: FilterInit::FirstSample,
+            estimate_transient: true,
+            robust_covariance: true,
+        }
+    }
+}

@@ -1,0 +1,8 @@
+//! Proof tests of the λ-filter identification against known truths.
+
+mod analytic;
+mod calibration;
+mod errors;
+mod multi;
+mod rov;
+mod truth;

@@ -1,0 +1,244 @@
+//! The identified model as the service stores and serves it: matrices as
+//! row-major nested arrays (what a control engineer pastes into MATLAB or
+//! NumPy), every estimate with its standard deviation, and a flat parameter
+//! table for display and CSV export.
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use crate::planning::dof::Dof;
+
+/// A matrix as rows of numbers.
+pub type Matrix = Vec<Vec<f64>>;
+
+/// Row-major nested arrays of a nalgebra matrix.
+pub fn to_rows(m: &DMatrix<f64>) -> Matrix {
+    (0..m.nrows())
+        .map(|i| m.row(i).iter().copied().collect())
+        .collect()
+}
+
+/// The nalgebra matrix of row-major nested arrays (`None` when ragged).
+pub fn from_rows(rows: &Matrix) -> Option<DMatrix<f64>> {
+    let n = rows.len();
+    let m = rows.first().map_or(0, Vec::len);
+    if rows.iter().any(|r| r.len() != m) {
+        return None;
+    }
+    Some(DMatrix::from_fn(n, m, |i, j| rows[i][j]))
+}
+
+/// What kind of model a document holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum ModelKind {
+    /// LPV model scheduled on forward speed: one M ν̇ + D̄ ν = γ per grid point.
+    Lpv,
+    /// DP ship low-frequency model: M, A_h = −D M⁻¹, thrust coefficients K.
+    DpShip,
+    /// Discrete-time innovation-form state space (subspace identification).
+    StateSpace,
+}
+
+/// How it was identified.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Continuous-time Kalman-filter identification through λ(s) = 1/(1+sT).
+    LambdaKf,
+    /// State-augmented EKF in parallel over N runs, staged SI1→SI2→SI3.
+    ParallelEkf,
+    /// N4SID subspace identification.
+    N4sid,
+    /// A baseline augmented by missing-physics discovery.
+    Discovery,
+}
+
+impl Method {
+    /// The snake_case name used in the API and the database.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::LambdaKf => "lambda_kf",
+            Method::ParallelEkf => "parallel_ekf",
+            Method::N4sid => "n4sid",
+            Method::Discovery => "discovery",
+        }
+    }
+}
+
+/// One estimated parameter for tables and CSV.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct ParameterRow {
+    /// Group: `M`, `D̄`, `A`, `B`, `g(η)`, `θ″`, …
+    pub group: String,
+    /// Symbol in the papers' notation, e.g. `M[surge,pitch]`, `θ″3`, `W−B`.
+    pub symbol: String,
+    /// LPV grid speed (m/s) the parameter belongs to.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid_speed_mps: Option<f64>,
+    /// Estimate.
+    pub value: f64,
+    /// Standard deviation, when the method gives one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub std: Option<f64>,
+    /// SI unit (or `-` for non-dimensional).
+    pub unit: String,
+}
+
+/// Estimated restoring forces and tether moment (thesis eq. 2.1–2.4).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct RestoringDoc {
+    /// Named parameters with standard deviations (W−B, z_G·W−z_B·B, tether moment…).
+    pub parameters: Vec<ParameterRow>,
+    /// Static runs and segments used.
+    pub evidence: Vec<String>,
+}
+
+/// One LPV sub-model: M ν̇ + D̄ ν = γ at a forward speed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct LpvPoint {
+    /// Grid forward speed (m/s).
+    pub speed_mps: f64,
+    /// Inertia M (kg, kg·m, kg·m²).
+    pub m: Matrix,
+    /// Std of M's entries.
+    pub m_std: Matrix,
+    /// Damping D̄ (kg/s, …).
+    pub d_bar: Matrix,
+    /// Std of D̄'s entries.
+    pub d_bar_std: Matrix,
+    /// A = −M⁻¹D̄ (1/s).
+    pub a: Matrix,
+    /// Std of A's entries.
+    pub a_std: Matrix,
+    /// B = M⁻¹.
+    pub b: Matrix,
+    /// Std of B's entries.
+    pub b_std: Matrix,
+    /// Samples used.
+    pub n_samples: usize,
+    /// Runs used.
+    pub run_ids: Vec<String>,
+}
+
+/// An LPV model on forward speed (thesis eq. 2.16–2.18).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct LpvDoc {
+    /// State-variable filter time constant T of λ(s) = 1/(1+sT) (s).
+    pub t_lambda_s: f64,
+    /// `diagonal` or `coupled`.
+    pub structure: String,
+    /// Free entries of A (and B) for a coupled structure, by DOF index.
+    pub coupling: Vec<Vec<bool>>,
+    /// Sub-models by ascending speed.
+    pub points: Vec<LpvPoint>,
+}
+
+/// A DP ship's low-frequency model in momentum form (Fossen et al. 1995).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct DpShipDoc {
+    /// Units of the matrices, e.g. `Bis` (non-dimensional) or `SI`.
+    pub units: String,
+    /// Inertia M (known a priori).
+    pub m: Matrix,
+    /// Thruster configuration T (3 × r).
+    pub t_config: Matrix,
+    /// A_h = −D M⁻¹.
+    pub a_h: Matrix,
+    /// Std of A_h's entries.
+    pub a_h_std: Matrix,
+    /// Thrust coefficients K (diagonal).
+    pub k: Vec<f64>,
+    /// Std of K.
+    pub k_std: Vec<f64>,
+    /// D = −A_h M.
+    pub d: Matrix,
+    /// A = M⁻¹A_h M.
+    pub a: Matrix,
+    /// B = M⁻¹ T K.
+    pub b: Matrix,
+}
+
+/// A discrete-time innovation-form model x⁺ = Φx + Γu + Ke, y = Cx + Du + e.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct StateSpaceDoc {
+    /// Sample time h (s).
+    pub h: f64,
+    /// Order n.
+    pub order: usize,
+    /// Φ.
+    pub phi: Matrix,
+    /// Γ.
+    pub gamma: Matrix,
+    /// C.
+    pub c: Matrix,
+    /// D.
+    pub d: Matrix,
+    /// Kalman gain K.
+    pub k: Matrix,
+    /// Singular values that chose the order.
+    pub singular_values: Vec<f64>,
+    /// Continuous-time A (when Φ has a real logarithm).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub a_continuous: Option<Matrix>,
+    /// Continuous-time B.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub b_continuous: Option<Matrix>,
+}
+
+/// The identified model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct ModelDocument {
+    /// Kind of model.
+    pub kind: ModelKind,
+    /// Method.
+    pub method: Method,
+    /// Modelled DOFs.
+    pub dofs: Vec<Dof>,
+    /// Input channels, in column order (γ = τ − g(η) per DOF, or thr_i).
+    pub inputs: Vec<String>,
+    /// Output channels (ν per DOF, or x, y, ψ).
+    pub outputs: Vec<String>,
+    /// Restoring forces, when estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub restoring: Option<RestoringDoc>,
+    /// LPV model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lpv: Option<LpvDoc>,
+    /// DP ship model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dp_ship: Option<DpShipDoc>,
+    /// Subspace model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub state_space: Option<StateSpaceDoc>,
+    /// Every estimated parameter with its standard deviation.
+    pub parameters: Vec<ParameterRow>,
+    /// Physical-structure findings (M not SPD, D̄ not dissipative…), reported
+    /// rather than silently corrected.
+    pub structure_findings: Vec<String>,
+    /// Other notes for the engineer.
+    pub notes: Vec<String>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_round_trip_and_ragged_is_refused() {
+        let m = DMatrix::from_row_slice(2, 3, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        let rows = to_rows(&m);
+        assert_eq!(rows, vec![vec![1.0, 2.0, 3.0], vec![4.0, 5.0, 6.0]]);
+        assert_eq!(from_rows(&rows).unwrap(), m);
+        assert!(from_rows(&vec![vec![1.0], vec![1.0, 2.0]]).is_none());
+    }
+}

@@ -1,0 +1,209 @@
+//! Exports of a model document: the parameter table as CSV, and a Fossen-form
+//! parameter set — M, D, g(η) terms, thruster configuration — in the notation
+//! of Fossen's MSS toolbox and PythonVehicleSimulator (`M = MRB + MA`, `D`,
+//! restoring `W`, `B`-type terms, `T`, `K`), so a simulator can be loaded with
+//! it directly (`np.array(p["M"])`, `M = jsondecode(...).M` in MATLAB).
+
+use serde::Serialize;
+
+use super::document::{Matrix, ModelDocument, ModelKind, ParameterRow};
+
+/// CSV of every estimated parameter: `group,symbol,grid_speed_mps,value,std,unit`.
+pub fn parameter_csv(doc: &ModelDocument) -> String {
+    let mut out = String::from("group,symbol,grid_speed_mps,value,std,unit\n");
+    for p in &doc.parameters {
+        let q = |s: &str| {
+            if s.contains([',', '"', '\n']) {
+                format!("\"{}\"", s.replace('"', "\"\""))
+            } else {
+                s.to_string()
+            }
+        };
+        out.push_str(&format!(
+            "{},{},{},{},{},{}\n",
+            q(&p.group),
+            q(&p.symbol),
+            p.grid_speed_mps.map(|v| v.to_string()).unwrap_or_default(),
+            p.value,
+            p.std.map(|v| v.to_string()).unwrap_or_default(),
+            q(&p.unit)
+        ));
+    }
+    out
+}
+
+/// One speed's rigid-body-plus-added-mass and damping matrices.
+#[derive(Debug, Clone, Serialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct FossenPoint {
+    /// Forward speed U (m/s) the matrices hold at.
+    #[serde(rename = "U")]
+    pub u: f64,
+    /// M = M_RB + M_A.
+    #[serde(rename = "M")]
+    pub m: Matrix,
+    /// Linear damping D (the λ-identified D̄).
+    #[serde(rename = "D")]
+    pub d: Matrix,
+}
+
+/// A Fossen-form parameter set.
+#[derive(Debug, Clone, Serialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct FossenParameterSet {
+    /// `seatrial-fossen/1`.
+    pub format: String,
+    /// The equation the matrices belong to.
+    pub equation: String,
+    /// DOF order of every matrix (`surge`, `sway`, …).
+    pub dofs: Vec<String>,
+    /// Units of the matrices.
+    pub units: String,
+    /// M and D per forward speed (one entry for a DP ship).
+    pub points: Vec<FossenPoint>,
+    /// Restoring terms g(η): name → value (SI), e.g. `W_minus_B`.
+    pub restoring: Vec<ParameterRow>,
+    /// Thruster configuration T (DP ship).
+    #[serde(rename = "T", skip_serializing_if = "Option::is_none")]
+    pub t: Option<Matrix>,
+    /// Thrust coefficients K (diagonal, DP ship).
+    #[serde(rename = "K", skip_serializing_if = "Option::is_none")]
+    pub k: Option<Vec<f64>>,
+    /// How to use it.
+    pub notes: Vec<String>,
+}
+
+/// The Fossen-form set of a physical model; `Err` for a black-box
+/// state-space model, which has no M, D or g(η).
+pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, String> {
+    let dofs = doc.dofs.iter().map(|d| d.name().to_string()).collect();
+    let restoring = doc
+        .restoring
+        .as_ref()
+        .map(|r| r.parameters.clone())
+        .unwrap_or_default();
+    match doc.kind {
+        ModelKind::Lpv => {
+            let lpv = doc.lpv.as_ref().ok_or("the LPV model has no grid points")?;
+            Ok(FossenParameterSet {
+                format: "seatrial-fossen/1".into(),
+                equation: "M·ν̇ + D·ν + g(η) = τ (per forward speed U; C(ν) from M)".into(),
+                dofs,
+                units: "SI (kg, kg·m, kg·m², kg/s, N, N·m)".into(),
+                points: lpv
+                    .points
+                    .iter()
+                    .map(|p| FossenPoint {
+                        u: p.speed_mps,
+                        m: p.m.clone(),
+                        d: p.d_bar.clone(),
+                    })
+                    .collect(),
+                restoring,
+                t: None,
+                k: None,
+                notes: vec![
+                    "Schedule on forward speed: nearest U, or interpolate M and D between neighbours."
+                        .into(),
+                    "D is the λ-identified D̄ (linear damping about the grid speed).".into(),
+                ],
+            })
+        }
+        ModelKind::DpShip => {
+            let s = doc.dp_ship.as_ref().ok_or("the DP model is missing")?;
+            Ok(FossenParameterSet {
+                format: "seatrial-fossen/1".into(),
+                equation: "M·ν̇ + C(ν)ν + D·ν = T·K·u, η̇ = J(ψ)ν".into(),
+                dofs,
+                units: s.units.clone(),
+                points: vec![FossenPoint {
+                    u: 0.0,
+                    m: s.m.clone(),
+                    d: s.d.clone(),
+                }],
+                restoring,
+                t: Some(s.t_config.clone()),
+                k: Some(s.k.clone()),
+                notes: vec![
+                    "Low-frequency DP model; D = −A_h·M (Fossen et al. 1995, eq. 39).".into(),
+                ],
+            })
+        }
+        ModelKind::StateSpace => Err(
+            "a subspace (N4SID) model is a black box in its own state coordinates: it has no M, D or g(η); export it as json"
+                .into(),
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identification::document::{LpvDoc, LpvPoint, Method, ModelKind};
+    use crate::planning::dof::Dof;
+
+    fn doc() -> ModelDocument {
+        let id = vec![vec![1.0]];
+        ModelDocument {
+            kind: ModelKind::Lpv,
+            method: Method::LambdaKf,
+            dofs: vec![Dof::Surge],
+            inputs: vec!["gamma_X".into()],
+            outputs: vec!["u".into()],
+            restoring: None,
+            lpv: Some(LpvDoc {
+                t_lambda_s: 1.0,
+                structure: "diagonal".into(),
+                coupling: vec![vec![true]],
+                points: vec![LpvPoint {
+                    speed_mps: 0.5,
+                    m: vec![vec![2700.0]],
+                    m_std: vec![vec![30.0]],
+                    d_bar: vec![vec![800.0]],
+                    d_bar_std: vec![vec![12.0]],
+                    a: id.clone(),
+                    a_std: id.clone(),
+                    b: id.clone(),
+                    b_std: id,
+                    n_samples: 100,
+                    run_ids: vec![],
+                }],
+            }),
+            dp_ship: None,
+            state_space: None,
+            parameters: vec![ParameterRow {
+                group: "M".into(),
+                symbol: "M[surge,surge], \"rigid\"".into(),
+                grid_speed_mps: Some(0.5),
+                value: 2700.0,
+                std: Some(30.0),
+                unit: "kg".into(),
+            }],
+            structure_findings: vec![],
+            notes: vec![],
+        }
+    }
+
+    #[test]
+    fn csv_quotes_fields_and_leaves_missing_std_empty() {
+        let csv = parameter_csv(&doc());
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "group,symbol,grid_speed_mps,value,std,unit");
+        assert_eq!(
+            lines[1],
+            "M,\"M[surge,surge], \"\"rigid\"\"\",0.5,2700,30,kg"
+        );
+    }
+
+    #[test]
+    fn fossen_set_carries_m_and_d_per_speed_and_refuses_black_boxes() {
+        let set = fossen_parameter_set(&doc()).unwrap();
+        assert_eq!(set.points[0].m, vec![vec![2700.0]]);
+        assert_eq!(set.points[0].d, vec![vec![800.0]]);
+        let json = serde_json::to_value(&set).unwrap();
+        assert_eq!(json["points"][0]["U"], 0.5);
+        let mut ss = doc();
+        ss.kind = ModelKind::StateSpace;
+        assert!(fossen_parameter_set(&ss).unwrap_err().contains("black box"));
+    }
+}

@@ -1,0 +1,29 @@
+//! Campaign identification: from stored runs (records plus what the plan says
+//! they were) to a validated model document. Pure orchestration over the
+//! estimators of [`crate::estimation`] and [`crate::validation`].
+//!
+//! - [`dataset`]: runs → segments (one per valid block, never concatenated).
+//! - [`roles`]: static, estimation and held-out validation runs.
+//! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method.
+//! - [`document`]: the stored/served model: matrices, parameters with std.
+//! - [`discrete`]: ZOH matrices at a chosen h.
+//! - [`export`]: parameter CSV and the Fossen-form parameter set.
+//! - [`outcome`], [`error`]: what an identification returns.
+
+pub mod dataset;
+pub mod discrete;
+pub mod document;
+pub mod error;
+pub mod export;
+pub mod lambda_campaign;
+pub mod outcome;
+pub mod roles;
+
+pub use dataset::{DatasetError, RunInput, Segment, segments};
+pub use document::{Method, ModelDocument, ModelKind, ParameterRow};
+pub use error::IdentifyError;
+pub use lambda_campaign::{LambdaCampaignSettings, identify_lambda_campaign};
+pub use outcome::{Identified, RunValidation};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,131 @@
+//! Which run does what: static runs give the restoring forces, validation
+//! runs are held out, the rest estimate the dynamics at their grid point.
+
+use super::dataset::RunInput;
+use super::error::IdentifyError;
+use crate::planning::campaign::ExperimentFamily;
+
+/// The runs of an identification, by role.
+#[derive(Debug, Default)]
+pub struct Roles<'a> {
+    /// Static runs (restoring forces and tether moment).
+    pub statics: Vec<&'a RunInput>,
+    /// Runs the dynamics are estimated from.
+    pub estimation: Vec<&'a RunInput>,
+    /// Runs held out for validation.
+    pub validation: Vec<&'a RunInput>,
+}
+
+/// Splits `runs`: the ids in `validation_run_ids` (or, when none are given,
+/// the runs of the plan's validation family) are held out; static runs go to
+/// restoring; everything else is estimation data. A validation run is
+/// required — a model is only stored with a test on data it was not fitted
+/// to.
+pub fn assign_roles<'a>(
+    runs: &'a [RunInput],
+    validation_run_ids: Option<&[String]>,
+) -> Result<Roles<'a>, IdentifyError> {
+    if let Some(ids) = validation_run_ids {
+        for id in ids {
+            if !runs.iter().any(|r| &r.run_id == id) {
+                return Err(IdentifyError::invalid(
+                    "settings.validation_run_ids",
+                    format!("run '{id}' is not among the job's runs"),
+                ));
+            }
+        }
+    }
+    let mut roles = Roles::default();
+    for r in runs {
+        let held_out = match validation_run_ids {
+            Some(ids) => ids.contains(&r.run_id),
+            None => r.family == Some(ExperimentFamily::Validation),
+        };
+        if held_out {
+            roles.validation.push(r);
+        } else if r.family == Some(ExperimentFamily::Static) {
+            roles.statics.push(r);
+        } else {
+            roles.estimation.push(r);
+        }
+    }
+    if roles.validation.is_empty() {
+        return Err(IdentifyError::invalid(
+            "settings.validation_run_ids",
+            "no validation run: fly the plan's validation experiment, or name held-out runs in settings.validation_run_ids",
+        ));
+    }
+    if roles.estimation.is_empty() {
+        return Err(IdentifyError::invalid(
+            "run_ids",
+            "no estimation run left once validation and static runs are set aside",
+        ));
+    }
+    Ok(roles)
+}
+
+/// Index of the grid speed nearest `speed`.
+pub fn nearest_grid_index(grid: &[f64], speed: f64) -> usize {
+    grid.iter()
+        .enumerate()
+        .min_by(|a, b| (a.1 - speed).abs().total_cmp(&(b.1 - speed).abs()))
+        .map_or(0, |(i, _)| i)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::timeseries::UniformRecord;
+
+    fn run(id: &str, family: Option<ExperimentFamily>) -> RunInput {
+        RunInput {
+            run_id: id.into(),
+            name: id.into(),
+            family,
+            grid_speed_mps: None,
+            record: UniformRecord {
+                sample_rate_hz: 10.0,
+                t0: 0.0,
+                names: vec![],
+                data: vec![],
+                valid: vec![],
+            },
+        }
+    }
+
+    #[test]
+    fn roles_follow_the_plan_or_the_settings() {
+        use ExperimentFamily::*;
+        let runs = vec![
+            run("s", Some(Static)),
+            run("d", Some(Dynamic)),
+            run("v", Some(Validation)),
+            run("x", None),
+        ];
+        let r = assign_roles(&runs, None).unwrap();
+        assert_eq!(r.statics.len(), 1);
+        assert_eq!(r.validation[0].run_id, "v");
+        assert_eq!(
+            r.estimation
+                .iter()
+                .map(|r| r.run_id.as_str())
+                .collect::<Vec<_>>(),
+            ["d", "x"]
+        );
+        let r = assign_roles(&runs, Some(&["x".to_string()])).unwrap();
+        assert_eq!(r.validation[0].run_id, "x");
+        assert_eq!(r.estimation.len(), 2);
+        let e = assign_roles(&runs, Some(&["nope".to_string()])).unwrap_err();
+        assert_eq!(e.field(), "settings.validation_run_ids");
+        let e = assign_roles(&runs[..2], None).unwrap_err();
+        assert!(e.to_string().contains("no validation run"));
+    }
+
+    #[test]
+    fn nearest_grid_point() {
+        let g = [0.25, 0.5, 1.0];
+        assert_eq!(nearest_grid_index(&g, 0.0), 0);
+        assert_eq!(nearest_grid_index(&g, 0.8), 2);
+        assert_eq!(nearest_grid_index(&g, 0.6), 1);
+    }
+}

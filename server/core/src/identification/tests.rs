@@ -1,0 +1,224 @@
+//! End-to-end proof of the campaign pipeline on a simulated ROV whose truth
+//! is known: runs → roles → λ identification per grid point → validation.
+
+use nalgebra::DMatrix;
+
+use super::dataset::RunInput;
+use super::lambda_campaign::{LambdaCampaignSettings, StructureChoice, identify_lambda_campaign};
+use crate::estimation::NoProgress;
+use crate::planning::campaign::ExperimentFamily;
+use crate::planning::examples::surveyor_rov;
+use crate::rng::SplitMix64;
+use crate::simulation::rov::{RovRecord, RovTruth, SimConfig};
+use crate::timeseries::UniformRecord;
+
+const H: f64 = 0.1;
+
+/// τ: the trim force that holds `speed` in surge, plus a random-binary
+/// excitation in every DOF (clock 2 s) of `amp` times the DOF's force limit.
+fn excitation(truth: &RovTruth, speed: &[f64], amp: f64, seed: u64) -> DMatrix<f64> {
+    let profile = surveyor_rov();
+    let mut rng = SplitMix64::new(seed);
+    let n = speed.len();
+    let mut tau = DMatrix::zeros(n, 6);
+    let clock = (2.0 / H) as usize;
+    let mut level = [0.0; 6];
+    for k in 0..n {
+        if k % clock == 0 {
+            for l in &mut level {
+                *l = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+            }
+        }
+        let d = truth.damping.at(speed[k]);
+        for (i, dof) in profile.dofs.iter().enumerate() {
+            let f = profile.limit(*dof).max_force;
+            tau[(k, i)] = amp * f * level[i];
+        }
+        tau[(k, 0)] += d[(0, 0)] * speed[k];
+    }
+    tau
+}
+
+fn to_run(id: &str, family: ExperimentFamily, grid: Option<f64>, rec: &RovRecord) -> RunInput {
+    let mut names = vec!["t".to_string()];
+    let mut data = vec![rec.t.clone()];
+    for (j, c) in ["tau_X", "tau_Y", "tau_Z", "tau_K", "tau_M", "tau_N"]
+        .iter()
+        .enumerate()
+    {
+        names.push(c.to_string());
+        data.push(rec.tau_commanded.column(j).iter().copied().collect());
+    }
+    for (j, c) in ["u", "v", "w", "p", "q", "r"].iter().enumerate() {
+        names.push(c.to_string());
+        data.push(rec.nu.column(j).iter().copied().collect());
+    }
+    for (j, c) in ["x", "y", "z", "phi", "theta", "psi"].iter().enumerate() {
+        names.push(c.to_string());
+        data.push(rec.eta.column(j).iter().copied().collect());
+    }
+    let n = rec.t.len();
+    RunInput {
+        run_id: id.into(),
+        name: id.into(),
+        family: Some(family),
+        grid_speed_mps: grid,
+        record: UniformRecord {
+            sample_rate_hz: 1.0 / H,
+            t0: 0.0,
+            names,
+            data,
+            valid: std::iter::once(0..n).collect(),
+        },
+    }
+}
+
+fn simulate(truth: &RovTruth, speed: Vec<f64>, seed: u64) -> RovRecord {
+    let tau = excitation(truth, &speed, 0.25, seed);
+    let cfg = SimConfig {
+        h: H,
+        nu0: [speed[0], 0.0, 0.0, 0.0, 0.0, 0.0],
+        noise_nu: [0.005, 0.005, 0.005, 0.002, 0.002, 0.002],
+        noise_seed: seed ^ 0xA5,
+        ..SimConfig::default()
+    };
+    truth.simulate(&tau, &cfg).expect("simulation")
+}
+
+fn campaign() -> (RovTruth, Vec<f64>, Vec<RunInput>) {
+    // Linear truth (no quadratic damping, no Coriolis, neutral restoring):
+    // what the λ method's model M ν̇ + D̄ ν = γ can represent exactly at each
+    // grid point.
+    let mut truth = RovTruth::surveyor_like();
+    truth.restoring = Default::default();
+    let grid = vec![0.5, 1.0];
+    let mut runs = Vec::new();
+    for (g, &u0) in grid.iter().enumerate() {
+        for r in 0..2 {
+            let rec = simulate(&truth, vec![u0; 3000], 100 + 10 * g as u64 + r);
+            runs.push(to_run(
+                &format!("dyn-{g}-{r}"),
+                ExperimentFamily::Recursive,
+                Some(u0),
+                &rec,
+            ));
+        }
+    }
+    // Validation: 300 s at each grid speed in turn, never fitted.
+    let speed: Vec<f64> = (0..4000)
+        .map(|k| if k < 2000 { 0.5 } else { 1.0 })
+        .collect();
+    let rec = simulate(&truth, speed, 999);
+    runs.push(to_run("val", ExperimentFamily::Validation, None, &rec));
+    (truth, grid, runs)
+}
+
+#[test]
+fn lpv_campaign_recovers_the_coupled_truth_and_validates_on_held_out_data() {
+    let (truth, grid, runs) = campaign();
+    let profile = surveyor_rov();
+    let inputs: Vec<String> = profile
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
+    let settings = LambdaCampaignSettings::default();
+    let out = identify_lambda_campaign(&profile, &grid, &inputs, &runs, &settings, &mut NoProgress)
+        .unwrap();
+    assert_eq!(out.validation_run_ids, ["val"]);
+    assert_eq!(out.estimation_run_ids.len(), 4);
+    let lpv = out.document.lpv.as_ref().unwrap();
+    assert_eq!(lpv.points.len(), 2);
+    // M is speed-independent in the truth: every grid point recovers it.
+    for p in &lpv.points {
+        for i in 0..6 {
+            let (est, true_m) = (p.m[i][i], truth.m[(i, i)]);
+            assert!(
+                (est - true_m).abs() < 0.1 * true_m,
+                "M[{i},{i}] at {} m/s: {est} vs {true_m}",
+                p.speed_mps
+            );
+        }
+    }
+    // Held-out validation: every channel fits well in simulation.
+    let rep = &out.validation[0].report;
+    for ch in &rep.channels {
+        let fit = ch.fit_simulation.expect("simulation fit");
+        assert!(fit > 0.8, "{}: simulation fit {fit}", ch.output);
+        assert!(ch.fit_one_step.unwrap() > 0.8, "{}: 1-step", ch.output);
+    }
+    assert!(!out.document.parameters.is_empty());
+    assert!(out.document.parameters.iter().all(|p| p.std.is_some()));
+}
+
+#[test]
+fn diagonal_structure_is_worse_on_the_coupled_truth() {
+    let (_, grid, runs) = campaign();
+    let profile = surveyor_rov();
+    let inputs: Vec<String> = profile
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
+    let fit = |structure| {
+        let s = LambdaCampaignSettings {
+            structure,
+            ..Default::default()
+        };
+        let out =
+            identify_lambda_campaign(&profile, &grid, &inputs, &runs, &s, &mut NoProgress).unwrap();
+        out.validation[0]
+            .report
+            .channels
+            .iter()
+            .map(|c| c.fit_simulation.unwrap())
+            .collect::<Vec<_>>()
+    };
+    let coupled = fit(StructureChoice::Auto);
+    let diagonal = fit(StructureChoice::Diagonal);
+    // Sway–yaw and heave–pitch are coupled in the truth.
+    let worst_gap = coupled
+        .iter()
+        .zip(&diagonal)
+        .map(|(c, d)| c - d)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        worst_gap > 0.02,
+        "coupled {coupled:?} vs diagonal {diagonal:?}"
+    );
+}
+
+#[test]
+fn missing_validation_and_bad_settings_name_the_field() {
+    let (_, grid, runs) = campaign();
+    let profile = surveyor_rov();
+    let inputs: Vec<String> = profile
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
+    let e = identify_lambda_campaign(
+        &profile,
+        &grid,
+        &inputs,
+        &runs[..4],
+        &LambdaCampaignSettings::default(),
+        &mut NoProgress,
+    )
+    .unwrap_err();
+    assert_eq!(e.field(), "settings.validation_run_ids");
+    let s = LambdaCampaignSettings {
+        t_lambda_s: Some(0.01),
+        ..Default::default()
+    };
+    let e =
+        identify_lambda_campaign(&profile, &grid, &inputs, &runs, &s, &mut NoProgress).unwrap_err();
+    assert_eq!(e.field(), "settings.t_lambda_s");
+    let s = LambdaCampaignSettings {
+        structure: StructureChoice::Custom,
+        ..Default::default()
+    };
+    let e =
+        identify_lambda_campaign(&profile, &grid, &inputs, &runs, &s, &mut NoProgress).unwrap_err();
+    assert_eq!(e.field(), "settings.coupling");
+}

@@ -1,0 +1,181 @@
+//! Coriolis–centripetal matrix C(ν) computed from the inertia matrix M
+//! (rigid body plus added mass), Fossen (2011) eq. 3.46 / 6.43:
+//!
+//! with M = [[M₁₁ M₁₂],[M₂₁ M₂₂]], ν₁ = [u v w]ᵀ, ν₂ = [p q r]ᵀ,
+//!
+//! C(ν) = [[0₃ₓ₃, −S(M₁₁ν₁ + M₁₂ν₂)], [−S(M₁₁ν₁ + M₁₂ν₂), −S(M₂₁ν₁ + M₂₂ν₂)]]
+//!
+//! where S(a)b = a × b. For symmetric M this C(ν) is skew-symmetric, so
+//! νᵀC(ν)ν = 0: Coriolis forces do no work and kinetic energy ½νᵀMν is
+//! conserved without damping and forces. It adds no parameters to estimate
+//! (Fossen et al. 1995, eq. 11).
+
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
+
+use super::error::{ModelError, check_finite};
+
+/// Skew-symmetric cross-product matrix S(a): S(a)b = a × b.
+pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
+}
+
+/// 6-DOF C(ν) from M (6×6) at ν = [u v w p q r]ᵀ (Fossen 2011, eq. 6.43).
+pub fn coriolis_6dof(m: &Matrix6<f64>, nu: &Vector6<f64>) -> Matrix6<f64> {
+    let nu1 = nu.fixed_rows::<3>(0).into_owned();
+    let nu2 = nu.fixed_rows::<3>(3).into_owned();
+    let m11 = m.fixed_view::<3, 3>(0, 0);
+    let m12 = m.fixed_view::<3, 3>(0, 3);
+    let m21 = m.fixed_view::<3, 3>(3, 0);
+    let m22 = m.fixed_view::<3, 3>(3, 3);
+    let s1 = -skew(&(m11 * nu1 + m12 * nu2));
+    let s2 = -skew(&(m21 * nu1 + m22 * nu2));
+    let mut c = Matrix6::zeros();
+    c.fixed_view_mut::<3, 3>(0, 3).copy_from(&s1);
+    c.fixed_view_mut::<3, 3>(3, 0).copy_from(&s1);
+    c.fixed_view_mut::<3, 3>(3, 3).copy_from(&s2);
+    c
+}
+
+/// 3-DOF horizontal C(ν) from M (3×3, order surge, sway, yaw) at
+/// ν = [u v r]ᵀ: the 6-DOF form restricted to w = p = q = 0,
+///
+/// C(ν) = [[0, 0, −(m₂₁u + m₂₂v + m₂₃r)], [0, 0, m₁₁u + m₁₂v + m₁₃r],
+///         [m₂₁u + m₂₂v + m₂₃r, −(m₁₁u + m₁₂v + m₁₃r), 0]],
+///
+/// which for port–starboard symmetry (m₁₂ = m₁₃ = 0) is Fossen et al. (1995)
+/// eq. 11.
+pub fn coriolis_3dof(m: &Matrix3<f64>, nu: &Vector3<f64>) -> Matrix3<f64> {
+    let a1 = m[(0, 0)] * nu.x + m[(0, 1)] * nu.y + m[(0, 2)] * nu.z;
+    let a2 = m[(1, 0)] * nu.x + m[(1, 1)] * nu.y + m[(1, 2)] * nu.z;
+    Matrix3::new(0.0, 0.0, -a2, 0.0, 0.0, a1, a2, -a1, 0.0)
+}
+
+/// C(ν) for a 6-DOF (6×6 M, ν = [u v w p q r]) or a 3-DOF horizontal
+/// (3×3 M, ν = [u v r]) model; other sizes are an error naming `M`.
+pub fn coriolis(m: &DMatrix<f64>, nu: &DVector<f64>) -> Result<DMatrix<f64>, ModelError> {
+    let n = m.nrows();
+    if !(n == 6 || n == 3) || m.ncols() != n {
+        return Err(ModelError::Shape {
+            name: "M".into(),
+            expected: "6×6 (6 DOF) or 3×3 (surge, sway, yaw)".into(),
+            found: m.shape(),
+        });
+    }
+    if nu.len() != n {
+        return Err(ModelError::Shape {
+            name: "ν".into(),
+            expected: format!("{n}×1 (one velocity per DOF of M)"),
+            found: (nu.len(), 1),
+        });
+    }
+    check_finite("M", m.iter())?;
+    check_finite("ν", nu.iter())?;
+    Ok(if n == 6 {
+        let c = coriolis_6dof(
+            &Matrix6::from_iterator(m.iter().copied()),
+            &Vector6::from_iterator(nu.iter().copied()),
+        );
+        DMatrix::from_iterator(6, 6, c.iter().copied())
+    } else {
+        let c = coriolis_3dof(
+            &Matrix3::from_iterator(m.iter().copied()),
+            &Vector3::from_iterator(nu.iter().copied()),
+        );
+        DMatrix::from_iterator(3, 3, c.iter().copied())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A coupled symmetric positive-definite M (ROV-like magnitudes).
+    fn coupled_m() -> Matrix6<f64> {
+        let mut m = Matrix6::from_diagonal(&Vector6::new(
+            7500.0, 9000.0, 10000.0, 2500.0, 6000.0, 6500.0,
+        ));
+        for (i, j, v) in [
+            (0, 2, -400.0),
+            (0, 4, 900.0),
+            (1, 3, -700.0),
+            (1, 5, 350.0),
+            (2, 4, 500.0),
+        ] {
+            m[(i, j)] = v;
+            m[(j, i)] = v;
+        }
+        m
+    }
+
+    #[test]
+    fn six_dof_c_is_skew_and_does_no_work() {
+        let m = coupled_m();
+        assert!(m.cholesky().is_some());
+        let nus = [
+            Vector6::new(1.2, -0.3, 0.2, 0.05, -0.1, 0.2),
+            Vector6::new(-0.4, 0.8, -0.6, 0.3, 0.2, -0.25),
+        ];
+        for nu in nus {
+            let c = coriolis_6dof(&m, &nu);
+            let scale = c.amax();
+            assert!(scale > 100.0, "C(ν) is not trivially zero");
+            assert!((c + c.transpose()).amax() < 1e-12 * scale);
+            let work = nu.dot(&(c * nu));
+            assert!(work.abs() < 1e-12 * scale, "νᵀCν = {work}");
+        }
+        // Direct check of one entry: C[0][4] = −S(a)[0][1] = a_z where
+        // a = M₁₁ν₁ + M₁₂ν₂.
+        let nu = nus[0];
+        let a = m.fixed_view::<3, 3>(0, 0) * nu.fixed_rows::<3>(0)
+            + m.fixed_view::<3, 3>(0, 3) * nu.fixed_rows::<3>(3);
+        let c = coriolis_6dof(&m, &nu);
+        assert!((c[(0, 4)] - a.z).abs() < 1e-12);
+        assert!((c[(1, 3)] + a.z).abs() < 1e-12);
+    }
+
+    #[test]
+    fn three_dof_hand_computed_case() {
+        // M = [[100, 0, 0], [0, 200, 30], [0, 30, 400]], ν = [2, 1, 0.5]:
+        // a₁ = 100·2 = 200, a₂ = 200·1 + 30·0.5 = 215.
+        let m = Matrix3::new(100.0, 0.0, 0.0, 0.0, 200.0, 30.0, 0.0, 30.0, 400.0);
+        let nu = Vector3::new(2.0, 1.0, 0.5);
+        let c = coriolis_3dof(&m, &nu);
+        let want = Matrix3::new(0.0, 0.0, -215.0, 0.0, 0.0, 200.0, 215.0, -200.0, 0.0);
+        assert_eq!(c, want);
+        // C(ν)ν = [−215·0.5, 200·0.5, 215·2 − 200·1] = [−107.5, 100, 230].
+        assert_eq!(c * nu, Vector3::new(-107.5, 100.0, 230.0));
+        assert_eq!(nu.dot(&(c * nu)), 0.0);
+        // The same numbers from the 6-DOF form restricted to (u, v, r).
+        let mut m6 = Matrix6::identity();
+        for (i, a) in [0usize, 1, 5].iter().enumerate() {
+            for (j, b) in [0usize, 1, 5].iter().enumerate() {
+                m6[(*a, *b)] = m[(i, j)];
+            }
+        }
+        let c6 = coriolis_6dof(&m6, &Vector6::new(2.0, 1.0, 0.0, 0.0, 0.0, 0.5));
+        for (i, a) in [0usize, 1, 5].iter().enumerate() {
+            for (j, b) in [0usize, 1, 5].iter().enumerate() {
+                assert_eq!(c6[(*a, *b)], c[(i, j)], "({a},{b})");
+            }
+        }
+    }
+
+    #[test]
+    fn dynamic_front_end_checks_shapes() {
+        let m = DMatrix::from_iterator(6, 6, coupled_m().iter().copied());
+        let nu = DVector::from_vec(vec![1.0, 0.0, 0.0, 0.0, 0.0, 0.3]);
+        let c = coriolis(&m, &nu).unwrap();
+        // Surge–yaw: C[1][5] = (M₁₁ν₁ + M₁₂ν₂)_x = 7500·1 = 7500 (m₁₆ = 0).
+        assert!((c[(1, 5)] - 7500.0).abs() < 1e-9);
+        let err = coriolis(&DMatrix::zeros(4, 4), &DVector::zeros(4)).unwrap_err();
+        assert!(err.to_string().starts_with("M is 4×4"), "{err}");
+        let err = coriolis(&m, &DVector::zeros(3)).unwrap_err();
+        assert!(err.to_string().starts_with("ν is 3×1"), "{err}");
+        let mut bad = nu.clone();
+        bad[2] = f64::NAN;
+        assert!(matches!(
+            coriolis(&m, &bad),
+            Err(ModelError::NonFinite { .. })
+        ));
+    }
+}

@@ -1,0 +1,167 @@
+//! Identified models: list, one model (document, validation, ZOH matrices at
+//! a chosen h), exports (JSON, parameter CSV, Fossen-form set).
+
+use axum::Json;
+use axum::extract::{Path, State};
+use axum::http::header;
+use axum::response::{IntoResponse, Response};
+use seatrial_core::identification::discrete::{DiscreteModel, discretize};
+use seatrial_core::identification::document::ModelDocument;
+use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv};
+use serde::{Deserialize, Serialize};
+
+use super::query::ApiQuery;
+use super::{AppState, found};
+use crate::error::{ApiError, ApiResult, ErrorBody};
+use crate::storage::models::{self, ModelSummary, StoredModel};
+
+/// Filters of the model list.
+#[derive(Debug, Deserialize, utoipa::IntoParams)]
+pub struct ModelFilter {
+    /// Only models of this campaign.
+    pub campaign_id: Option<String>,
+    /// Only the versions of this lineage.
+    pub lineage_id: Option<String>,
+}
+
+/// Models, newest first (metadata only).
+#[utoipa::path(get, path = "/api/models", tag = "models", params(ModelFilter),
+    responses((status = 200, description = "Models, newest first", body = [ModelSummary])))]
+pub async fn list_models(
+    State(s): State<AppState>,
+    ApiQuery(f): ApiQuery<ModelFilter>,
+) -> ApiResult<Json<Vec<ModelSummary>>> {
+    Ok(Json(
+        models::list(&s.db, f.campaign_id.as_deref(), f.lineage_id.as_deref()).await?,
+    ))
+}
+
+/// A model with provenance, its document and its validation reports.
+#[derive(Debug, Serialize, utoipa::ToSchema)]
+pub struct ModelView {
+    /// Metadata and version.
+    pub model: ModelSummary,
+    /// Method settings as used.
+    pub settings: serde_json::Value,
+    /// Estimation runs.
+    pub run_ids: Vec<String>,
+    /// Runs held out for validation.
+    pub validation_run_ids: Vec<String>,
+    /// The model: matrices, parameters with standard deviations.
+    pub document: ModelDocument,
+    /// Validation reports per held-out run.
+    #[schema(value_type = Object)]
+    pub validation: serde_json::Value,
+    /// ZOH-discretized Φ, Γ at the requested `h` (only with `?h=`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub discrete: Option<DiscreteModel>,
+}
+
+/// Options of one model.
+#[derive(Debug, Deserialize, utoipa::IntoParams)]
+pub struct ModelQuery {
+    /// Sample time h (s) at which to add the ZOH-discretized Φ, Γ.
+    pub h: Option<f64>,
+}
+
+fn view(m: StoredModel) -> ApiResult<ModelView> {
+    let document: ModelDocument = serde_json::from_value(m.document)
+        .map_err(|e| ApiError::Internal(anyhow::anyhow!("stored model document unreadable: {e}")))?;
+    Ok(ModelView {
+        model: m.summary,
+        settings: m.settings,
+        run_ids: m.run_ids,
+        validation_run_ids: m.validation_run_ids,
+        document,
+        validation: m.validation,
+        discrete: None,
+    })
+}
+
+/// One model: provenance, matrices and parameters with standard deviations,
+/// validation reports; with `?h=` also the ZOH-discretized Φ, Γ at that h.
+#[utoipa::path(get, path = "/api/models/{id}", tag = "models",
+    params(("id" = String, Path, description = "Model id"), ModelQuery),
+    responses((status = 200, description = "The model", body = ModelView),
+              (status = 404, description = "No such model", body = ErrorBody),
+              (status = 422, description = "`h` unusable (not positive; a subspace model's own h differs)", body = ErrorBody)))]
+pub async fn get_model(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+    ApiQuery(q): ApiQuery<ModelQuery>,
+) -> ApiResult<Json<ModelView>> {
+    let m = found(models::get(&s.db, &id).await?, "model", &id)?;
+    let mut v = view(m)?;
+    if let Some(h) = q.h {
+        v.discrete = Some(discretize(&v.document, h).map_err(|msg| ApiError::invalid("h", msg))?);
+    }
+    Ok(Json(v))
+}
+
+/// Export format.
+#[derive(Debug, Deserialize, utoipa::IntoParams)]
+pub struct ExportQuery {
+    /// `json` (default: the whole model with provenance), `csv` (parameter
+    /// table with standard deviations) or `fossen` (M, D, g(η), T, K in Fossen
+    /// form for MSS / PythonVehicleSimulator).
+    pub format: Option<String>,
+}
+
+fn attachment(body: String, content_type: &str, filename: String) -> Response {
+    (
+        [
+            (header::CONTENT_TYPE, content_type.to_string()),
+            (
+                header::CONTENT_DISPOSITION,
+                format!("attachment; filename=\"{filename}\""),
+            ),
+        ],
+        body,
+    )
+        .into_response()
+}
+
+/// Download a model.
+#[utoipa::path(get, path = "/api/models/{id}/export", tag = "models",
+    params(("id" = String, Path, description = "Model id"), ExportQuery),
+    responses(
+        (status = 200, description = "The export: JSON (`json`, `fossen`) or CSV (`csv`)", content(
+            (ModelView = "application/json"),
+            (String = "text/csv"))),
+        (status = 400, description = "Unknown format", body = ErrorBody),
+        (status = 404, description = "No such model", body = ErrorBody),
+        (status = 422, description = "No Fossen form for a black-box model", body = ErrorBody)))]
+pub async fn export_model(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+    ApiQuery(q): ApiQuery<ExportQuery>,
+) -> ApiResult<Response> {
+    let m = found(models::get(&s.db, &id).await?, "model", &id)?;
+    let stem = format!("{}-v{}", m.summary.name.replace([' ', '/', '"'], "_"), m.summary.version);
+    let v = view(m)?;
+    match q.format.as_deref().unwrap_or("json") {
+        "json" => Ok(attachment(
+            serde_json::to_string_pretty(&v).map_err(anyhow::Error::from)?,
+            "application/json",
+            format!("{stem}.json"),
+        )),
+        "csv" => Ok(attachment(
+            parameter_csv(&v.document),
+            "text/csv",
+            format!("{stem}.csv"),
+        )),
+        "fossen" => {
+            let set = fossen_parameter_set(&v.document)
+                .map_err(|msg| ApiError::invalid("format", msg))?;
+            Ok(attachment(
+                serde_json::to_string_pretty(&set).map_err(anyhow::Error::from)?,
+                "application/json",
+                format!("{stem}-fossen.json"),
+            ))
+        }
+        other => Err(ApiError::bad_field(
+            "format",
+            format!("unknown export format '{other}'; use json, csv or fossen"),
+        )),
+    }
+}

@@ -1,0 +1,227 @@
+//! Identified models: versioned rows with provenance. The model itself (the
+//! core's document: matrices, parameters, uncertainties) and its validation
+//! reports are JSON columns; the metadata columns are what lists and
+//! lineages query.
+
+use serde::Serialize;
+use sqlx::{Sqlite, Transaction};
+
+use super::{Db, new_id, now};
+
+/// A stored model without its (large) document and validation.
+#[derive(Debug, Clone, Serialize, sqlx::FromRow, utoipa::ToSchema)]
+pub struct ModelSummary {
+    /// Id (UUIDv7).
+    pub id: String,
+    /// The lineage (the id of version 1) this version belongs to.
+    pub lineage_id: String,
+    /// Version within the lineage, from 1.
+    pub version: i64,
+    /// The version it was derived from (augmentation, re-identification).
+    pub parent_id: Option<String>,
+    /// Campaign whose runs it was identified from.
+    pub campaign_id: String,
+    /// Vessel.
+    pub vessel_id: String,
+    /// `lpv`, `dp_ship` or `state_space`.
+    pub kind: String,
+    /// `lambda_kf`, `parallel_ekf`, `n4sid` or `discovery`.
+    pub method: String,
+    /// Display name.
+    pub name: String,
+    /// Software version that identified it.
+    pub software_version: String,
+    /// The job that produced it.
+    pub job_id: Option<String>,
+    /// Creation time (RFC 3339).
+    pub created_at: String,
+}
+
+/// A stored model with provenance, document and validation (JSON).
+#[derive(Debug, Clone)]
+pub struct StoredModel {
+    /// Metadata.
+    pub summary: ModelSummary,
+    /// Method settings as used.
+    pub settings: serde_json::Value,
+    /// Estimation runs.
+    pub run_ids: Vec<String>,
+    /// Runs held out for validation.
+    pub validation_run_ids: Vec<String>,
+    /// The model (core document).
+    pub document: serde_json::Value,
+    /// Validation reports per held-out run.
+    pub validation: serde_json::Value,
+}
+
+/// Where a new model goes in the version history.
+#[derive(Debug, Clone)]
+pub enum Lineage {
+    /// Version 1 of a new lineage.
+    New,
+    /// The next version of the lineage of this model (which becomes the parent).
+    After(String),
+}
+
+/// A model to store.
+#[derive(Debug, Clone)]
+pub struct NewModel {
+    /// Position in the version history.
+    pub lineage: Lineage,
+    /// Campaign.
+    pub campaign_id: String,
+    /// Vessel.
+    pub vessel_id: String,
+    /// `lpv`, `dp_ship`, `state_space`.
+    pub kind: String,
+    /// Method name.
+    pub method: String,
+    /// Display name.
+    pub name: String,
+    /// Settings as used.
+    pub settings: serde_json::Value,
+    /// Estimation runs.
+    pub run_ids: Vec<String>,
+    /// Validation runs.
+    pub validation_run_ids: Vec<String>,
+    /// The producing job.
+    pub job_id: Option<String>,
+    /// The model.
+    pub document: serde_json::Value,
+    /// Validation reports.
+    pub validation: serde_json::Value,
+}
+
+const SUMMARY: &str = "id, lineage_id, version, parent_id, campaign_id, vessel_id, kind, method, \
+                       name, software_version, job_id, created_at";
+
+/// Stores a model inside the caller's transaction (so a job's success and its
+/// model commit together); versions are assigned here.
+pub async fn insert(tx: &mut Transaction<'_, Sqlite>, m: NewModel) -> anyhow::Result<ModelSummary> {
+    let id = new_id();
+    let (lineage_id, version, parent_id) = match &m.lineage {
+        Lineage::New => (id.clone(), 1_i64, None),
+        Lineage::After(parent) => {
+            let lineage: Option<(String,)> =
+                sqlx::query_as("SELECT lineage_id FROM model WHERE id = $1")
+                    .bind(parent)
+                    .fetch_optional(&mut **tx)
+                    .await?;
+            let Some((lineage_id,)) = lineage else {
+                anyhow::bail!("no model with id '{parent}' to version after");
+            };
+            let (max,): (i64,) =
+                sqlx::query_as("SELECT COALESCE(MAX(version), 0) FROM model WHERE lineage_id = $1")
+                    .bind(&lineage_id)
+                    .fetch_one(&mut **tx)
+                    .await?;
+            (lineage_id, max + 1, Some(parent.clone()))
+        }
+    };
+    sqlx::query(
+        "INSERT INTO model (id, lineage_id, version, parent_id, campaign_id, vessel_id, kind, \
+         method, name, settings, run_ids, validation_run_ids, software_version, job_id, \
+         document, validation, created_at) \
+         VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, $17)",
+    )
+    .bind(&id)
+    .bind(&lineage_id)
+    .bind(version)
+    .bind(&parent_id)
+    .bind(&m.campaign_id)
+    .bind(&m.vessel_id)
+    .bind(&m.kind)
+    .bind(&m.method)
+    .bind(&m.name)
+    .bind(m.settings.to_string())
+    .bind(serde_json::to_string(&m.run_ids)?)
+    .bind(serde_json::to_string(&m.validation_run_ids)?)
+    .bind(env!("CARGO_PKG_VERSION"))
+    .bind(&m.job_id)
+    .bind(m.document.to_string())
+    .bind(m.validation.to_string())
+    .bind(now())
+    .execute(&mut **tx)
+    .await?;
+    let summary = sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
+        "SELECT {SUMMARY} FROM model WHERE id = $1"
+    )))
+    .bind(&id)
+    .fetch_one(&mut **tx)
+    .await?;
+    Ok(summary)
+}
+
+/// The latest version of the lineage identified from `campaign_id` by
+/// `method`, if any (re-identification continues it).
+pub async fn latest_of_method(
+    db: &Db,
+    campaign_id: &str,
+    method: &str,
+) -> anyhow::Result<Option<ModelSummary>> {
+    Ok(
+        sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
+            "SELECT {SUMMARY} FROM model WHERE campaign_id = $1 AND method = $2 \
+         ORDER BY created_at DESC, version DESC LIMIT 1"
+        )))
+        .bind(campaign_id)
+        .bind(method)
+        .fetch_optional(db)
+        .await?,
+    )
+}
+
+/// Models, newest first, optionally of one campaign or lineage.
+pub async fn list(
+    db: &Db,
+    campaign_id: Option<&str>,
+    lineage_id: Option<&str>,
+) -> anyhow::Result<Vec<ModelSummary>> {
+    Ok(
+        sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
+            "SELECT {SUMMARY} FROM model \
+         WHERE ($1 IS NULL OR campaign_id = $1) AND ($2 IS NULL OR lineage_id = $2) \
+         ORDER BY created_at DESC, version DESC"
+        )))
+        .bind(campaign_id)
+        .bind(lineage_id)
+        .fetch_all(db)
+        .await?,
+    )
+}
+
+#[derive(sqlx::FromRow)]
+struct Heavy {
+    settings: String,
+    run_ids: String,
+    validation_run_ids: String,
+    document: String,
+    validation: String,
+}
+
+/// One model with everything.
+pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<StoredModel>> {
+    let Some(summary) = sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
+        "SELECT {SUMMARY} FROM model WHERE id = $1"
+    )))
+    .bind(id)
+    .fetch_optional(db)
+    .await?
+    else {
+        return Ok(None);
+    };
+    let h = sqlx::query_as::<_, Heavy>(
+        "SELECT settings, run_ids, validation_run_ids, document, validation FROM model WHERE id = $1",
+    )
+    .bind(id)
+    .fetch_one(db)
+    .await?;
+    Ok(Some(StoredModel {
+        summary,
+        settings: serde_json::from_str(&h.settings)?,
+        run_ids: serde_json::from_str(&h.run_ids)?,
+        validation_run_ids: serde_json::from_str(&h.validation_run_ids)?,
+        document: serde_json::from_str(&h.document)?,
+        validation: serde_json::from_str(&h.validation)?,
+    }))
+}
