@@ -42,11 +42,14 @@
 //! magnitudes (`proof_table_one_seed`; four more seeds behind `#[ignore]`).
 //!
 //! Not done yet:
-//! - move the proof onto `simulation::rov` and the real
-//!   `estimation::lambda` baseline once they land on main (then delete
-//!   `tests/truth.rs` and the LS baseline of `tests/scenario.rs`); use the
-//!   shared residual tests of `validation` instead of [`residual`] where
-//!   they coincide; accept `models::LinearVesselModel` as the baseline;
+//! - main (models, rov, lambda, validation residuals) is merged, but the
+//!   proof still runs on the inline truth: move it onto
+//!   `simulation::rov` (`RovTruth`, `SimConfig`) and a baseline from
+//!   `estimation::lambda::identify`, then delete `tests/truth.rs` and the
+//!   LS baseline of `tests/scenario.rs`; use `validation::residuals` /
+//!   `validation::correlation` instead of [`residual`] where they
+//!   coincide; accept `models::LinearVesselModel` as the baseline (a
+//!   `From` into [`Baseline`]);
 //! - a current that varies slowly (random walk) is fitted as constant;
 //!   cubic and cross damping terms (|ν_j|ν_i) are not in the library;
 //! - ambiguity is judged pairwise: a current at one heading looks like two
