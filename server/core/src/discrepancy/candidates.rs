@@ -1,0 +1,588 @@
+//! The library of physically meaningful candidate terms and their regressor
+//! signatures in M·ν̇ + C(ν)ν + D(ν)ν + g(η) = τ.
+//!
+//! A candidate either adds a force φ(ν, η)·θ to the left-hand side of a DOF's
+//! equation (damping, Coriolis, restoring, constant load, current, missing
+//! coupling), or changes the force that actually acts, τ_a = A(τ_c)
+//! (actuator lag, delay, saturation, dead zone — functions of the command τ,
+//! not of ν). Actuator candidates carry one shape parameter that enters
+//! non-linearly and is found by a profile search.
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use crate::planning::Dof;
+
+/// Odd restoring shapes of the general g(η) (thesis eq. 1.4). The even
+/// shape cos θ cos φ is left to [`Effect::ConstantLoad`]: at trial attitudes
+/// it differs from a constant by O(φ², θ²) and no run tells them apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum RestoringShape {
+    /// sin θ (surge W−B, pitch z_G W − z_B B, yaw y_G W − y_B B).
+    SinTheta,
+    /// cos θ sin φ (sway W−B, roll z_G W − z_B B, yaw x_G W − x_B B).
+    CosThetaSinPhi,
+}
+
+/// One candidate piece of missing physics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(tag = "effect", rename_all = "snake_case")]
+pub enum Effect {
+    /// Quadratic damping d·|ν_i|ν_i in DOF i.
+    QuadraticDamping {
+        /// The DOF.
+        dof: Dof,
+    },
+    /// Coriolis–centripetal C(ν)ν with the structure C(ν) takes from the
+    /// baseline M (Fossen), one scale factor θ (≈ 1 when M is right) over
+    /// all DOFs.
+    CoriolisFromM,
+    /// One Coriolis product ν_a·ν_b in DOF `dof`'s equation, free coefficient.
+    CoriolisProduct {
+        /// The equation it enters.
+        dof: Dof,
+        /// First velocity of the product.
+        a: Dof,
+        /// Second velocity of the product.
+        b: Dof,
+    },
+    /// A restoring shape of g(η) the baseline lacks or has wrong.
+    Restoring {
+        /// The equation it enters.
+        dof: Dof,
+        /// sin θ or cos θ sin φ.
+        shape: RestoringShape,
+    },
+    /// A constant force or moment: tether, buoyancy or CG-offset error.
+    ConstantLoad {
+        /// The DOF.
+        dof: Dof,
+    },
+    /// Ocean current: damping acts on ν − ν_c with ν_c = R(ψ)ᵀ[V_N V_E]ᵀ;
+    /// two coefficients (north and east current, m/s) shared by all DOFs.
+    Current,
+    /// Coupling a diagonal baseline misses: M_ij ν̇_j + D̄_ij ν_j in DOF i.
+    Coupling {
+        /// The equation i.
+        dof: Dof,
+        /// The velocity j.
+        from: Dof,
+    },
+    /// First-order lag τ_a = τ_c/(1 + s·T_a) between command and thrust.
+    ActuatorLag {
+        /// The DOF.
+        dof: Dof,
+    },
+    /// Pure delay τ_a(t) = τ_c(t − d·h) of d whole samples.
+    InputDelay {
+        /// The DOF.
+        dof: Dof,
+    },
+    /// Thrust saturation τ_a = clip(τ_c, ±τ_max).
+    Saturation {
+        /// The DOF.
+        dof: Dof,
+    },
+    /// Dead zone: no thrust for |τ_c| < δ, τ_c − sign(τ_c)·δ beyond.
+    DeadZone {
+        /// The DOF.
+        dof: Dof,
+    },
+}
+
+/// Effects grouped by physics, for ranking and look-alike pairs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Family {
+    /// |ν|ν damping.
+    QuadraticDamping,
+    /// C(ν)ν products.
+    Coriolis,
+    /// g(η) shapes.
+    Restoring,
+    /// Constant force/moment (tether).
+    ConstantLoad,
+    /// Ocean current.
+    Current,
+    /// Missing off-diagonal M, D̄.
+    Coupling,
+    /// Actuator lag.
+    ActuatorLag,
+    /// Input delay.
+    InputDelay,
+    /// Saturation.
+    Saturation,
+    /// Dead zone.
+    DeadZone,
+}
+
+impl Family {
+    /// Plain name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Family::QuadraticDamping => "quadratic damping",
+            Family::Coriolis => "Coriolis–centripetal coupling",
+            Family::Restoring => "restoring force",
+            Family::ConstantLoad => "constant load (tether)",
+            Family::Current => "ocean current",
+            Family::Coupling => "missing coupling",
+            Family::ActuatorLag => "actuator lag",
+            Family::InputDelay => "input delay",
+            Family::Saturation => "actuator saturation",
+            Family::DeadZone => "actuator dead zone",
+        }
+    }
+}
+
+/// The non-linear shape parameter of an actuator effect.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShapeKind {
+    /// T_a (s).
+    LagTime,
+    /// d (samples).
+    DelaySamples,
+    /// τ_max (N or N·m).
+    SaturationLevel,
+    /// δ (N or N·m).
+    DeadZoneWidth,
+}
+
+/// Coriolis products of each DOF's equation for a diagonal M:
+/// (C(ν)ν)_i = Σ ±(m_a − m_b)·ν_a·ν_b over these pairs.
+pub const CORIOLIS_PAIRS: [(Dof, [(Dof, Dof); 2]); 6] = [
+    (
+        Dof::Surge,
+        [(Dof::Heave, Dof::Pitch), (Dof::Sway, Dof::Yaw)],
+    ),
+    (Dof::Sway, [(Dof::Surge, Dof::Yaw), (Dof::Heave, Dof::Roll)]),
+    (
+        Dof::Heave,
+        [(Dof::Sway, Dof::Roll), (Dof::Surge, Dof::Pitch)],
+    ),
+    (Dof::Roll, [(Dof::Sway, Dof::Heave), (Dof::Pitch, Dof::Yaw)]),
+    (
+        Dof::Pitch,
+        [(Dof::Surge, Dof::Heave), (Dof::Roll, Dof::Yaw)],
+    ),
+    (Dof::Yaw, [(Dof::Surge, Dof::Sway), (Dof::Roll, Dof::Pitch)]),
+];
+
+impl Effect {
+    /// Its family.
+    pub fn family(&self) -> Family {
+        match self {
+            Effect::QuadraticDamping { .. } => Family::QuadraticDamping,
+            Effect::CoriolisFromM | Effect::CoriolisProduct { .. } => Family::Coriolis,
+            Effect::Restoring { .. } => Family::Restoring,
+            Effect::ConstantLoad { .. } => Family::ConstantLoad,
+            Effect::Current => Family::Current,
+            Effect::Coupling { .. } => Family::Coupling,
+            Effect::ActuatorLag { .. } => Family::ActuatorLag,
+            Effect::InputDelay { .. } => Family::InputDelay,
+            Effect::Saturation { .. } => Family::Saturation,
+            Effect::DeadZone { .. } => Family::DeadZone,
+        }
+    }
+
+    /// The DOF it is attached to (None for the effects spanning DOFs).
+    pub fn dof(&self) -> Option<Dof> {
+        match *self {
+            Effect::QuadraticDamping { dof }
+            | Effect::CoriolisProduct { dof, .. }
+            | Effect::Restoring { dof, .. }
+            | Effect::ConstantLoad { dof }
+            | Effect::Coupling { dof, .. }
+            | Effect::ActuatorLag { dof }
+            | Effect::InputDelay { dof }
+            | Effect::Saturation { dof }
+            | Effect::DeadZone { dof } => Some(dof),
+            Effect::CoriolisFromM | Effect::Current => None,
+        }
+    }
+
+    /// The shape parameter of an actuator effect.
+    pub fn shape(&self) -> Option<ShapeKind> {
+        match self {
+            Effect::ActuatorLag { .. } => Some(ShapeKind::LagTime),
+            Effect::InputDelay { .. } => Some(ShapeKind::DelaySamples),
+            Effect::Saturation { .. } => Some(ShapeKind::SaturationLevel),
+            Effect::DeadZone { .. } => Some(ShapeKind::DeadZoneWidth),
+            _ => None,
+        }
+    }
+
+    /// Number of coefficients that enter linearly.
+    pub fn n_linear(&self) -> usize {
+        match self {
+            Effect::Current | Effect::Coupling { .. } => 2,
+            e if e.shape().is_some() => 0,
+            _ => 1,
+        }
+    }
+
+    /// Names of the linear coefficients, with units.
+    pub fn coefficient_names(&self) -> Vec<String> {
+        let unit = |d: Dof| d.force_unit();
+        match *self {
+            Effect::QuadraticDamping { dof } => {
+                let s = dof.velocity_symbol();
+                let vu = dof.velocity_unit();
+                vec![format!(
+                    "d_{s}|{s}| ({}·s²/{}²)",
+                    unit(dof),
+                    vu.trim_end_matches("/s")
+                )]
+            }
+            Effect::CoriolisFromM => vec!["scale of C(ν) from M (–)".into()],
+            Effect::CoriolisProduct { dof, a, b } => vec![format!(
+                "coefficient of {}·{} in {} ({})",
+                a.velocity_symbol(),
+                b.velocity_symbol(),
+                dof.name(),
+                unit(dof)
+            )],
+            Effect::Restoring { dof, shape } => vec![format!(
+                "{} coefficient in {} ({})",
+                match shape {
+                    RestoringShape::SinTheta => "sin θ",
+                    RestoringShape::CosThetaSinPhi => "cos θ sin φ",
+                },
+                dof.name(),
+                unit(dof)
+            )],
+            Effect::ConstantLoad { dof } => {
+                vec![format!("constant {} load ({})", dof.name(), unit(dof))]
+            }
+            Effect::Current => vec!["V_N (m/s)".into(), "V_E (m/s)".into()],
+            Effect::Coupling { dof, from } => vec![
+                format!("M_{}{}", dof.velocity_symbol(), from.velocity_symbol()),
+                format!("D̄_{}{}", dof.velocity_symbol(), from.velocity_symbol()),
+            ],
+            _ => vec![],
+        }
+    }
+
+    /// A short label a control engineer reads.
+    pub fn label(&self) -> String {
+        match *self {
+            Effect::QuadraticDamping { dof } => {
+                let s = dof.velocity_symbol();
+                format!("quadratic damping |{s}|{s} in {}", dof.name())
+            }
+            Effect::CoriolisFromM => "Coriolis–centripetal C(ν)ν from M".into(),
+            Effect::CoriolisProduct { dof, a, b } => format!(
+                "Coriolis product {}·{} in {}",
+                a.velocity_symbol(),
+                b.velocity_symbol(),
+                dof.name()
+            ),
+            Effect::Restoring { dof, shape } => format!(
+                "restoring {} in {}",
+                match shape {
+                    RestoringShape::SinTheta => "sin θ",
+                    RestoringShape::CosThetaSinPhi => "cos θ sin φ",
+                },
+                dof.name()
+            ),
+            Effect::ConstantLoad { dof } => {
+                format!(
+                    "constant {} in {} (tether/bias)",
+                    load_word(dof),
+                    dof.name()
+                )
+            }
+            Effect::Current => "ocean current (damping on ν − ν_c)".into(),
+            Effect::Coupling { dof, from } => {
+                format!("missing coupling from {} into {}", from.name(), dof.name())
+            }
+            Effect::ActuatorLag { dof } => format!("actuator lag in {}", dof.name()),
+            Effect::InputDelay { dof } => format!("input delay in {}", dof.name()),
+            Effect::Saturation { dof } => format!("thrust saturation in {}", dof.name()),
+            Effect::DeadZone { dof } => format!("thrust dead zone in {}", dof.name()),
+        }
+    }
+
+    /// Row indices (into the baseline DOFs) of the equations it enters.
+    pub fn rows(&self, dofs: &[Dof], d_ref: &DMatrix<f64>) -> Vec<usize> {
+        let idx = |d: Dof| dofs.iter().position(|&x| x == d);
+        match *self {
+            Effect::CoriolisFromM => (0..dofs.len()).collect(),
+            Effect::Current => match (idx(Dof::Surge), idx(Dof::Sway)) {
+                (Some(iu), Some(iv)) => (0..dofs.len())
+                    .filter(|&i| d_ref[(i, iu)] != 0.0 || d_ref[(i, iv)] != 0.0)
+                    .collect(),
+                _ => vec![],
+            },
+            _ => self.dof().and_then(idx).into_iter().collect(),
+        }
+    }
+
+    /// φ_p for coefficient `p` in equation row `row` at (ν, η), the force
+    /// it adds to the left-hand side per unit coefficient. Not used for
+    /// [`Effect::Coupling`] (which enters M and D̄) nor actuator effects.
+    pub fn regressor(
+        &self,
+        p: usize,
+        row: usize,
+        ctx: &TermContext<'_>,
+        nu: &[f64],
+        eta: &[f64; 6],
+    ) -> f64 {
+        let row_dof = ctx.dofs[row];
+        let v = |d: Dof| ctx.dofs.iter().position(|&x| x == d).map_or(0.0, |j| nu[j]);
+        match *self {
+            Effect::QuadraticDamping { dof } if dof == row_dof => {
+                let x = v(dof);
+                x.abs() * x
+            }
+            Effect::CoriolisFromM => coriolis_force(ctx.dofs, ctx.m_ref, nu)[row],
+            Effect::CoriolisProduct { dof, a, b } if dof == row_dof => v(a) * v(b),
+            Effect::Restoring { dof, shape } if dof == row_dof => {
+                let (sp, cp) = eta[3].sin_cos();
+                let (st, ct) = eta[4].sin_cos();
+                let _ = cp;
+                match shape {
+                    RestoringShape::SinTheta => st,
+                    RestoringShape::CosThetaSinPhi => ct * sp,
+                }
+            }
+            Effect::ConstantLoad { dof } if dof == row_dof => 1.0,
+            Effect::Current => {
+                let (Some(iu), Some(iv)) = (ctx.index(Dof::Surge), ctx.index(Dof::Sway)) else {
+                    return 0.0;
+                };
+                let (du, dv) = (ctx.d_ref[(row, iu)], ctx.d_ref[(row, iv)]);
+                let (s, c) = eta[5].sin_cos();
+                // −D̄·ν_c with ν_c = R(ψ)ᵀ[V_N V_E]ᵀ = [V_N c + V_E s, −V_N s + V_E c].
+                if p == 0 {
+                    -(du * c - dv * s)
+                } else {
+                    -(du * s + dv * c)
+                }
+            }
+            _ => 0.0,
+        }
+    }
+}
+
+fn load_word(dof: Dof) -> &'static str {
+    if dof.is_angular() { "moment" } else { "force" }
+}
+
+/// What regressors need besides (ν, η): the DOFs and the M, D̄ the
+/// structured terms (C(ν) from M, current through D̄) are built from.
+#[derive(Debug, Clone, Copy)]
+pub struct TermContext<'a> {
+    /// Modeled DOFs.
+    pub dofs: &'a [Dof],
+    /// M that C(ν) is built from.
+    pub m_ref: &'a DMatrix<f64>,
+    /// D̄ that acts on the current.
+    pub d_ref: &'a DMatrix<f64>,
+}
+
+impl TermContext<'_> {
+    /// Index of a DOF among the modeled ones.
+    pub fn index(&self, d: Dof) -> Option<usize> {
+        self.dofs.iter().position(|&x| x == d)
+    }
+}
+
+/// C(ν)ν over the modeled DOFs for a symmetric M (Fossen 1994):
+/// C(ν) = [[0, −S(M₁₁ν₁+M₁₂ν₂)], [−S(M₁₁ν₁+M₁₂ν₂), −S(M₂₁ν₁+M₂₂ν₂)]];
+/// unmodeled velocities are zero.
+pub fn coriolis_force(dofs: &[Dof], m: &DMatrix<f64>, nu: &[f64]) -> Vec<f64> {
+    let mut m6 = [[0.0; 6]; 6];
+    let mut v6 = [0.0; 6];
+    for (i, di) in dofs.iter().enumerate() {
+        v6[di.index()] = nu[i];
+        for (j, dj) in dofs.iter().enumerate() {
+            m6[di.index()][dj.index()] = 0.5 * (m[(i, j)] + m[(j, i)]);
+        }
+    }
+    let a: [f64; 6] = std::array::from_fn(|i| (0..6).map(|j| m6[i][j] * v6[j]).sum());
+    let cross = |x: [f64; 3], y: [f64; 3]| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    let (n1, n2) = ([v6[0], v6[1], v6[2]], [v6[3], v6[4], v6[5]]);
+    let (a1, a2) = ([a[0], a[1], a[2]], [a[3], a[4], a[5]]);
+    let lin = cross(n2, a1);
+    let ang1 = cross(n1, a1);
+    let ang2 = cross(n2, a2);
+    let f6 = [
+        lin[0],
+        lin[1],
+        lin[2],
+        ang1[0] + ang2[0],
+        ang1[1] + ang2[1],
+        ang1[2] + ang2[2],
+    ];
+    dofs.iter().map(|d| f6[d.index()]).collect()
+}
+
+/// Which candidate families to try.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(default)]
+pub struct LibrarySettings {
+    /// |ν_i|ν_i per DOF.
+    pub quadratic_damping: bool,
+    /// C(ν)ν from M and its single products.
+    pub coriolis: bool,
+    /// sin θ, cos θ sin φ shapes.
+    pub restoring: bool,
+    /// Constant force/moment per DOF.
+    pub constant_load: bool,
+    /// Ocean current (needs surge and sway).
+    pub current: bool,
+    /// Off-diagonal M, D̄ entries the baseline lacks.
+    pub coupling: bool,
+    /// Actuator lag per DOF.
+    pub actuator_lag: bool,
+    /// Input delay per DOF.
+    pub input_delay: bool,
+    /// Saturation per DOF.
+    pub saturation: bool,
+    /// Dead zone per DOF.
+    pub dead_zone: bool,
+}
+
+impl Default for LibrarySettings {
+    fn default() -> Self {
+        LibrarySettings {
+            quadratic_damping: true,
+            coriolis: true,
+            restoring: true,
+            constant_load: true,
+            current: true,
+            coupling: true,
+            actuator_lag: true,
+            input_delay: true,
+            saturation: true,
+            dead_zone: true,
+        }
+    }
+}
+
+/// Every candidate the library offers for a baseline over `dofs` with
+/// matrices `m`, `d_bar` (coupling only where both entries are zero).
+pub fn library(
+    dofs: &[Dof],
+    m: &DMatrix<f64>,
+    d_bar: &DMatrix<f64>,
+    s: &LibrarySettings,
+) -> Vec<Effect> {
+    let has = |d: Dof| dofs.contains(&d);
+    let mut out = Vec::new();
+    for &dof in dofs {
+        if s.quadratic_damping {
+            out.push(Effect::QuadraticDamping { dof });
+        }
+        if s.constant_load {
+            out.push(Effect::ConstantLoad { dof });
+        }
+        if s.restoring {
+            let shapes: &[RestoringShape] = match dof {
+                Dof::Surge | Dof::Pitch => &[RestoringShape::SinTheta],
+                Dof::Sway | Dof::Roll => &[RestoringShape::CosThetaSinPhi],
+                Dof::Yaw => &[RestoringShape::SinTheta, RestoringShape::CosThetaSinPhi],
+                Dof::Heave => &[],
+            };
+            // Attitude-dependent shapes need attitude DOFs in the model.
+            if has(Dof::Roll) || has(Dof::Pitch) {
+                for &shape in shapes {
+                    out.push(Effect::Restoring { dof, shape });
+                }
+            }
+        }
+        if s.actuator_lag {
+            out.push(Effect::ActuatorLag { dof });
+        }
+        if s.input_delay {
+            out.push(Effect::InputDelay { dof });
+        }
+        if s.saturation {
+            out.push(Effect::Saturation { dof });
+        }
+        if s.dead_zone {
+            out.push(Effect::DeadZone { dof });
+        }
+    }
+    if s.coriolis && dofs.len() > 1 {
+        out.push(Effect::CoriolisFromM);
+        for (dof, pairs) in CORIOLIS_PAIRS {
+            for (a, b) in pairs {
+                if has(dof) && has(a) && has(b) {
+                    out.push(Effect::CoriolisProduct { dof, a, b });
+                }
+            }
+        }
+    }
+    if s.current && has(Dof::Surge) && has(Dof::Sway) {
+        out.push(Effect::Current);
+    }
+    if s.coupling {
+        for (i, &dof) in dofs.iter().enumerate() {
+            for (j, &from) in dofs.iter().enumerate() {
+                if i != j && m[(i, j)] == 0.0 && d_bar[(i, j)] == 0.0 {
+                    out.push(Effect::Coupling { dof, from });
+                }
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coriolis_from_diagonal_m_has_fossens_products_and_does_no_work() {
+        let dofs = Dof::ALL.to_vec();
+        let m = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![
+            10.0, 20.0, 30.0, 4.0, 5.0, 6.0,
+        ]));
+        let nu = [0.3, -0.2, 0.1, 0.05, -0.04, 0.07];
+        let f = coriolis_force(&dofs, &m, &nu);
+        let [u, v, w, p, q, r] = nu;
+        assert!((f[0] - (30.0 * w * q - 20.0 * v * r)).abs() < 1e-12);
+        assert!((f[5] - ((20.0 - 10.0) * u * v + (5.0 - 4.0) * p * q)).abs() < 1e-12);
+        // Skew-symmetric C: νᵀC(ν)ν = 0.
+        let work: f64 = f.iter().zip(&nu).map(|(a, b)| a * b).sum();
+        assert!(work.abs() < 1e-12);
+    }
+
+    #[test]
+    fn library_lists_coupling_only_where_the_baseline_has_none() {
+        let dofs = vec![Dof::Surge, Dof::Sway, Dof::Yaw];
+        let mut m = DMatrix::identity(3, 3);
+        m[(1, 2)] = 0.1;
+        let d = DMatrix::identity(3, 3);
+        let lib = library(&dofs, &m, &d, &LibrarySettings::default());
+        assert!(!lib.contains(&Effect::Coupling {
+            dof: Dof::Sway,
+            from: Dof::Yaw
+        }));
+        assert!(lib.contains(&Effect::Coupling {
+            dof: Dof::Yaw,
+            from: Dof::Sway
+        }));
+        assert!(lib.contains(&Effect::Current));
+        assert!(lib.contains(&Effect::CoriolisProduct {
+            dof: Dof::Yaw,
+            a: Dof::Surge,
+            b: Dof::Sway
+        }));
+        // No attitude DOFs: no restoring shapes.
+        assert!(!lib.iter().any(|e| e.family() == Family::Restoring));
+    }
+}

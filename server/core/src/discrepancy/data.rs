@@ -1,0 +1,207 @@
+//! What discovery works on: the baseline M ν̇ + D̄ ν = γ with γ = τ − g(η)
+//! (thesis eq. 2.7–2.9), and recorded runs on a uniform grid.
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use super::error::DiscoveryError;
+use crate::planning::Dof;
+
+/// Restoring forces and moments g(η) of the baseline (thesis eq. 1.6):
+/// W−B, z_G·W − z_B·B and the tether pitch moment τ_θ.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct Restoring {
+    /// W − B (N): weight minus buoyancy.
+    pub w_minus_b: f64,
+    /// z_G·W − z_B·B (N·m): metacentric restoring of roll and pitch.
+    pub zg_w_minus_zb_b: f64,
+    /// τ_θ (N·m): tether pitch moment already known to the baseline.
+    pub tether_pitch_moment: f64,
+}
+
+impl Restoring {
+    /// g(η) in all six DOFs for η = [x y z φ θ ψ] (thesis eq. 1.6).
+    pub fn g(&self, eta: &[f64; 6]) -> [f64; 6] {
+        let (sp, cp) = eta[3].sin_cos();
+        let (st, ct) = eta[4].sin_cos();
+        let w = self.w_minus_b;
+        let z = self.zg_w_minus_zb_b;
+        [
+            w * st,
+            -w * ct * sp,
+            -w * ct * cp,
+            z * ct * sp,
+            z * st + self.tether_pitch_moment,
+            0.0,
+        ]
+    }
+}
+
+/// The baseline linear model M ν̇ + D̄ ν = τ − g(η) over the modeled DOFs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Baseline {
+    /// Modeled DOFs, in the column order of every matrix and record.
+    pub dofs: Vec<Dof>,
+    /// Mass and added mass M (n × n, invertible).
+    pub m: DMatrix<f64>,
+    /// Lumped linear damping and Coriolis D̄ (n × n).
+    pub d_bar: DMatrix<f64>,
+    /// g(η) of the baseline.
+    pub restoring: Restoring,
+}
+
+impl Baseline {
+    /// Number of modeled DOFs.
+    pub fn n(&self) -> usize {
+        self.dofs.len()
+    }
+
+    /// Index of `dof` among the modeled DOFs.
+    pub fn index_of(&self, dof: Dof) -> Option<usize> {
+        self.dofs.iter().position(|&d| d == dof)
+    }
+
+    /// g(η) restricted to the modeled DOFs.
+    pub fn g(&self, eta: &[f64; 6]) -> Vec<f64> {
+        let g = self.restoring.g(eta);
+        self.dofs.iter().map(|d| g[d.index()]).collect()
+    }
+
+    /// Checks shapes, finiteness and invertibility of M.
+    pub fn validate(&self) -> Result<(), DiscoveryError> {
+        let n = self.n();
+        if n == 0 {
+            return Err(DiscoveryError::invalid(
+                "baseline.dofs",
+                "at least one DOF is needed",
+            ));
+        }
+        for (i, d) in self.dofs.iter().enumerate() {
+            if self.dofs[..i].contains(d) {
+                return Err(DiscoveryError::invalid(
+                    format!("baseline.dofs[{i}]"),
+                    format!("{} is listed twice", d.name()),
+                ));
+            }
+        }
+        for (name, mat) in [("baseline.m", &self.m), ("baseline.d_bar", &self.d_bar)] {
+            if mat.shape() != (n, n) {
+                return Err(DiscoveryError::invalid(
+                    name,
+                    format!("must be {n} × {n}, got {:?}", mat.shape()),
+                ));
+            }
+            if mat.iter().any(|x| !x.is_finite()) {
+                return Err(DiscoveryError::invalid(name, "must be finite"));
+            }
+        }
+        if self.m.clone().try_inverse().is_none() || (0..n).any(|i| self.m[(i, i)] <= 0.0) {
+            return Err(DiscoveryError::invalid(
+                "baseline.m",
+                "must be invertible with a positive diagonal",
+            ));
+        }
+        let r = &self.restoring;
+        if ![r.w_minus_b, r.zg_w_minus_zb_b, r.tether_pitch_moment]
+            .iter()
+            .all(|x| x.is_finite())
+        {
+            return Err(DiscoveryError::invalid(
+                "baseline.restoring",
+                "must be finite",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One recorded run on a uniform grid t_k = k·h.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    /// Name used in the report (e.g. `DYN-1.5kn-sway-r1`).
+    pub name: String,
+    /// Sample time h (s).
+    pub h: f64,
+    /// Commanded τ, N × n, columns in the baseline's DOF order.
+    pub tau: DMatrix<f64>,
+    /// Measured body velocities ν, N × n.
+    pub nu: DMatrix<f64>,
+    /// Measured η = [x y z φ θ ψ], N × 6 (zeros where not measured: a DP
+    /// vessel has φ = θ = 0).
+    pub eta: DMatrix<f64>,
+}
+
+impl Record {
+    /// Number of samples N.
+    pub fn len(&self) -> usize {
+        self.nu.nrows()
+    }
+
+    /// True when the run holds no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// η at sample k.
+    pub fn eta_at(&self, k: usize) -> [f64; 6] {
+        std::array::from_fn(|j| self.eta[(k, j)])
+    }
+
+    /// The samples `start..end` as a run of its own.
+    pub fn slice(&self, start: usize, end: usize, name: String) -> Record {
+        let n = end - start;
+        Record {
+            name,
+            h: self.h,
+            tau: self.tau.rows(start, n).into_owned(),
+            nu: self.nu.rows(start, n).into_owned(),
+            eta: self.eta.rows(start, n).into_owned(),
+        }
+    }
+
+    /// Checks shapes, sample time and finiteness; `field` prefixes messages.
+    pub fn validate(
+        &self,
+        n_dofs: usize,
+        min_len: usize,
+        field: &str,
+    ) -> Result<(), DiscoveryError> {
+        if !(self.h.is_finite() && self.h > 0.0) {
+            return Err(DiscoveryError::invalid(
+                format!("{field}.h"),
+                "sample time must be finite and > 0",
+            ));
+        }
+        let n = self.len();
+        if n < min_len {
+            return Err(DiscoveryError::invalid(
+                format!("{field}.nu"),
+                format!("needs at least {min_len} samples, got {n}"),
+            ));
+        }
+        for (name, mat, cols) in [
+            ("tau", &self.tau, n_dofs),
+            ("nu", &self.nu, n_dofs),
+            ("eta", &self.eta, 6),
+        ] {
+            if mat.shape() != (n, cols) {
+                return Err(DiscoveryError::invalid(
+                    format!("{field}.{name}"),
+                    format!("must be {n} × {cols}, got {:?}", mat.shape()),
+                ));
+            }
+            if let Some(i) = mat.iter().position(|x| !x.is_finite()) {
+                return Err(DiscoveryError::invalid(
+                    format!("{field}.{name}"),
+                    format!(
+                        "non-finite sample at row {}, column {}",
+                        i % n.max(1),
+                        i / n.max(1)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}

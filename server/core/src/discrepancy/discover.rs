@@ -1,0 +1,652 @@
+//! The entry point: locate, name, model, show, ask, be honest.
+
+use serde::{Deserialize, Serialize};
+
+use super::candidates::{LibrarySettings, library};
+use super::data::{Baseline, Record};
+use super::error::DiscoveryError;
+use super::evidence::{effect_text, separating_evidence};
+use super::experiment::propose;
+use super::fit::{Prepared, Spec};
+use super::locate::{
+    BAND_EXCESS_DB, Predictions, capital, channel_fits, locate, phi_diag, predict, residual,
+    signature_words,
+};
+use super::model::AugmentedModel;
+use super::report::*;
+use super::residual::{residual_spectrum, whiteness};
+use super::select::{Criteria, Scored, step};
+use crate::estimation::Progress;
+use crate::planning::VesselProfile;
+
+/// Settings of [`discover`]. Defaults suit a 10 Hz ROV log.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(default)]
+pub struct DiscoverySettings {
+    /// T of the state-variable filter λ(s) = 1/(1+sT) (s).
+    pub svf_time_constant_s: f64,
+    /// k of the k-step predictions (thesis: 10).
+    pub k_step: usize,
+    /// Bartlett window of the HAC covariance (s).
+    pub hac_window_s: f64,
+    /// Least significance z of a term.
+    pub min_z: f64,
+    /// Largest ΔBIC of a term (negative: evidence for it).
+    pub max_delta_bic: f64,
+    /// Least held-out free-run fit gain (summed over channels) to accept a term.
+    pub min_cv_gain: f64,
+    /// A look-alike whose held-out gain reaches this share of the winner's is
+    /// reported as ambiguous.
+    pub ambiguity_ratio: f64,
+    /// Most terms added.
+    pub max_terms: usize,
+    /// Candidates cross-validated per step.
+    pub cv_candidates: usize,
+    /// Longest actuator lag searched (s).
+    pub max_lag_s: f64,
+    /// Longest input delay searched (s).
+    pub max_delay_s: f64,
+    /// Segment length of the location report (s).
+    pub segment_s: f64,
+    /// Points per plot series.
+    pub plot_points: usize,
+    /// Candidate families.
+    pub library: LibrarySettings,
+    /// The vessel, for deciding-experiment proposals within its limits.
+    pub vessel: Option<VesselProfile>,
+}
+
+impl Default for DiscoverySettings {
+    fn default() -> Self {
+        DiscoverySettings {
+            svf_time_constant_s: 0.5,
+            k_step: 10,
+            hac_window_s: 3.0,
+            min_z: 4.0,
+            max_delta_bic: -10.0,
+            min_cv_gain: 0.01,
+            ambiguity_ratio: 0.8,
+            max_terms: 4,
+            cv_candidates: 5,
+            max_lag_s: 3.0,
+            max_delay_s: 1.0,
+            segment_s: 30.0,
+            plot_points: 400,
+            library: LibrarySettings::default(),
+            vessel: None,
+        }
+    }
+}
+
+impl DiscoverySettings {
+    fn validate(&self) -> Result<(), DiscoveryError> {
+        let pos = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(DiscoveryError::invalid(
+                    format!("settings.{name}"),
+                    "must be finite and > 0",
+                ))
+            }
+        };
+        pos("svf_time_constant_s", self.svf_time_constant_s)?;
+        pos("hac_window_s", self.hac_window_s)?;
+        pos("min_z", self.min_z)?;
+        pos("max_lag_s", self.max_lag_s)?;
+        pos("max_delay_s", self.max_delay_s)?;
+        pos("segment_s", self.segment_s)?;
+        pos("ambiguity_ratio", self.ambiguity_ratio)?;
+        if !(self.min_cv_gain.is_finite() && self.max_delta_bic.is_finite()) {
+            return Err(DiscoveryError::invalid(
+                "settings.min_cv_gain",
+                "must be finite",
+            ));
+        }
+        if self.k_step == 0 || self.k_step > 1000 {
+            return Err(DiscoveryError::invalid(
+                "settings.k_step",
+                "must be in 1..=1000",
+            ));
+        }
+        if self.max_terms > 20 {
+            return Err(DiscoveryError::invalid(
+                "settings.max_terms",
+                "must be at most 20",
+            ));
+        }
+        if self.plot_points < 2 {
+            return Err(DiscoveryError::invalid(
+                "settings.plot_points",
+                "must be at least 2",
+            ));
+        }
+        if let Some(v) = &self.vessel {
+            v.validate()
+                .map_err(|e| DiscoveryError::invalid("settings.vessel", e.to_string()))?;
+        }
+        Ok(())
+    }
+}
+
+fn check(p: &mut dyn Progress, f: f64, stage: &str) -> Result<(), DiscoveryError> {
+    p.update(f, stage).map_err(DiscoveryError::from)
+}
+
+/// Runs missing-physics discovery (see the [module documentation](super)).
+///
+/// # Errors
+/// [`DiscoveryError::Invalid`] naming the field for a malformed baseline,
+/// settings or run (shape, non-finite sample, sample times that differ,
+/// runs too short for the filter transient and the k-step horizon);
+/// [`DiscoveryError::Cancelled`] when `progress` asks to stop.
+pub fn discover(
+    baseline: &Baseline,
+    estimation_runs: &[Record],
+    validation_runs: &[Record],
+    settings: &DiscoverySettings,
+    progress: &mut dyn Progress,
+) -> Result<DiscoveryReport, DiscoveryError> {
+    baseline.validate()?;
+    settings.validate()?;
+    let n = baseline.n();
+    let Some(first) = estimation_runs.first() else {
+        return Err(DiscoveryError::invalid(
+            "estimation_runs",
+            "at least one run is needed",
+        ));
+    };
+    let h = first.h;
+    let skip = ((5.0 * settings.svf_time_constant_s / h).ceil() as usize)
+        .max((settings.max_delay_s / h).ceil() as usize + 1)
+        .max(settings.k_step);
+    let min_len = skip + settings.k_step + 64;
+    for (name, runs) in [
+        ("estimation_runs", estimation_runs),
+        ("validation_runs", validation_runs),
+    ] {
+        for (i, r) in runs.iter().enumerate() {
+            let f = format!("{name}[{i}]");
+            r.validate(n, min_len, &f)?;
+            if (r.h - h).abs() > 1e-9 * h {
+                return Err(DiscoveryError::invalid(
+                    format!("{f}.h"),
+                    format!("sample time {} differs from the first run's {h}", r.h),
+                ));
+            }
+        }
+    }
+    // Cross-validation needs two folds: a single run is split in halves.
+    let est: Vec<Record> = if estimation_runs.len() == 1 {
+        let len = first.len();
+        if len / 2 < min_len {
+            return Err(DiscoveryError::invalid(
+                "estimation_runs[0].nu",
+                format!(
+                    "a single run needs {} samples to be split for cross-validation",
+                    2 * min_len
+                ),
+            ));
+        }
+        vec![
+            first.slice(0, len / 2, format!("{} (first half)", first.name)),
+            first.slice(len / 2, len, format!("{} (second half)", first.name)),
+        ]
+    } else {
+        estimation_runs.to_vec()
+    };
+    let k = settings.k_step;
+    check(progress, 0.0, "locating the misfit")?;
+    let base_model = AugmentedModel::from_baseline(baseline);
+    let all_runs: Vec<&Record> = est.iter().chain(validation_runs).collect();
+    let location = locate(&base_model, &all_runs, k, settings.segment_s);
+
+    check(progress, 0.1, "filtering the runs")?;
+    let hac_lags = ((settings.hac_window_s / h).ceil() as usize).max(1);
+    let prep = Prepared::new(baseline, &est, settings.svf_time_constant_s, skip, hac_lags)
+        .ok_or_else(|| {
+            DiscoveryError::invalid(
+                "estimation_runs",
+                "no samples left after the filter transient",
+            )
+        })?;
+    let lib = library(
+        &baseline.dofs,
+        &baseline.m,
+        &baseline.d_bar,
+        &settings.library,
+    );
+    let crit = Criteria {
+        min_z: settings.min_z,
+        max_delta_bic: settings.max_delta_bic,
+        min_cv_gain: settings.min_cv_gain,
+        cv_candidates: settings.cv_candidates,
+        max_lag_s: settings.max_lag_s,
+        max_delay_samples: ((settings.max_delay_s / h).round() as usize).max(1),
+        k_step: k,
+    };
+    let runs: Vec<usize> = (0..est.len()).collect();
+
+    // Forward selection.
+    let mut chosen: Vec<Spec> = Vec::new();
+    let mut winners: Vec<Scored> = Vec::new();
+    let mut steps: Vec<Vec<Scored>> = Vec::new();
+    let mut pool = lib.clone();
+    for s in 0..settings.max_terms {
+        check(
+            progress,
+            0.15 + 0.6 * s as f64 / settings.max_terms.max(1) as f64,
+            "testing hypotheses",
+        )?;
+        let st = step(&prep, &chosen, &pool, &runs, &crit);
+        if s == 0 {
+            // Later steps re-test only what showed at least weak evidence.
+            pool = st
+                .scored
+                .iter()
+                .filter(|x| x.z >= 0.5 * settings.min_z)
+                .map(|x| x.spec.effect)
+                .collect();
+        }
+        let Some(w) = st.winner else {
+            steps.push(st.scored);
+            break;
+        };
+        let win = st.scored[w].clone();
+        chosen.push(win.spec);
+        winners.push(win);
+        steps.push(st.scored);
+    }
+
+    check(progress, 0.8, "fitting the augmented model")?;
+    let shape_std: Vec<Option<f64>> = winners.iter().map(|w| w.shape_std).collect();
+    let model = if chosen.is_empty() {
+        base_model.clone()
+    } else {
+        match prep.fit(&chosen, &[], &runs, true) {
+            Some(f) => prep.model(&chosen, &f, &shape_std),
+            None => base_model.clone(),
+        }
+    };
+
+    // Before/after on validation runs (estimation runs if none were given).
+    let val: Vec<&Record> = if validation_runs.is_empty() {
+        est.iter().collect()
+    } else {
+        validation_runs.iter().collect()
+    };
+    let before: Vec<Predictions> = val.iter().map(|r| predict(&base_model, r, k)).collect();
+    let after: Vec<Predictions> = val.iter().map(|r| predict(&model, r, k)).collect();
+    let validation: Vec<ChannelComparison> = (0..n)
+        .map(|i| {
+            let rb: Vec<Vec<f64>> = val
+                .iter()
+                .zip(&before)
+                .map(|(r, p)| residual(r, &p.one, i))
+                .collect();
+            let ra: Vec<Vec<f64>> = val
+                .iter()
+                .zip(&after)
+                .map(|(r, p)| residual(r, &p.one, i))
+                .collect();
+            ChannelComparison {
+                dof: baseline.dofs[i],
+                before: channel_fits(&val, &before, i),
+                after: channel_fits(&val, &after, i),
+                whiteness_before: whiteness(&rb, 30),
+                whiteness_after: whiteness(&ra, 30),
+            }
+        })
+        .collect();
+    let plots = plot_series(
+        val[0],
+        &before[0],
+        &after[0],
+        &baseline.dofs,
+        settings.plot_points,
+    );
+
+    check(progress, 0.85, "weighing look-alikes")?;
+    let base_resid: Vec<Vec<Vec<f64>>> = all_runs
+        .iter()
+        .map(|r| {
+            let p = base_model.predict_k_step(r, 1);
+            (0..n).map(|i| residual(r, &p, i)).collect()
+        })
+        .collect();
+    let noise_sigma: Vec<f64> = (0..n)
+        .map(|i| {
+            let v: Vec<f64> = base_resid
+                .iter()
+                .flat_map(|r| r[i].iter().copied())
+                .filter(|x| x.is_finite())
+                .collect();
+            (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
+        })
+        .collect();
+    let mut ambiguities = Vec::new();
+    for (si, w) in winners.iter().enumerate() {
+        let wg = w.cv_gain.unwrap_or(0.0);
+        let w_rows = prep.rows_of(&[w.spec], &[]);
+        let rival = steps[si]
+            .iter()
+            .filter(|o| o.spec.effect.family() != w.spec.effect.family())
+            .filter(|o| !chosen.iter().any(|c| c.effect == o.spec.effect))
+            .filter(|o| {
+                o.cv_gain
+                    .is_some_and(|g| g >= settings.ambiguity_ratio * wg)
+            })
+            .find(|o| {
+                prep.rows_of(&[o.spec], &[])
+                    .iter()
+                    .any(|r| w_rows.contains(r))
+            });
+        if let Some(o) = rival {
+            let before_terms = &chosen[..si];
+            let fit_with = |s: Spec| {
+                let mut v = before_terms.to_vec();
+                v.push(s);
+                prep.fit(&v, &[], &runs, false)
+                    .map(|f| prep.model(&v, &f, &[]))
+            };
+            let labels = [w.spec.effect.label(), o.spec.effect.label()];
+            let mut focus: Vec<_> = prep
+                .rows_of(&[w.spec, o.spec], &[])
+                .iter()
+                .map(|&r| baseline.dofs[r])
+                .collect();
+            focus.dedup();
+            let experiment = match (&settings.vessel, fit_with(w.spec), fit_with(o.spec)) {
+                (Some(v), Some(ma), Some(mb)) => propose(
+                    v,
+                    &ma,
+                    &mb,
+                    labels.clone(),
+                    &focus,
+                    &noise_sigma,
+                    est[0].eta[(0, 5)],
+                    h,
+                ),
+                _ => None,
+            };
+            let og = o.cv_gain.unwrap_or(0.0);
+            ambiguities.push(Ambiguity {
+                chosen: w.spec.effect,
+                alternative: o.spec.effect,
+                cv_gains: [wg, og],
+                text: format!(
+                    "{} and {} explain these runs about equally well (held-out fit gained {:.3} vs {:.3}); {}",
+                    capital(&labels[0]),
+                    labels[1],
+                    wg,
+                    og,
+                    match &experiment {
+                        Some(e) => format!("a deciding run: {}", e.instruction),
+                        None => "no vessel profile was given to design the run that separates them.".into(),
+                    }
+                ),
+                experiment,
+            });
+        }
+    }
+
+    check(progress, 0.92, "looking for unexplained structure")?;
+    let unexplained = unexplained(&model, &all_runs, &chosen);
+
+    // Hypotheses: the first step's tests, chosen terms first.
+    let mut hypotheses: Vec<HypothesisReport> = Vec::new();
+    for (si, w) in winners.iter().enumerate() {
+        hypotheses.push(hypothesis(w, si + 1, Verdict::Chosen, &crit));
+    }
+    if let Some(first) = steps.first() {
+        let mut rest: Vec<&Scored> = first
+            .iter()
+            .filter(|s| !chosen.iter().any(|c| c.effect == s.spec.effect))
+            .collect();
+        rest.sort_by(|a, b| {
+            b.cv_gain
+                .unwrap_or(f64::NEG_INFINITY)
+                .total_cmp(&a.cv_gain.unwrap_or(f64::NEG_INFINITY))
+                .then(a.delta_bic.total_cmp(&b.delta_bic))
+        });
+        for s in rest.into_iter().take(20) {
+            let v = if s.significant(&crit) {
+                Verdict::NotConfirmed
+            } else {
+                Verdict::NotSignificant
+            };
+            hypotheses.push(hypothesis(s, 1, v, &crit));
+        }
+    }
+
+    let findings: Vec<Finding> = winners
+        .iter()
+        .enumerate()
+        .map(|(i, w)| {
+            let term = &model.terms[i];
+            let mut evidence = vec![format!(
+                "ΔBIC {:.0}, significance z = {:.1}; on held-out runs the free-run fit gains {:.3} (summed over channels).",
+                w.delta_bic,
+                w.z,
+                w.cv_gain.unwrap_or(0.0)
+            )];
+            if let Some(o) = steps[i]
+                .iter()
+                .filter(|o| o.spec.effect.family() != w.spec.effect.family() && o.cv_gain.is_some())
+                .max_by(|a, b| a.cv_gain.unwrap_or(0.0).total_cmp(&b.cv_gain.unwrap_or(0.0)))
+            {
+                evidence.push(format!(
+                    "The nearest alternative, {}, gains {:.3} on held-out runs (ΔBIC {:.0}).",
+                    o.spec.effect.label(),
+                    o.cv_gain.unwrap_or(0.0),
+                    o.delta_bic
+                ));
+            }
+            evidence.extend(separating_evidence(w.spec.effect, &all_runs, &base_resid, &baseline.dofs, h));
+            let h_rep = hypothesis(w, i + 1, Verdict::Chosen, &crit);
+            Finding {
+                effect: w.spec.effect,
+                label: w.spec.effect.label(),
+                dofs: prep.rows_of(&[w.spec], &[]).iter().map(|&r| baseline.dofs[r]).collect(),
+                coefficients: term
+                    .coefficients
+                    .iter()
+                    .zip(w.spec.effect.coefficient_names())
+                    .enumerate()
+                    .map(|(j, (v, name))| Estimate {
+                        name,
+                        value: *v,
+                        std: term.covariance.get(j).and_then(|r| r.get(j)).map_or(f64::NAN, |x| x.max(0.0).sqrt()),
+                    })
+                    .collect(),
+                shape: h_rep.shape,
+                effect_text: effect_text(term, h),
+                evidence,
+            }
+        })
+        .collect();
+
+    let summary = summary(
+        &location,
+        &findings,
+        &validation,
+        &ambiguities,
+        &unexplained,
+    );
+    check(progress, 1.0, "done")?;
+    Ok(DiscoveryReport {
+        dofs: baseline.dofs.clone(),
+        summary,
+        location,
+        hypotheses,
+        findings,
+        model: ModelReport {
+            dofs: model.dofs.clone(),
+            m: rows_of(&model.m),
+            d_bar: rows_of(&model.d_bar),
+            restoring: model.restoring,
+            terms: model.terms.clone(),
+        },
+        validation,
+        plots,
+        ambiguities,
+        unexplained,
+    })
+}
+
+fn rows_of(m: &nalgebra::DMatrix<f64>) -> Vec<Vec<f64>> {
+    (0..m.nrows())
+        .map(|i| m.row(i).iter().copied().collect())
+        .collect()
+}
+
+fn hypothesis(s: &Scored, step: usize, verdict: Verdict, _c: &Criteria) -> HypothesisReport {
+    let e = s.spec.effect;
+    let own = s.own();
+    let cov = s.fit.theta_cov(own);
+    let coefficients = s.fit.theta[own]
+        .iter()
+        .zip(e.coefficient_names())
+        .enumerate()
+        .map(|(i, (v, name))| Estimate {
+            name,
+            value: *v,
+            std: cov.as_ref().map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt()),
+        })
+        .collect();
+    let shape = s.spec.shape.map(|v| Estimate {
+        name: match e.shape() {
+            Some(super::candidates::ShapeKind::LagTime) => "T_a (s)".into(),
+            Some(super::candidates::ShapeKind::DelaySamples) => "delay (samples)".into(),
+            Some(super::candidates::ShapeKind::SaturationLevel) => "τ_max".into(),
+            _ => "δ".into(),
+        },
+        value: v,
+        std: s.shape_std.unwrap_or(f64::NAN),
+    });
+    HypothesisReport {
+        effect: e,
+        family: e.family(),
+        label: e.label(),
+        step,
+        coefficients,
+        shape,
+        delta_bic: s.delta_bic,
+        z: s.z,
+        cv_gain: s.cv_gain,
+        verdict,
+    }
+}
+
+fn plot_series(
+    rec: &Record,
+    before: &Predictions,
+    after: &Predictions,
+    dofs: &[crate::planning::Dof],
+    points: usize,
+) -> Vec<PlotSeries> {
+    let step = rec.len().div_ceil(points).max(1);
+    let idx: Vec<usize> = (0..rec.len()).step_by(step).collect();
+    dofs.iter()
+        .enumerate()
+        .map(|(i, &dof)| PlotSeries {
+            run: rec.name.clone(),
+            dof,
+            t: idx.iter().map(|&k| k as f64 * rec.h).collect(),
+            measured: idx.iter().map(|&k| rec.nu[(k, i)]).collect(),
+            before: idx.iter().map(|&k| before.free[(k, i)]).collect(),
+            after: idx.iter().map(|&k| after.free[(k, i)]).collect(),
+        })
+        .collect()
+}
+
+/// Bands of the augmented model's 1-step residual still above the noise floor.
+fn unexplained(model: &AugmentedModel, runs: &[&Record], chosen: &[Spec]) -> Vec<Unexplained> {
+    let h = runs.first().map_or(0.1, |r| r.h);
+    let phi = phi_diag(model, h);
+    let preds: Vec<_> = runs.iter().map(|r| model.predict_k_step(r, 1)).collect();
+    let mut out = Vec::new();
+    for (i, &dof) in model.dofs.iter().enumerate() {
+        let e: Vec<Vec<f64>> = runs
+            .iter()
+            .zip(&preds)
+            .map(|(r, p)| residual(r, p, i))
+            .collect();
+        let Some(spec) = residual_spectrum(&e, 1.0 / h, phi[i]) else {
+            continue;
+        };
+        let Some(b) = spec
+            .bands
+            .iter()
+            .filter(|b| b.excess_db > BAND_EXCESS_DB)
+            .max_by(|a, b| a.excess_db.total_cmp(&b.excess_db))
+        else {
+            continue;
+        };
+        let signature = signature_words(spec.low_slope, b)
+            .trim_start_matches(", ")
+            .to_string();
+        let explained_here = chosen.iter().any(|c| c.effect.dof() == Some(dof));
+        out.push(Unexplained {
+            dof,
+            band: b.clone(),
+            low_slope: spec.low_slope,
+            text: format!(
+                "{}: structure no candidate explains{} — 1-step residual {:.0} dB above the noise floor at {:.3}–{:.3} Hz, {signature}.",
+                capital(dof.name()),
+                if explained_here { " after the chosen terms" } else { "" },
+                b.excess_db,
+                b.f_lo_hz,
+                b.f_hi_hz
+            ),
+            signature,
+        });
+    }
+    out
+}
+
+fn summary(
+    loc: &super::locate::LocationReport,
+    findings: &[Finding],
+    validation: &[ChannelComparison],
+    ambiguities: &[Ambiguity],
+    unexplained: &[Unexplained],
+) -> Vec<String> {
+    let mut out = Vec::new();
+    let parting: Vec<&str> = loc
+        .per_dof
+        .iter()
+        .filter(|d| d.parts)
+        .map(|d| d.dof.name())
+        .collect();
+    if parting.is_empty() && findings.is_empty() {
+        out.push(
+            "The baseline explains the recordings: no candidate term improves held-out runs."
+                .into(),
+        );
+    } else if !parting.is_empty() {
+        out.push(format!(
+            "The baseline parts from the recordings in {}.",
+            parting.join(", ")
+        ));
+    }
+    for f in findings {
+        out.push(f.effect_text.clone());
+    }
+    for c in validation {
+        if let (Some(b), Some(a)) = (c.before.free_run, c.after.free_run)
+            && (a - b).abs() >= 0.01
+        {
+            out.push(format!(
+                "{}: validation free-run fit {:.2} → {:.2}.",
+                capital(c.dof.name()),
+                b,
+                a
+            ));
+        }
+    }
+    out.extend(ambiguities.iter().map(|a| a.text.clone()));
+    out.extend(unexplained.iter().map(|u| u.text.clone()));
+    out
+}

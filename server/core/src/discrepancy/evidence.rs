@@ -1,0 +1,263 @@
+//! Plain-words effects and the evidence that separates look-alikes:
+//! lag vs delay (the lag of the peak input–residual cross-correlation),
+//! current vs tether (does the load turn with heading?), quadratic damping
+//! vs saturation (does the misfit follow ν or τ?).
+
+use super::candidates::Effect;
+use super::data::Record;
+use super::model::ModelTerm;
+use crate::planning::Dof;
+
+fn pm(v: f64, s: Option<f64>) -> String {
+    match s.filter(|x| x.is_finite()) {
+        Some(s) => format!("{} ± {}", sig(v), sig(s)),
+        None => sig(v),
+    }
+}
+
+/// Three significant digits without noise.
+fn sig(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let d = (3 - 1 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.d$}")
+}
+
+fn std_of(t: &ModelTerm, i: usize) -> Option<f64> {
+    t.covariance
+        .get(i)
+        .and_then(|r| r.get(i))
+        .map(|v| v.max(0.0).sqrt())
+}
+
+/// What a chosen term does, in one sentence.
+pub(crate) fn effect_text(t: &ModelTerm, h: f64) -> String {
+    let c = |i: usize| t.coefficients.get(i).copied().unwrap_or(f64::NAN);
+    match t.effect {
+        Effect::QuadraticDamping { dof } => format!(
+            "Damping in {} grows with speed: an extra {}·|{s}|{s} of {} {}·s²/{}².",
+            dof.name(),
+            dof.force_column(),
+            pm(c(0), std_of(t, 0)),
+            dof.force_unit(),
+            if dof.is_angular() { "rad" } else { "m" },
+            s = dof.velocity_symbol()
+        ),
+        Effect::CoriolisFromM => format!(
+            "Coriolis–centripetal forces C(ν)ν built from the baseline M act, at scale {} (1 = as M predicts).",
+            pm(c(0), std_of(t, 0))
+        ),
+        Effect::CoriolisProduct { dof, a, b } => format!(
+            "{} feels a Coriolis-type force {}·{}·{} {}.",
+            super::locate::capital(dof.name()),
+            pm(c(0), std_of(t, 0)),
+            a.velocity_symbol(),
+            b.velocity_symbol(),
+            dof.force_unit()
+        ),
+        Effect::Restoring { dof, .. } => format!(
+            "{} has a restoring term the baseline's g(η) lacks: {} {} per unit of the attitude shape.",
+            super::locate::capital(dof.name()),
+            pm(c(0), std_of(t, 0)),
+            dof.force_unit()
+        ),
+        Effect::ConstantLoad { dof } => format!(
+            "A constant {} of {} {} acts in {} (tether pull, buoyancy or trim error).",
+            if dof.is_angular() { "moment" } else { "force" },
+            pm(c(0), std_of(t, 0)),
+            dof.force_unit(),
+            dof.name()
+        ),
+        Effect::Current => {
+            let (n, e) = (c(0), c(1));
+            let speed = n.hypot(e);
+            let to = e.atan2(n).to_degrees().rem_euclid(360.0);
+            format!(
+                "A current of {} m/s setting towards {:.0}° (north {}, east {} m/s) acts through the damping.",
+                sig(speed),
+                to,
+                pm(n, std_of(t, 0)),
+                pm(e, std_of(t, 1))
+            )
+        }
+        Effect::Coupling { dof, from } => format!(
+            "{} couples into {}: M_{i}{j} = {}, D̄_{i}{j} = {}.",
+            super::locate::capital(from.name()),
+            dof.name(),
+            pm(c(0), std_of(t, 0)),
+            pm(c(1), std_of(t, 1)),
+            i = dof.velocity_symbol(),
+            j = from.velocity_symbol()
+        ),
+        Effect::ActuatorLag { dof } => format!(
+            "Thrust in {} follows the command through a first-order lag T_a = {} s.",
+            dof.name(),
+            pm(t.shape.unwrap_or(f64::NAN), t.shape_std)
+        ),
+        Effect::InputDelay { dof } => {
+            let d = t.shape.unwrap_or(0.0);
+            format!(
+                "Thrust in {} acts {:.0} samples ({} s) after the command.",
+                dof.name(),
+                d,
+                sig(d * h)
+            )
+        }
+        Effect::Saturation { dof } => format!(
+            "Thrust in {} saturates at ±{} {}.",
+            dof.name(),
+            pm(t.shape.unwrap_or(f64::NAN), t.shape_std),
+            dof.force_unit()
+        ),
+        Effect::DeadZone { dof } => format!(
+            "Commands in {} below {} {} produce no thrust.",
+            dof.name(),
+            pm(t.shape.unwrap_or(f64::NAN), t.shape_std),
+            dof.force_unit()
+        ),
+    }
+}
+
+/// Lag (samples) of the peak cross-correlation between the input changes
+/// Δτ_i and the residual e_i, over 0..=max_lag: a delay d puts it at d,
+/// a first-order lag at 0–1 samples with a slow tail.
+pub(crate) fn xcorr_peak(
+    runs: &[&Record],
+    resid: &[Vec<f64>],
+    row: usize,
+    max_lag: usize,
+) -> Option<(usize, f64)> {
+    let mut acc = vec![0.0; max_lag + 1];
+    let (mut ee, mut tt) = (0.0, 0.0);
+    for (rec, e) in runs.iter().zip(resid) {
+        let tau = rec.tau.column(row);
+        let n = rec.len();
+        for k in max_lag + 1..n {
+            if !e[k].is_finite() {
+                continue;
+            }
+            ee += e[k] * e[k];
+            let dt = tau[k] - tau[k - 1];
+            tt += dt * dt;
+            for (l, a) in acc.iter_mut().enumerate() {
+                // e[k] against Δτ[k − l]: the residual after the change.
+                let dtl = tau[k - l] - tau[k - l - 1];
+                *a += e[k] * dtl;
+            }
+        }
+    }
+    if ee <= 0.0 || tt <= 0.0 {
+        return None;
+    }
+    let norm = (ee * tt).sqrt();
+    acc.iter()
+        .enumerate()
+        .map(|(l, a)| (l, (a / norm).abs()))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// Fraction of the circle of headings the runs cover (8 sectors).
+pub(crate) fn heading_coverage(runs: &[&Record]) -> f64 {
+    let mut sectors = [false; 8];
+    for r in runs {
+        for k in 0..r.len() {
+            let s = (r.eta[(k, 5)].rem_euclid(std::f64::consts::TAU)
+                / (std::f64::consts::TAU / 8.0)) as usize;
+            sectors[s.min(7)] = true;
+        }
+    }
+    sectors.iter().filter(|&&s| s).count() as f64 / 8.0
+}
+
+/// Correlation of |ν_i| with |τ_i| in the runs: near 1, speed- and
+/// thrust-dependent effects cannot be told apart.
+pub(crate) fn speed_thrust_correlation(runs: &[&Record], row: usize) -> f64 {
+    let pairs: Vec<(f64, f64)> = runs
+        .iter()
+        .flat_map(|r| (0..r.len()).map(move |k| (r.nu[(k, row)].abs(), r.tau[(k, row)].abs())))
+        .collect();
+    let n = pairs.len() as f64;
+    if n < 3.0 {
+        return f64::NAN;
+    }
+    let mx = pairs.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = pairs.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxy: f64 = pairs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = pairs.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let syy: f64 = pairs.iter().map(|p| (p.1 - my).powi(2)).sum();
+    if sxx > 0.0 && syy > 0.0 {
+        sxy / (sxx * syy).sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
+/// Sentences specific to the look-alike pairs of `e`.
+pub(crate) fn separating_evidence(
+    e: Effect,
+    runs: &[&Record],
+    baseline_resid: &[Vec<Vec<f64>>],
+    dofs: &[Dof],
+    h: f64,
+) -> Vec<String> {
+    let row = e.dof().and_then(|d| dofs.iter().position(|&x| x == d));
+    let mut out = Vec::new();
+    match (e, row) {
+        (Effect::ActuatorLag { dof } | Effect::InputDelay { dof }, Some(r)) => {
+            let resid: Vec<Vec<f64>> = baseline_resid.iter().map(|v| v[r].clone()).collect();
+            if let Some((lag, rho)) = xcorr_peak(runs, &resid, r, 20) {
+                out.push(format!(
+                    "The baseline's 1-step residual in {} follows a change of {} most strongly after {lag} samples ({} s, ρ = {:.2}): {}.",
+                    dof.name(),
+                    dof.force_column(),
+                    sig(lag as f64 * h),
+                    rho,
+                    if lag >= 2 {
+                        "a pure delay shows this way; a lag would answer at once and fade"
+                    } else {
+                        "an immediate, fading answer, as a first-order lag gives; a delay would answer later"
+                    }
+                ));
+            }
+        }
+        (Effect::Current, _) => {
+            out.push(format!(
+                "The runs cover {:.0} % of the compass; the fitted load turns with heading in the body frame, which a tether or bias cannot.",
+                100.0 * heading_coverage(runs)
+            ));
+        }
+        (
+            Effect::ConstantLoad {
+                dof: Dof::Surge | Dof::Sway,
+            },
+            _,
+        ) => {
+            out.push(format!(
+                "The runs cover {:.0} % of the compass and the load stays fixed in the body frame, which a current would not.",
+                100.0 * heading_coverage(runs)
+            ));
+        }
+        (
+            Effect::QuadraticDamping { dof }
+            | Effect::Saturation { dof }
+            | Effect::DeadZone { dof },
+            Some(r),
+        ) => {
+            let c = speed_thrust_correlation(runs, r);
+            out.push(format!(
+                "|{}| and |{}| correlate at {:.2} in these runs, {}.",
+                dof.velocity_symbol(),
+                dof.force_column(),
+                c,
+                if c < 0.8 {
+                    "so a misfit that follows speed is told from one that follows thrust"
+                } else {
+                    "too closely to tell speed- from thrust-dependence"
+                }
+            ));
+        }
+        _ => {}
+    }
+    out
+}

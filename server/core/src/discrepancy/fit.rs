@@ -1,0 +1,775 @@
+//! Equation-error fits of hypotheses as augmentations of the baseline.
+//!
+//! Every signal passes the state-variable filter λ(s) = 1/(1+sT), so the
+//! regression per DOF row i reads
+//! [λγ_i] = Σ_j M_ij [sλν_j] + Σ_j D̄_ij [λν_j] + Σ_p θ_p [λφ_p,i],
+//! with [sλν] = (ν − [λν])/T (no raw differencing). The baseline entries of
+//! the rows a hypothesis touches are refitted with it, so a term is not
+//! biased by what the baseline already absorbed. Rows are weighted by
+//! 1/σ_i of the baseline's own equation error, so forces and moments mix.
+//! Coefficient covariances are heteroskedasticity-and-autocorrelation
+//! consistent (Newey–West, Bartlett weights): filtered residuals are far
+//! from white, and OLS standard errors would call noise significant.
+
+use nalgebra::DMatrix;
+
+use super::candidates::{Effect, TermContext};
+use super::data::{Baseline, Record};
+use super::model::{AugmentedModel, ModelTerm, actuate};
+use super::svf::{Svf, lag_zoh};
+
+/// A hypothesis term with its shape parameter fixed (actuator effects).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Spec {
+    pub effect: Effect,
+    pub shape: Option<f64>,
+}
+
+/// Filtered signals of one run.
+pub(crate) struct PrepRun {
+    /// g_i(η) per DOF at the samples.
+    g: Vec<Vec<f64>>,
+    lam_nu: Vec<Vec<f64>>,
+    dlam_nu: Vec<Vec<f64>>,
+    lam_tau: Vec<Vec<f64>>,
+    lam_g: Vec<Vec<f64>>,
+}
+
+/// Everything the fits share: the runs, their filtered signals, the
+/// baseline's structure and the row weights.
+pub(crate) struct Prepared<'a> {
+    pub records: &'a [Record],
+    pub baseline: &'a Baseline,
+    pub svf: Svf,
+    /// Samples dropped at the start of each run (filter transient, delays).
+    pub skip: usize,
+    runs: Vec<PrepRun>,
+    /// Per row: free M columns and free D̄ columns of the baseline.
+    structure: Vec<(Vec<usize>, Vec<usize>)>,
+    /// 1/σ_i of the baseline's equation error per row.
+    pub weights: Vec<f64>,
+    /// Long-run variance inflation of the residuals (≥ 1).
+    pub kappa: f64,
+    /// Bartlett lags of the HAC covariance.
+    pub hac_lags: usize,
+}
+
+/// One (row, run) block of the stacked regression: global parameter
+/// indices, their weighted columns, the weighted target.
+type Block = (Vec<usize>, Vec<Vec<f64>>, Vec<f64>);
+
+/// A fitted hypothesis.
+#[derive(Debug, Clone)]
+pub(crate) struct FitOut {
+    pub rows: Vec<usize>,
+    /// Per row of `rows`: (M free values, D̄ free values).
+    pub base: Vec<(Vec<f64>, Vec<f64>)>,
+    /// Per spec: its linear coefficients.
+    pub theta: Vec<Vec<f64>>,
+    /// Global parameter index of each spec's first coefficient.
+    pub theta_index: Vec<usize>,
+    /// Weighted residual sum of squares.
+    pub sse: f64,
+    /// Stacked samples.
+    pub n: usize,
+    /// HAC covariance over all parameters, if asked for.
+    pub cov: Option<DMatrix<f64>>,
+    /// Weighted residuals per (row, run) block.
+    pub resid: Vec<Vec<f64>>,
+    /// D̄ the current's regressors were built with.
+    pub d_ref: DMatrix<f64>,
+}
+
+impl FitOut {
+    /// HAC covariance of spec `s`'s coefficients.
+    pub fn theta_cov(&self, s: usize) -> Option<DMatrix<f64>> {
+        let cov = self.cov.as_ref()?;
+        let k = self.theta.get(s)?.len();
+        let i = self.theta_index[s];
+        Some(cov.view((i, i), (k, k)).into_owned())
+    }
+}
+
+impl<'a> Prepared<'a> {
+    /// Filters every run and fits the baseline structure per row to set
+    /// the weights and κ. `None` when no row has samples left.
+    pub fn new(
+        baseline: &'a Baseline,
+        records: &'a [Record],
+        svf_t: f64,
+        skip: usize,
+        hac_lags: usize,
+    ) -> Option<Self> {
+        let h = records.first()?.h;
+        let svf = Svf::new(svf_t, h);
+        let n = baseline.n();
+        let runs = records
+            .iter()
+            .map(|rec| {
+                let mut p = PrepRun {
+                    g: vec![],
+                    lam_nu: vec![],
+                    dlam_nu: vec![],
+                    lam_tau: vec![],
+                    lam_g: vec![],
+                };
+                let gs: Vec<Vec<f64>> =
+                    (0..rec.len()).map(|k| baseline.g(&rec.eta_at(k))).collect();
+                for i in 0..n {
+                    let nu = rec.nu.column(i);
+                    let l = svf.foh(nu.as_slice());
+                    p.dlam_nu.push(svf.derivative(nu.as_slice(), &l));
+                    p.lam_nu.push(l);
+                    p.lam_tau.push(svf.zoh(rec.tau.column(i).as_slice()));
+                    let g: Vec<f64> = gs.iter().map(|g| g[i]).collect();
+                    p.lam_g.push(svf.foh(&g));
+                    p.g.push(g);
+                }
+                p
+            })
+            .collect();
+        let structure = (0..n)
+            .map(|i| {
+                let mf = (0..n)
+                    .filter(|&j| baseline.m[(i, j)] != 0.0 || i == j)
+                    .collect();
+                let df = (0..n)
+                    .filter(|&j| baseline.d_bar[(i, j)] != 0.0 || i == j)
+                    .collect();
+                (mf, df)
+            })
+            .collect();
+        let mut prep = Prepared {
+            records,
+            baseline,
+            svf,
+            skip,
+            runs,
+            structure,
+            weights: vec![1.0; n],
+            kappa: 1.0,
+            hac_lags,
+        };
+        let all: Vec<usize> = (0..records.len()).collect();
+        let mut weights = vec![1.0; n];
+        for (i, w) in weights.iter_mut().enumerate() {
+            let f = prep.fit(&[], &[i], &all, false)?;
+            let s = (f.sse / f.n.max(1) as f64).sqrt();
+            *w = if s > 0.0 && s.is_finite() {
+                1.0 / s
+            } else {
+                1.0
+            };
+        }
+        prep.weights = weights;
+        let all_rows: Vec<usize> = (0..n).collect();
+        let null = prep.fit(&[], &all_rows, &all, false)?;
+        prep.kappa = long_run_inflation(&null.resid, hac_lags);
+        Some(prep)
+    }
+
+    /// Rows touched by `specs` plus `extra`, sorted.
+    pub fn rows_of(&self, specs: &[Spec], extra: &[usize]) -> Vec<usize> {
+        let mut rows: Vec<usize> = extra.to_vec();
+        for s in specs {
+            rows.extend(s.effect.rows(&self.baseline.dofs, &self.baseline.d_bar));
+        }
+        rows.sort_unstable();
+        rows.dedup();
+        rows
+    }
+
+    /// Fits `specs` jointly with the baseline entries of their rows (and of
+    /// `extra` rows) on the runs `runs`. `None` if nothing is left to fit.
+    pub fn fit(
+        &self,
+        specs: &[Spec],
+        extra: &[usize],
+        runs: &[usize],
+        hac: bool,
+    ) -> Option<FitOut> {
+        if !specs.iter().any(|s| s.effect == Effect::Current) {
+            return self.fit_with(specs, extra, runs, hac, &self.baseline.d_bar);
+        }
+        // The current acts through D̄(ν − ν_c): its regressors need the D̄
+        // being fitted. A baseline identified with the current present has a
+        // biased D̄, so iterate to the fixed point (two passes suffice).
+        let mut d = self.baseline.d_bar.clone();
+        let mut f = self.fit_with(specs, extra, runs, false, &d)?;
+        for pass in 0..3 {
+            d = self.d_bar_of(specs, &f, &d);
+            f = self.fit_with(specs, extra, runs, hac && pass == 2, &d)?;
+        }
+        Some(f)
+    }
+
+    /// D̄ with the rows and coupling entries of `f` written into `d`.
+    fn d_bar_of(&self, specs: &[Spec], f: &FitOut, d: &DMatrix<f64>) -> DMatrix<f64> {
+        let mut d = d.clone();
+        for (ri, &r) in f.rows.iter().enumerate() {
+            for (k, &j) in self.structure[r].1.iter().enumerate() {
+                d[(r, j)] = f.base[ri].1[k];
+            }
+        }
+        for (si, s) in specs.iter().enumerate() {
+            if let Effect::Coupling { dof, from } = s.effect
+                && let (Some(i), Some(j)) =
+                    (self.baseline.index_of(dof), self.baseline.index_of(from))
+            {
+                d[(i, j)] = f.theta[si][1];
+            }
+        }
+        d
+    }
+
+    fn fit_with(
+        &self,
+        specs: &[Spec],
+        extra: &[usize],
+        runs: &[usize],
+        hac: bool,
+        d_ref: &DMatrix<f64>,
+    ) -> Option<FitOut> {
+        let rows = self.rows_of(specs, extra);
+        if rows.is_empty() {
+            return None;
+        }
+        let dofs = &self.baseline.dofs;
+        let shapes: Vec<(Effect, f64)> = specs
+            .iter()
+            .filter_map(|s| s.shape.map(|v| (s.effect, v)))
+            .collect();
+        // Parameter layout: base entries of each row, then the specs' θ.
+        let mut base_index = Vec::with_capacity(rows.len());
+        let mut p = 0;
+        for &r in &rows {
+            base_index.push(p);
+            p += self.structure[r].0.len() + self.structure[r].1.len();
+        }
+        let mut theta_index = Vec::with_capacity(specs.len());
+        for s in specs {
+            theta_index.push(p);
+            p += s.effect.n_linear();
+        }
+        let ctx = TermContext {
+            dofs,
+            m_ref: &self.baseline.m,
+            d_ref,
+        };
+        let mut hmat = DMatrix::<f64>::zeros(p, p);
+        let mut bvec = vec![0.0; p];
+        let mut blocks: Vec<Block> = Vec::new();
+        let mut n_tot = 0;
+        for &run in runs {
+            let rec = &self.records[run];
+            let pr = &self.runs[run];
+            let len = rec.len();
+            if len <= self.skip + 1 {
+                continue;
+            }
+            for (ri, &r) in rows.iter().enumerate() {
+                let w = self.weights[r];
+                let dof = dofs[r];
+                // Target [λτ_a] − [λg]: the applied force depends on the
+                // actuator hypotheses of this DOF.
+                let lam_tau_a = if shapes.iter().any(|(e, _)| e.dof() == Some(dof)) {
+                    let (x, lag) = actuate(rec.tau.column(r).as_slice(), dof, &shapes);
+                    match lag {
+                        Some(t) => self.svf.foh(&lag_zoh(&x, t, rec.h)),
+                        None => self.svf.zoh(&x),
+                    }
+                } else {
+                    pr.lam_tau[r].clone()
+                };
+                let y: Vec<f64> = (self.skip..len)
+                    .map(|k| w * (lam_tau_a[k] - pr.lam_g[r][k]))
+                    .collect();
+                let mut idx = Vec::new();
+                let mut cols: Vec<Vec<f64>> = Vec::new();
+                let (mf, df) = &self.structure[r];
+                let mut q = base_index[ri];
+                for &j in mf {
+                    idx.push(q);
+                    q += 1;
+                    cols.push(pr.dlam_nu[j][self.skip..].iter().map(|x| w * x).collect());
+                }
+                for &j in df {
+                    idx.push(q);
+                    q += 1;
+                    cols.push(pr.lam_nu[j][self.skip..].iter().map(|x| w * x).collect());
+                }
+                for (si, s) in specs.iter().enumerate() {
+                    let nl = s.effect.n_linear();
+                    if nl == 0 || !s.effect.rows(dofs, &self.baseline.d_bar).contains(&r) {
+                        continue;
+                    }
+                    if let Effect::Coupling { from, .. } = s.effect {
+                        let j = dofs.iter().position(|&d| d == from)?;
+                        idx.push(theta_index[si]);
+                        cols.push(pr.dlam_nu[j][self.skip..].iter().map(|x| w * x).collect());
+                        idx.push(theta_index[si] + 1);
+                        cols.push(pr.lam_nu[j][self.skip..].iter().map(|x| w * x).collect());
+                        continue;
+                    }
+                    for pi in 0..nl {
+                        let raw: Vec<f64> = (0..len)
+                            .map(|k| {
+                                let nu: Vec<f64> = rec.nu.row(k).iter().copied().collect();
+                                s.effect.regressor(pi, r, &ctx, &nu, &rec.eta_at(k))
+                            })
+                            .collect();
+                        let f = self.svf.foh(&raw);
+                        idx.push(theta_index[si] + pi);
+                        cols.push(f[self.skip..].iter().map(|x| w * x).collect());
+                    }
+                }
+                for a in 0..idx.len() {
+                    bvec[idx[a]] += dot(&cols[a], &y);
+                    for b in a..idx.len() {
+                        let v = dot(&cols[a], &cols[b]);
+                        hmat[(idx[a], idx[b])] += v;
+                        if a != b {
+                            hmat[(idx[b], idx[a])] += v;
+                        }
+                    }
+                }
+                n_tot += y.len();
+                blocks.push((idx, cols, y));
+            }
+        }
+        if n_tot <= p {
+            return None;
+        }
+        let (theta_all, h_inv) = solve_scaled(&hmat, &bvec)?;
+        let mut sse = 0.0;
+        let mut resid = Vec::with_capacity(blocks.len());
+        for (idx, cols, y) in &blocks {
+            let e: Vec<f64> = (0..y.len())
+                .map(|k| {
+                    y[k] - idx
+                        .iter()
+                        .zip(cols)
+                        .map(|(&i, c)| theta_all[i] * c[k])
+                        .sum::<f64>()
+                })
+                .collect();
+            sse += dot(&e, &e);
+            resid.push(e);
+        }
+        let cov = hac.then(|| {
+            let mut s = DMatrix::<f64>::zeros(p, p);
+            for ((idx, cols, _), e) in blocks.iter().zip(&resid) {
+                let q = idx.len();
+                let len = e.len();
+                for l in 0..=self.hac_lags.min(len.saturating_sub(1)) {
+                    let wl = 1.0 - l as f64 / (self.hac_lags as f64 + 1.0);
+                    for a in 0..q {
+                        for b in 0..q {
+                            let mut acc = 0.0;
+                            for k in l..len {
+                                acc += cols[a][k] * e[k] * cols[b][k - l] * e[k - l];
+                            }
+                            let v = if l == 0 { acc } else { wl * acc };
+                            s[(idx[a], idx[b])] += v;
+                            if l > 0 {
+                                s[(idx[b], idx[a])] += v;
+                            }
+                        }
+                    }
+                }
+            }
+            &h_inv * s * &h_inv
+        });
+        let base = rows
+            .iter()
+            .enumerate()
+            .map(|(ri, &r)| {
+                let (mf, df) = &self.structure[r];
+                let i0 = base_index[ri];
+                (
+                    theta_all[i0..i0 + mf.len()].to_vec(),
+                    theta_all[i0 + mf.len()..i0 + mf.len() + df.len()].to_vec(),
+                )
+            })
+            .collect();
+        let theta = specs
+            .iter()
+            .zip(&theta_index)
+            .map(|(s, &i)| theta_all[i..i + s.effect.n_linear()].to_vec())
+            .collect();
+        Some(FitOut {
+            rows,
+            base,
+            theta,
+            theta_index,
+            sse,
+            n: n_tot,
+            cov,
+            resid,
+            d_ref: d_ref.clone(),
+        })
+    }
+
+    /// The augmented model of a fit: the baseline with the fitted rows
+    /// replaced, coupling entries set, and the terms attached.
+    pub fn model(&self, specs: &[Spec], f: &FitOut, shape_std: &[Option<f64>]) -> AugmentedModel {
+        let b = self.baseline;
+        let mut m = b.m.clone();
+        let mut d = b.d_bar.clone();
+        for (ri, &r) in f.rows.iter().enumerate() {
+            let (mf, df) = &self.structure[r];
+            for (k, &j) in mf.iter().enumerate() {
+                m[(r, j)] = f.base[ri].0[k];
+            }
+            for (k, &j) in df.iter().enumerate() {
+                d[(r, j)] = f.base[ri].1[k];
+            }
+        }
+        let mut terms = Vec::with_capacity(specs.len());
+        for (si, s) in specs.iter().enumerate() {
+            if let Effect::Coupling { dof, from } = s.effect
+                && let (Some(i), Some(j)) = (b.index_of(dof), b.index_of(from))
+            {
+                m[(i, j)] = f.theta[si][0];
+                d[(i, j)] = f.theta[si][1];
+            }
+            let covariance = f
+                .theta_cov(si)
+                .map(|c| {
+                    (0..c.nrows())
+                        .map(|i| c.row(i).iter().copied().collect())
+                        .collect()
+                })
+                .unwrap_or_default();
+            terms.push(ModelTerm {
+                effect: s.effect,
+                coefficients: f.theta[si].clone(),
+                covariance,
+                shape: s.shape,
+                shape_std: shape_std.get(si).copied().flatten(),
+            });
+        }
+        AugmentedModel::new(
+            b.dofs.clone(),
+            m,
+            d,
+            b.restoring,
+            b.m.clone(),
+            f.d_ref.clone(),
+            terms,
+        )
+    }
+
+    /// Pooled |τ| of one DOF over `runs`, sorted (for threshold grids).
+    pub fn abs_tau_sorted(&self, row: usize, runs: &[usize]) -> Vec<f64> {
+        let mut v: Vec<f64> = runs
+            .iter()
+            .flat_map(|&r| {
+                self.records[r]
+                    .tau
+                    .column(row)
+                    .iter()
+                    .map(|x| x.abs())
+                    .collect::<Vec<_>>()
+            })
+            .filter(|x| x.is_finite())
+            .collect();
+        v.sort_by(|a, b| a.total_cmp(b));
+        v
+    }
+}
+
+impl Prepared<'_> {
+    /// Output error of one row: the k-step-ahead prediction of ν_r from
+    /// the measured ν_r(t−k), the other velocities and η taken as measured
+    /// (linear between samples), under the fitted row of `f`. Returns the
+    /// squared-error sum and the residual runs.
+    ///
+    /// Why: an actuator lag T_a ≈ M_ii/D̄_ii with M_ii → 0 re-describes a
+    /// first-order DOF exactly, and the equation error prefers it because
+    /// it drops the noisy [sλν] regressor. Prediction error carries no such
+    /// bias, so shape parameters are profiled on it.
+    pub fn kstep_row(
+        &self,
+        specs: &[Spec],
+        f: &FitOut,
+        r: usize,
+        runs: &[usize],
+        k: usize,
+    ) -> Option<(f64, Vec<Vec<f64>>)> {
+        let ri = f.rows.iter().position(|&x| x == r)?;
+        let dofs = &self.baseline.dofs;
+        let n = dofs.len();
+        let (mf, df) = &self.structure[r];
+        let mut m_row = vec![0.0; n];
+        let mut d_row = vec![0.0; n];
+        for (q, &j) in mf.iter().enumerate() {
+            m_row[j] = f.base[ri].0[q];
+        }
+        for (q, &j) in df.iter().enumerate() {
+            d_row[j] = f.base[ri].1[q];
+        }
+        let mut terms: Vec<(Effect, Vec<f64>)> = Vec::new();
+        for (si, s) in specs.iter().enumerate() {
+            if let Effect::Coupling { dof, from } = s.effect {
+                if dofs[r] == dof {
+                    let j = dofs.iter().position(|&d| d == from)?;
+                    m_row[j] = f.theta[si][0];
+                    d_row[j] = f.theta[si][1];
+                }
+            } else if s.effect.n_linear() > 0
+                && s.effect.rows(dofs, &self.baseline.d_bar).contains(&r)
+            {
+                terms.push((s.effect, f.theta[si].clone()));
+            }
+        }
+        let mrr = m_row[r];
+        if mrr.is_nan() || mrr <= 0.0 {
+            return None;
+        }
+        let shapes: Vec<(Effect, f64)> = specs
+            .iter()
+            .filter_map(|s| s.shape.map(|v| (s.effect, v)))
+            .collect();
+        let ctx = TermContext {
+            dofs,
+            m_ref: &self.baseline.m,
+            d_ref: &f.d_ref,
+        };
+        let k = k.max(1);
+        let mut sse = 0.0;
+        let mut resid = Vec::new();
+        for &run in runs {
+            let rec = &self.records[run];
+            let pr = &self.runs[run];
+            let len = rec.len();
+            if len <= self.skip + k {
+                continue;
+            }
+            let h = rec.h;
+            let (held, lag) = actuate(rec.tau.column(r).as_slice(), dofs[r], &shapes);
+            let lag_states = lag.map(|t| lag_zoh(&held, t, h));
+            // Everything but τ_a and ν_r, at the samples (linear in between):
+            // −g_r(η) − Σ_{j≠r} (D̄_rj ν_j + M_rj [sλν_j]).
+            let ext: Vec<f64> = (0..len)
+                .map(|kk| {
+                    let mut v = -pr.g[r][kk];
+                    for j in 0..n {
+                        if j != r {
+                            v -= d_row[j] * rec.nu[(kk, j)] + m_row[j] * pr.dlam_nu[j][kk];
+                        }
+                    }
+                    v
+                })
+                .collect();
+            let d_rr = d_row[r];
+            let mut nu_buf = vec![0.0; n];
+            let mut force = |k0: usize, frac: f64, nu_r: f64, tau_a: f64| -> f64 {
+                let k1 = (k0 + 1).min(len - 1);
+                let mut fr = tau_a + ext[k0] + frac * (ext[k1] - ext[k0]) - d_rr * nu_r;
+                if !terms.is_empty() {
+                    for (j, v) in nu_buf.iter_mut().enumerate() {
+                        *v = rec.nu[(k0, j)] + frac * (rec.nu[(k1, j)] - rec.nu[(k0, j)]);
+                    }
+                    nu_buf[r] = nu_r;
+                    let eta: [f64; 6] = std::array::from_fn(|j| {
+                        rec.eta[(k0, j)] + frac * (rec.eta[(k1, j)] - rec.eta[(k0, j)])
+                    });
+                    for (e, th) in &terms {
+                        for (p, c) in th.iter().enumerate() {
+                            fr -= c * e.regressor(p, r, &ctx, &nu_buf, &eta);
+                        }
+                    }
+                }
+                fr / mrr
+            };
+            let mut e = Vec::with_capacity(len - self.skip);
+            // Every other start point: neighbouring k-step errors share
+            // k − 1 steps, so little information is lost for half the cost.
+            for t in (self.skip..len).step_by(2) {
+                let s0 = t - k;
+                let mut x = rec.nu[(s0, r)];
+                let mut a = lag_states.as_ref().map_or(0.0, |l| l[s0]);
+                for (step, &u) in held.iter().enumerate().take(t).skip(s0) {
+                    let ta = lag.unwrap_or(1.0);
+                    let da = |a: f64| if lag.is_some() { (u - a) / ta } else { 0.0 };
+                    let tau = |a: f64| if lag.is_some() { a } else { u };
+                    let k1x = force(step, 0.0, x, tau(a));
+                    let k1a = da(a);
+                    let k2x = force(step, 0.5, x + 0.5 * h * k1x, tau(a + 0.5 * h * k1a));
+                    let k2a = da(a + 0.5 * h * k1a);
+                    let k3x = force(step, 0.5, x + 0.5 * h * k2x, tau(a + 0.5 * h * k2a));
+                    let k3a = da(a + 0.5 * h * k2a);
+                    let k4x = force(step, 1.0, x + h * k3x, tau(a + h * k3a));
+                    let k4a = da(a + h * k3a);
+                    x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+                    a += h / 6.0 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a);
+                }
+                if !x.is_finite() {
+                    return None;
+                }
+                let err = rec.nu[(t, r)] - x;
+                sse += err * err;
+                e.push(err);
+            }
+            resid.push(e);
+        }
+        Some((sse, resid))
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Solves H θ = b with Jacobi scaling (columns span forces of 10⁴ N and
+/// velocities of 10⁻² m/s); returns θ and H⁻¹.
+fn solve_scaled(h: &DMatrix<f64>, b: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>)> {
+    let p = h.nrows();
+    let s: Vec<f64> = (0..p)
+        .map(|i| {
+            let d = h[(i, i)];
+            if d > 0.0 { 1.0 / d.sqrt() } else { 1.0 }
+        })
+        .collect();
+    let mut hs = DMatrix::from_fn(p, p, |i, j| h[(i, j)] * s[i] * s[j]);
+    let bs = nalgebra::DVector::from_fn(p, |i, _| b[i] * s[i]);
+    let inv = match hs.clone().cholesky() {
+        Some(c) => c.inverse(),
+        None => {
+            for i in 0..p {
+                hs[(i, i)] += 1e-10;
+            }
+            hs.clone().pseudo_inverse(1e-12).ok()?
+        }
+    };
+    let z = &inv * bs;
+    let theta: Vec<f64> = (0..p).map(|i| z[i] * s[i]).collect();
+    if theta.iter().any(|x| !x.is_finite()) {
+        return None;
+    }
+    let h_inv = DMatrix::from_fn(p, p, |i, j| inv[(i, j)] * s[i] * s[j]);
+    Some((theta, h_inv))
+}
+
+/// κ = 1 + 2 Σ_l (1 − l/(L+1)) ρ(l) of residual blocks (the factor by which
+/// correlated residuals shrink the effective sample count), ≥ 1.
+pub(crate) fn long_run_inflation(blocks: &[Vec<f64>], lags: usize) -> f64 {
+    let mut r0 = 0.0;
+    let mut rl = vec![0.0; lags + 1];
+    for e in blocks {
+        r0 += dot(e, e);
+        for (l, acc) in rl.iter_mut().enumerate().skip(1) {
+            if l < e.len() {
+                *acc += dot(&e[l..], &e[..e.len() - l]);
+            }
+        }
+    }
+    if r0 <= 0.0 {
+        return 1.0;
+    }
+    let k = 1.0
+        + 2.0
+            * (1..=lags)
+                .map(|l| (1.0 - l as f64 / (lags as f64 + 1.0)) * rl[l] / r0)
+                .sum::<f64>();
+    k.max(1.0)
+}
+
+/// A profile search over a shape parameter on the k-step prediction error
+/// of its row ([`Prepared::kstep_row`]): the grid minimum, refined by
+/// golden section between its neighbours when `continuous`, with a standard
+/// deviation from the curvature of the SSE (Δχ² = 1 at ΔSSE = κσ²).
+pub(crate) struct Profile {
+    pub value: f64,
+    pub fit: FitOut,
+    pub std: Option<f64>,
+    /// k-step prediction SSE of the row at the optimum.
+    pub sse: f64,
+    /// Predicted samples.
+    pub n: usize,
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn profile(
+    prep: &Prepared<'_>,
+    chosen: &[Spec],
+    effect: Effect,
+    extra: &[usize],
+    runs: &[usize],
+    grid: &[f64],
+    continuous: bool,
+    k: usize,
+) -> Option<Profile> {
+    let row = *extra.first()?;
+    let specs_at = |v: f64| {
+        let mut specs = chosen.to_vec();
+        specs.push(Spec {
+            effect,
+            shape: Some(v),
+        });
+        specs
+    };
+    let eval = |v: f64| -> Option<FitOut> { prep.fit(&specs_at(v), extra, runs, false) };
+    let sse = |v: f64| {
+        eval(v)
+            .and_then(|f| prep.kstep_row(&specs_at(v), &f, row, runs, k))
+            .map_or(f64::INFINITY, |x| x.0)
+    };
+    let values: Vec<f64> = grid.iter().map(|&g| sse(g)).collect();
+    let (ib, _) = values
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))?;
+    let mut best = grid[ib];
+    if continuous && grid.len() >= 3 {
+        // Golden section in log space (parameters are positive scales).
+        let lo = grid[ib.saturating_sub(1)].ln();
+        let hi = grid[(ib + 1).min(grid.len() - 1)].ln();
+        let (mut a, mut b) = (lo, hi);
+        let r = 0.618_033_988_749_895;
+        let mut c = b - r * (b - a);
+        let mut d = a + r * (b - a);
+        let (mut fc, mut fd) = (sse(c.exp()), sse(d.exp()));
+        for _ in 0..6 {
+            if fc < fd {
+                b = d;
+                d = c;
+                fd = fc;
+                c = b - r * (b - a);
+                fc = sse(c.exp());
+            } else {
+                a = c;
+                c = d;
+                fc = fd;
+                d = a + r * (b - a);
+                fd = sse(d.exp());
+            }
+        }
+        let cand = if fc < fd { c.exp() } else { d.exp() };
+        if sse(cand) < values[ib] {
+            best = cand;
+        }
+    }
+    let fit = eval(best)?;
+    let (s0, resid) = prep.kstep_row(&specs_at(best), &fit, row, runs, k)?;
+    let delta = if continuous {
+        0.03 * best.abs().max(1e-9)
+    } else {
+        1.0
+    };
+    let (sm, sp) = (sse(best - delta), sse(best + delta));
+    let curv = (sp - 2.0 * s0 + sm) / (delta * delta);
+    let n: usize = resid.iter().map(Vec::len).sum();
+    let kappa = long_run_inflation(&resid, prep.hac_lags.max(2 * k));
+    let sigma2 = s0 / n.max(1) as f64;
+    let std = (curv > 0.0 && sm.is_finite() && sp.is_finite())
+        .then(|| (2.0 * sigma2 * kappa / curv).sqrt());
+    Some(Profile {
+        value: best,
+        fit,
+        std,
+        sse: s0,
+        n,
+    })
+}

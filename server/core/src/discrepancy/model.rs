@@ -1,0 +1,417 @@
+//! The augmented model: the baseline M ν̇ + D̄ ν = τ_a − g(η) plus the chosen
+//! terms, with its simulator (free run) and k-step predictor on recorded
+//! inputs. η is taken from the record (as γ = τ − g(η) is in the thesis),
+//! so the model is driven by (τ_c, η) and predicts ν.
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use super::candidates::{Effect, ShapeKind, TermContext};
+use super::data::{Baseline, Record, Restoring};
+use super::svf::lag_zoh;
+use crate::planning::Dof;
+use crate::validation::{Predictor, ValidationRecord};
+
+/// One term of the augmented model with its estimates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct ModelTerm {
+    /// The effect.
+    pub effect: Effect,
+    /// Linear coefficients θ (see [`Effect::coefficient_names`]).
+    pub coefficients: Vec<f64>,
+    /// Covariance of θ (HAC, row-major), same order.
+    pub covariance: Vec<Vec<f64>>,
+    /// Shape parameter of an actuator effect: T_a (s), delay (samples),
+    /// τ_max or δ (N, N·m).
+    pub shape: Option<f64>,
+    /// Standard deviation of the shape parameter from the profile's curvature.
+    pub shape_std: Option<f64>,
+}
+
+/// Baseline plus chosen terms.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AugmentedModel {
+    /// Modeled DOFs.
+    pub dofs: Vec<Dof>,
+    /// M, with refitted rows and coupling entries.
+    pub m: DMatrix<f64>,
+    /// D̄, with refitted rows and coupling entries.
+    pub d_bar: DMatrix<f64>,
+    /// g(η) of the baseline.
+    pub restoring: Restoring,
+    /// M that C(ν) of a Coriolis term is built from (the baseline's).
+    pub m_ref: DMatrix<f64>,
+    /// D̄ the current acts through (the baseline's).
+    pub d_ref: DMatrix<f64>,
+    /// The added terms.
+    pub terms: Vec<ModelTerm>,
+    m_inv: DMatrix<f64>,
+}
+
+/// The input the vessel actually feels, per DOF: the held command after
+/// delay, saturation and dead zone, and the time constant of a lag after it.
+pub(crate) struct AppliedInput {
+    pub held: Vec<Vec<f64>>,
+    pub lag: Vec<Option<f64>>,
+}
+
+/// Applies the static actuator effects (delay → saturation → dead zone)
+/// of `terms` to the command `tau` of DOF `dof`; returns the lag, if any.
+pub(crate) fn actuate(tau: &[f64], dof: Dof, shapes: &[(Effect, f64)]) -> (Vec<f64>, Option<f64>) {
+    let mut x = tau.to_vec();
+    let mut lag = None;
+    let mine = shapes.iter().filter(|(e, _)| e.dof() == Some(dof));
+    let mut delay = None;
+    let mut sat = None;
+    let mut dz = None;
+    for (e, v) in mine {
+        match e.shape() {
+            Some(ShapeKind::DelaySamples) => delay = Some(v.round().max(0.0) as usize),
+            Some(ShapeKind::SaturationLevel) => sat = Some(v.abs()),
+            Some(ShapeKind::DeadZoneWidth) => dz = Some(v.abs()),
+            Some(ShapeKind::LagTime) => lag = Some(v.max(1e-6)),
+            None => {}
+        }
+    }
+    if let Some(d) = delay.filter(|&d| d > 0) {
+        let first = x.first().copied().unwrap_or(0.0);
+        x = (0..tau.len())
+            .map(|k| if k >= d { tau[k - d] } else { first })
+            .collect();
+    }
+    if let Some(l) = sat {
+        x.iter_mut().for_each(|v| *v = v.clamp(-l, l));
+    }
+    if let Some(w) = dz {
+        x.iter_mut().for_each(|v| {
+            *v = if v.abs() <= w {
+                0.0
+            } else {
+                *v - w * v.signum()
+            };
+        });
+    }
+    (x, lag)
+}
+
+impl AugmentedModel {
+    /// The baseline alone.
+    pub fn from_baseline(b: &Baseline) -> Self {
+        Self::new(
+            b.dofs.clone(),
+            b.m.clone(),
+            b.d_bar.clone(),
+            b.restoring,
+            b.m.clone(),
+            b.d_bar.clone(),
+            vec![],
+        )
+    }
+
+    /// A model from its parts (M must be invertible; a singular M is
+    /// replaced by its diagonal so simulation never panics).
+    pub fn new(
+        dofs: Vec<Dof>,
+        m: DMatrix<f64>,
+        d_bar: DMatrix<f64>,
+        restoring: Restoring,
+        m_ref: DMatrix<f64>,
+        d_ref: DMatrix<f64>,
+        terms: Vec<ModelTerm>,
+    ) -> Self {
+        let m_inv = m.clone().try_inverse().unwrap_or_else(|| {
+            DMatrix::from_diagonal(&m.diagonal().map(|x| if x != 0.0 { 1.0 / x } else { 0.0 }))
+        });
+        AugmentedModel {
+            dofs,
+            m,
+            d_bar,
+            restoring,
+            m_ref,
+            d_ref,
+            terms,
+            m_inv,
+        }
+    }
+
+    fn ctx(&self) -> TermContext<'_> {
+        TermContext {
+            dofs: &self.dofs,
+            m_ref: &self.m_ref,
+            d_ref: &self.d_ref,
+        }
+    }
+
+    fn shapes(&self) -> Vec<(Effect, f64)> {
+        self.terms
+            .iter()
+            .filter_map(|t| t.shape.map(|s| (t.effect, s)))
+            .collect()
+    }
+
+    pub(crate) fn applied_input(&self, rec: &Record) -> AppliedInput {
+        let shapes = self.shapes();
+        let mut held = Vec::with_capacity(self.dofs.len());
+        let mut lag = Vec::with_capacity(self.dofs.len());
+        for (i, &d) in self.dofs.iter().enumerate() {
+            let (x, l) = actuate(rec.tau.column(i).as_slice(), d, &shapes);
+            held.push(x);
+            lag.push(l);
+        }
+        AppliedInput { held, lag }
+    }
+
+    /// ν̇ from (ν, τ_a, η): M⁻¹(τ_a − g(η) − D̄ν − Σθφ(ν, η)).
+    fn nu_dot(&self, nu: &[f64], tau_a: &[f64], g: &[f64], eta: &[f64; 6], out: &mut [f64]) {
+        let n = self.dofs.len();
+        let ctx = self.ctx();
+        let mut f: Vec<f64> = (0..n)
+            .map(|i| {
+                let damping: f64 = nu
+                    .iter()
+                    .enumerate()
+                    .map(|(j, v)| self.d_bar[(i, j)] * v)
+                    .sum();
+                tau_a[i] - g[i] - damping
+            })
+            .collect();
+        for t in &self.terms {
+            if matches!(t.effect, Effect::Coupling { .. }) || t.coefficients.is_empty() {
+                continue;
+            }
+            for (i, fi) in f.iter_mut().enumerate() {
+                for (p, c) in t.coefficients.iter().enumerate() {
+                    *fi -= c * t.effect.regressor(p, i, &ctx, nu, eta);
+                }
+            }
+        }
+        for (i, o) in out.iter_mut().enumerate().take(n) {
+            *o = f
+                .iter()
+                .enumerate()
+                .map(|(j, fj)| self.m_inv[(i, j)] * fj)
+                .sum();
+        }
+    }
+
+    /// Runs the model from `nu0` (and lag states `lag0`) over samples
+    /// `start..end` of the record; returns ν at samples start+1..=end.
+    #[allow(clippy::too_many_arguments)]
+    fn run(
+        &self,
+        rec: &Record,
+        input: &AppliedInput,
+        start: usize,
+        end: usize,
+        nu0: &[f64],
+        lag0: &[f64],
+        out: &mut Vec<Vec<f64>>,
+    ) {
+        let n = self.dofs.len();
+        let lag_dofs: Vec<usize> = (0..n).filter(|&i| input.lag[i].is_some()).collect();
+        let mut x: Vec<f64> = nu0.to_vec();
+        x.extend(lag_dofs.iter().map(|&i| lag0[i]));
+        let mut u = vec![0.0; n];
+        let len = rec.len();
+        let dim = x.len();
+        let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (
+            vec![0.0; dim],
+            vec![0.0; dim],
+            vec![0.0; dim],
+            vec![0.0; dim],
+            vec![0.0; dim],
+        );
+        for k in start..end {
+            // η is recorded: linear between samples, so restoring and
+            // heading-dependent terms move within the step as they do at sea.
+            let e0 = rec.eta_at(k);
+            let e1 = rec.eta_at((k + 1).min(len - 1));
+            let eta_at =
+                |frac: f64| -> [f64; 6] { std::array::from_fn(|j| e0[j] + frac * (e1[j] - e0[j])) };
+            let etas = [eta_at(0.0), eta_at(0.5), eta_at(1.0)];
+            let gs: Vec<Vec<f64>> = etas
+                .iter()
+                .map(|e| {
+                    let g = self.restoring.g(e);
+                    self.dofs.iter().map(|d| g[d.index()]).collect()
+                })
+                .collect();
+            for (i, ui) in u.iter_mut().enumerate() {
+                *ui = input.held[i][k];
+            }
+            let f = |x: &[f64], stage: usize, dx: &mut [f64]| {
+                let mut tau_a = u.clone();
+                for (s, &i) in lag_dofs.iter().enumerate() {
+                    let t_a = input.lag[i].unwrap_or(1.0);
+                    tau_a[i] = x[n + s];
+                    dx[n + s] = (u[i] - x[n + s]) / t_a;
+                }
+                self.nu_dot(&x[..n], &tau_a, &gs[stage], &etas[stage], &mut dx[..n]);
+            };
+            let h = rec.h;
+            f(&x, 0, &mut k1);
+            for i in 0..dim {
+                tmp[i] = x[i] + 0.5 * h * k1[i];
+            }
+            f(&tmp, 1, &mut k2);
+            for i in 0..dim {
+                tmp[i] = x[i] + 0.5 * h * k2[i];
+            }
+            f(&tmp, 1, &mut k3);
+            for i in 0..dim {
+                tmp[i] = x[i] + h * k3[i];
+            }
+            f(&tmp, 2, &mut k4);
+            for i in 0..dim {
+                x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+            if x.iter().any(|v| !v.is_finite()) {
+                // A diverging candidate: restart from rest rather than overflow.
+                x.iter_mut().for_each(|v| *v = 0.0);
+            }
+            out.push(x[..n].to_vec());
+        }
+    }
+
+    fn lag_states(&self, input: &AppliedInput, h: f64) -> Vec<Option<Vec<f64>>> {
+        input
+            .lag
+            .iter()
+            .zip(&input.held)
+            .map(|(l, x)| l.map(|t| lag_zoh(x, t, h)))
+            .collect()
+    }
+
+    /// Free-run simulation from the recorded ν(0) (thesis eq. 2.20–2.21),
+    /// N × n.
+    pub fn simulate(&self, rec: &Record) -> DMatrix<f64> {
+        let n = self.dofs.len();
+        let len = rec.len();
+        let input = self.applied_input(rec);
+        let nu0: Vec<f64> = (0..n).map(|i| rec.nu[(0, i)]).collect();
+        let lag0: Vec<f64> = input.held.iter().map(|x| x[0]).collect();
+        let mut rows = vec![nu0.clone()];
+        if len > 1 {
+            self.run(rec, &input, 0, len - 1, &nu0, &lag0, &mut rows);
+        }
+        DMatrix::from_fn(len, n, |k, i| rows[k][i])
+    }
+
+    /// k-step-ahead prediction ν̂(t | t−k) from the measured ν(t−k); rows
+    /// t < k are NaN.
+    pub fn predict_k_step(&self, rec: &Record, k: usize) -> DMatrix<f64> {
+        let n = self.dofs.len();
+        let len = rec.len();
+        let k = k.max(1);
+        let input = self.applied_input(rec);
+        let lags = self.lag_states(&input, rec.h);
+        let mut out = DMatrix::from_element(len, n, f64::NAN);
+        let mut buf = Vec::with_capacity(k);
+        for t in k..len {
+            let s = t - k;
+            let nu0: Vec<f64> = (0..n).map(|i| rec.nu[(s, i)]).collect();
+            let lag0: Vec<f64> = lags
+                .iter()
+                .map(|l| l.as_ref().map_or(0.0, |v| v[s]))
+                .collect();
+            buf.clear();
+            self.run(rec, &input, s, t, &nu0, &lag0, &mut buf);
+            for i in 0..n {
+                out[(t, i)] = buf[k - 1][i];
+            }
+        }
+        out
+    }
+}
+
+/// The augmented model as a [`Predictor`]: a record's `u` holds [τ | η]
+/// (n + 6 columns), `y` holds ν.
+impl Predictor for AugmentedModel {
+    fn output_names(&self) -> Vec<String> {
+        self.dofs
+            .iter()
+            .map(|d| d.velocity_symbol().to_string())
+            .collect()
+    }
+
+    fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {
+        match to_record(self.dofs.len(), rec) {
+            Some(r) => AugmentedModel::predict_k_step(self, &r, k),
+            None => DMatrix::from_element(rec.y.nrows(), self.dofs.len(), f64::NAN),
+        }
+    }
+
+    fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
+        match to_record(self.dofs.len(), rec) {
+            Some(r) => AugmentedModel::simulate(self, &r),
+            None => DMatrix::from_element(rec.y.nrows(), self.dofs.len(), f64::NAN),
+        }
+    }
+}
+
+fn to_record(n: usize, rec: &ValidationRecord<'_>) -> Option<Record> {
+    if rec.u.ncols() != n + 6 || rec.y.ncols() != n || rec.u.nrows() != rec.y.nrows() {
+        return None;
+    }
+    Some(Record {
+        name: String::new(),
+        h: rec.h,
+        tau: rec.u.columns(0, n).into_owned(),
+        nu: rec.y.clone(),
+        eta: rec.u.columns(n, 6).into_owned(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn actuator_chain_delays_clips_and_kills_small_commands() {
+        let tau = [0.0, 1.0, 3.0, -3.0, 0.5];
+        let d = Dof::Surge;
+        let (x, _) = actuate(&tau, d, &[(Effect::InputDelay { dof: d }, 1.0)]);
+        assert_eq!(x, vec![0.0, 0.0, 1.0, 3.0, -3.0]);
+        let (x, _) = actuate(&tau, d, &[(Effect::Saturation { dof: d }, 2.0)]);
+        assert_eq!(x, vec![0.0, 1.0, 2.0, -2.0, 0.5]);
+        let (x, _) = actuate(&tau, d, &[(Effect::DeadZone { dof: d }, 0.8)]);
+        assert_eq!(x[4], 0.0);
+        assert!((x[2] - 2.2).abs() < 1e-12 && (x[3] + 2.2).abs() < 1e-12);
+        let (_, lag) = actuate(&tau, Dof::Sway, &[(Effect::ActuatorLag { dof: d }, 0.4)]);
+        assert!(lag.is_none(), "a surge lag must not act on sway");
+    }
+
+    #[test]
+    fn first_order_dof_matches_its_exponential_and_k_step_is_exact() {
+        // m u̇ + d u = X with a step: u = X/d (1 − e^{−t d/m}).
+        let (m, d, x) = (100.0, 50.0, 10.0);
+        let b = Baseline {
+            dofs: vec![Dof::Surge],
+            m: DMatrix::from_element(1, 1, m),
+            d_bar: DMatrix::from_element(1, 1, d),
+            restoring: Restoring::default(),
+        };
+        let n = 60;
+        let h = 0.1;
+        let nu = DMatrix::from_fn(n, 1, |k, _| x / d * (1.0 - (-(k as f64) * h * d / m).exp()));
+        let rec = Record {
+            name: "step".into(),
+            h,
+            tau: DMatrix::from_element(n, 1, x),
+            nu: nu.clone(),
+            eta: DMatrix::zeros(n, 6),
+        };
+        let model = AugmentedModel::from_baseline(&b);
+        let sim = model.simulate(&rec);
+        let k5 = model.predict_k_step(&rec, 5);
+        for k in 0..n {
+            assert!((sim[(k, 0)] - nu[(k, 0)]).abs() < 1e-7);
+            if k >= 5 {
+                assert!((k5[(k, 0)] - nu[(k, 0)]).abs() < 1e-7);
+            } else {
+                assert!(k5[(k, 0)].is_nan());
+            }
+        }
+    }
+}

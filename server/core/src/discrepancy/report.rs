@@ -1,0 +1,204 @@
+//! The discovery report: what a control engineer reads and a web page
+//! plots. Every public type is serde-serializable.
+
+use serde::{Deserialize, Serialize};
+
+use super::candidates::{Effect, Family};
+use super::data::Restoring;
+use super::experiment::ExperimentProposal;
+use super::locate::LocationReport;
+use super::model::ModelTerm;
+use super::residual::{BandPower, Whiteness};
+use crate::planning::Dof;
+
+/// A coefficient estimate with its uncertainty.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct Estimate {
+    /// Name and unit.
+    pub name: String,
+    /// Estimate.
+    pub value: f64,
+    /// Standard deviation (HAC, or profile curvature for shapes); NaN if
+    /// unavailable.
+    pub std: f64,
+}
+
+/// Whether a hypothesis made it into the model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Chosen: significant and improves held-out simulations.
+    Chosen,
+    /// Significant in the equation but no better on held-out runs.
+    NotConfirmed,
+    /// Not significant.
+    NotSignificant,
+}
+
+/// One tested hypothesis (first selection step, plus every chosen term).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct HypothesisReport {
+    /// The effect.
+    pub effect: Effect,
+    /// Its family.
+    pub family: Family,
+    /// Label in words.
+    pub label: String,
+    /// Selection step it was scored in (1 = on the baseline alone).
+    pub step: usize,
+    /// Linear coefficients.
+    pub coefficients: Vec<Estimate>,
+    /// Shape parameter of an actuator effect.
+    pub shape: Option<Estimate>,
+    /// ΔBIC against the model without it (negative favours it).
+    pub delta_bic: f64,
+    /// Significance: Wald z of the coefficients (HAC), or √LR for a shape.
+    pub z: f64,
+    /// Held-out free-run fit gained, summed over channels (if evaluated).
+    pub cv_gain: Option<f64>,
+    /// Outcome.
+    pub verdict: Verdict,
+}
+
+/// A chosen term in words.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct Finding {
+    /// The effect.
+    pub effect: Effect,
+    /// Label.
+    pub label: String,
+    /// DOFs whose equations it enters.
+    pub dofs: Vec<Dof>,
+    /// Coefficients ± std.
+    pub coefficients: Vec<Estimate>,
+    /// Shape parameter ± std.
+    pub shape: Option<Estimate>,
+    /// What it does, in plain words.
+    pub effect_text: String,
+    /// The evidence, one sentence each.
+    pub evidence: Vec<String>,
+}
+
+/// NRMSE fits of one channel (thesis eq. 1.13).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct Fits {
+    /// 1-step prediction.
+    pub one_step: Option<f64>,
+    /// k-step prediction.
+    pub k_step: Option<f64>,
+    /// Free-run simulation.
+    pub free_run: Option<f64>,
+}
+
+/// Before/after on the validation runs for one channel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct ChannelComparison {
+    /// The DOF.
+    pub dof: Dof,
+    /// Baseline fits (mean over validation runs).
+    pub before: Fits,
+    /// Augmented-model fits.
+    pub after: Fits,
+    /// 1-step residual whiteness, baseline.
+    pub whiteness_before: Whiteness,
+    /// 1-step residual whiteness, augmented model.
+    pub whiteness_after: Whiteness,
+}
+
+/// A decimated before/after series for plotting.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct PlotSeries {
+    /// Run name.
+    pub run: String,
+    /// DOF.
+    pub dof: Dof,
+    /// Time (s).
+    pub t: Vec<f64>,
+    /// Measured ν_i.
+    pub measured: Vec<f64>,
+    /// Baseline free run.
+    pub before: Vec<f64>,
+    /// Augmented free run.
+    pub after: Vec<f64>,
+}
+
+/// Two hypotheses the data cannot tell apart.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct Ambiguity {
+    /// The chosen one.
+    pub chosen: Effect,
+    /// Its look-alike.
+    pub alternative: Effect,
+    /// Held-out gains of both.
+    pub cv_gains: [f64; 2],
+    /// In words.
+    pub text: String,
+    /// The run that separates them, if a vessel profile was given.
+    pub experiment: Option<ExperimentProposal>,
+}
+
+/// Structure no candidate explains.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct Unexplained {
+    /// The DOF.
+    pub dof: Dof,
+    /// The band and its excess over the noise floor.
+    pub band: BandPower,
+    /// Low-frequency slope of the residual PSD.
+    pub low_slope: f64,
+    /// Spectral signature in words.
+    pub signature: String,
+    /// The sentence.
+    pub text: String,
+}
+
+/// The augmented model as numbers (row-major matrices).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct ModelReport {
+    /// DOFs.
+    pub dofs: Vec<Dof>,
+    /// M.
+    pub m: Vec<Vec<f64>>,
+    /// D̄.
+    pub d_bar: Vec<Vec<f64>>,
+    /// g(η).
+    pub restoring: Restoring,
+    /// Added terms with coefficients and covariances.
+    pub terms: Vec<ModelTerm>,
+}
+
+/// Everything discovery found.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct DiscoveryReport {
+    /// Modeled DOFs.
+    pub dofs: Vec<Dof>,
+    /// The story in a few sentences.
+    pub summary: Vec<String>,
+    /// Where baseline and recordings part.
+    pub location: LocationReport,
+    /// Tested hypotheses, best first.
+    pub hypotheses: Vec<HypothesisReport>,
+    /// Chosen terms, in the order chosen.
+    pub findings: Vec<Finding>,
+    /// The augmented model.
+    pub model: ModelReport,
+    /// Before/after on validation runs, per channel.
+    pub validation: Vec<ChannelComparison>,
+    /// Before/after series of the first validation run.
+    pub plots: Vec<PlotSeries>,
+    /// Look-alikes the data cannot separate, with the deciding experiment.
+    pub ambiguities: Vec<Ambiguity>,
+    /// Structure left unexplained.
+    pub unexplained: Vec<Unexplained>,
+}

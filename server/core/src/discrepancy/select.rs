@@ -1,0 +1,256 @@
+//! Hypothesis tests and forward selection.
+//!
+//! Each candidate is fitted as an augmentation of the current model
+//! (equation error, baseline rows refitted) and scored three ways:
+//! - the significance of its coefficients (Wald z from the HAC covariance;
+//!   for a shape parameter, z = √LR of the profile),
+//! - ΔBIC with the effective sample count N/κ of correlated residuals,
+//! - the cross-validated free-run NRMSE fit (thesis eq. 1.13) on runs left
+//!   out of the fit, against the same model without the candidate.
+//!
+//! Selection is greedy: the best cross-validated candidate among the
+//! significant ones joins, until none improves the held-out fit. The
+//! equation-error statistics only screen; held-out simulation decides, so
+//! a term that fits noise in the equation but not the vessel never joins.
+
+use super::candidates::{Effect, ShapeKind};
+use super::data::Record;
+use super::fit::{FitOut, Prepared, Spec, profile};
+use crate::validation::nrmse_fit;
+
+/// Thresholds of the selection.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Criteria {
+    pub min_z: f64,
+    pub max_delta_bic: f64,
+    pub min_cv_gain: f64,
+    pub cv_candidates: usize,
+    pub max_lag_s: f64,
+    pub max_delay_samples: usize,
+    pub k_step: usize,
+}
+
+/// A candidate fitted on top of the chosen terms.
+#[derive(Debug, Clone)]
+pub(crate) struct Scored {
+    pub spec: Spec,
+    pub fit: FitOut,
+    pub shape_std: Option<f64>,
+    pub delta_bic: f64,
+    pub z: f64,
+    pub cv_gain: Option<f64>,
+}
+
+impl Scored {
+    /// Index of this candidate's spec in its fit (the last one).
+    pub fn own(&self) -> usize {
+        self.fit.theta.len() - 1
+    }
+
+    /// Passes the equation-error screen.
+    pub fn significant(&self, c: &Criteria) -> bool {
+        self.z >= c.min_z && self.delta_bic <= c.max_delta_bic
+    }
+}
+
+/// Shape grid of an actuator effect over the data of its DOF.
+fn shape_grid(prep: &Prepared<'_>, effect: Effect, runs: &[usize], c: &Criteria) -> Vec<f64> {
+    let h = prep.records[0].h;
+    let row = effect
+        .dof()
+        .and_then(|d| prep.baseline.index_of(d))
+        .unwrap_or(0);
+    let quantiles = |qs: &[f64]| -> Vec<f64> {
+        let v = prep.abs_tau_sorted(row, runs);
+        let mut g: Vec<f64> = qs
+            .iter()
+            .filter_map(|q| v.get(((v.len() as f64 - 1.0) * q) as usize).copied())
+            .filter(|x| *x > 0.0)
+            .collect();
+        g.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
+        g
+    };
+    match effect.shape() {
+        Some(ShapeKind::LagTime) => {
+            let (lo, hi) = (0.5 * h, c.max_lag_s.max(h));
+            let k = 9;
+            (0..k)
+                .map(|i| lo * (hi / lo).powf(i as f64 / (k - 1) as f64))
+                .collect()
+        }
+        Some(ShapeKind::DelaySamples) => (1..=c.max_delay_samples).map(|d| d as f64).collect(),
+        Some(ShapeKind::SaturationLevel) => {
+            quantiles(&[0.3, 0.4, 0.5, 0.6, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95, 0.98])
+        }
+        Some(ShapeKind::DeadZoneWidth) => quantiles(&[0.02, 0.05, 0.1, 0.15, 0.2, 0.3]),
+        None => vec![],
+    }
+}
+
+/// Fits `effect` on top of `chosen` over `runs`, with its statistics
+/// against `chosen` alone refitted on the same rows.
+pub(crate) fn score(
+    prep: &Prepared<'_>,
+    chosen: &[Spec],
+    effect: Effect,
+    runs: &[usize],
+    c: &Criteria,
+) -> Option<Scored> {
+    let rows = effect.rows(&prep.baseline.dofs, &prep.baseline.d_bar);
+    if rows.is_empty() {
+        return None;
+    }
+    let null = prep.fit(chosen, &rows, runs, false)?;
+    if effect.shape().is_some() {
+        let grid = shape_grid(prep, effect, runs, c);
+        if grid.is_empty() {
+            return None;
+        }
+        let continuous = effect.shape() != Some(ShapeKind::DelaySamples);
+        let k = c.k_step.min(4);
+        let p = profile(prep, chosen, effect, &rows, runs, &grid, continuous, k)?;
+        // Output-error statistics against the chosen terms alone.
+        let (s0, r0) = prep.kstep_row(chosen, &null, rows[0], runs, k)?;
+        let kappa = super::fit::long_run_inflation(&r0, prep.hac_lags.max(2 * k));
+        let n_eff = (p.n as f64 / kappa).max(2.0);
+        let lr = n_eff * (s0 / p.sse.max(f64::MIN_POSITIVE)).ln();
+        return Some(Scored {
+            spec: Spec {
+                effect,
+                shape: Some(p.value),
+            },
+            fit: p.fit,
+            shape_std: p.std,
+            delta_bic: -lr + n_eff.ln(),
+            z: lr.max(0.0).sqrt(),
+            cv_gain: None,
+        });
+    }
+    let spec = Spec {
+        effect,
+        shape: None,
+    };
+    let mut specs = chosen.to_vec();
+    specs.push(spec);
+    let fit = prep.fit(&specs, &rows, runs, true)?;
+    let n_eff = (fit.n as f64 / prep.kappa).max(2.0);
+    let k = effect.n_linear().max(1) as f64;
+    let lr = n_eff * (null.sse / fit.sse.max(f64::MIN_POSITIVE)).ln();
+    let delta_bic = -lr + k * n_eff.ln();
+    let z = if effect.n_linear() > 0 {
+        let s = fit.theta.len() - 1;
+        let th = nalgebra::DVector::from_vec(fit.theta[s].clone());
+        match fit.theta_cov(s).and_then(|cv| cv.try_inverse()) {
+            Some(inv) => (th.transpose() * inv * &th)[(0, 0)].max(0.0).sqrt(),
+            None => 0.0,
+        }
+    } else {
+        lr.max(0.0).sqrt()
+    };
+    Some(Scored {
+        spec,
+        fit,
+        shape_std: None,
+        delta_bic,
+        z,
+        cv_gain: None,
+    })
+}
+
+/// Free-run NRMSE fits of `model` on `rec` for the channels `rows`.
+pub(crate) fn free_run_fits(
+    model: &super::model::AugmentedModel,
+    rec: &Record,
+    rows: &[usize],
+) -> Vec<f64> {
+    let sim = model.simulate(rec);
+    rows.iter()
+        .map(|&r| nrmse_fit(rec.nu.column(r).as_slice(), sim.column(r).as_slice()).unwrap_or(0.0))
+        .collect()
+}
+
+/// Held-out gain in free-run fit of adding `cand` to `chosen`
+/// (leave-one-run-out over `runs`): the sum over all channels of the fit
+/// gained, averaged over folds — a term that helps several DOFs at once
+/// counts for all of them. Both models are refitted on each training set.
+pub(crate) fn cv_gain(
+    prep: &Prepared<'_>,
+    chosen: &[Spec],
+    cand: &Scored,
+    runs: &[usize],
+) -> Option<f64> {
+    let rows = prep.rows_of(&[cand.spec], &[]);
+    let all_rows = prep.rows_of(chosen, &rows);
+    let channels: Vec<usize> = (0..prep.baseline.n()).collect();
+    let mut with = chosen.to_vec();
+    with.push(cand.spec);
+    let mut gains = Vec::new();
+    for &held in runs {
+        let train: Vec<usize> = runs.iter().copied().filter(|&r| r != held).collect();
+        let f0 = prep.fit(chosen, &all_rows, &train, false)?;
+        let f1 = prep.fit(&with, &all_rows, &train, false)?;
+        let m0 = prep.model(chosen, &f0, &[]);
+        let m1 = prep.model(&with, &f1, &[]);
+        let rec = &prep.records[held];
+        let a = free_run_fits(&m0, rec, &channels);
+        let b = free_run_fits(&m1, rec, &channels);
+        let g = b.iter().zip(&a).map(|(b, a)| b - a).sum::<f64>();
+        gains.push(g);
+    }
+    (!gains.is_empty()).then(|| gains.iter().sum::<f64>() / gains.len() as f64)
+}
+
+/// One step of forward selection: every candidate scored, the top ones
+/// cross-validated.
+pub(crate) struct Step {
+    pub scored: Vec<Scored>,
+    /// Index into `scored` of the winner, if one passed.
+    pub winner: Option<usize>,
+}
+
+pub(crate) fn step(
+    prep: &Prepared<'_>,
+    chosen: &[Spec],
+    library: &[Effect],
+    runs: &[usize],
+    c: &Criteria,
+) -> Step {
+    let taken: Vec<Effect> = chosen.iter().map(|s| s.effect).collect();
+    let mut scored: Vec<Scored> = library
+        .iter()
+        .filter(|e| !taken.contains(e) && !conflicts(e, &taken))
+        .filter_map(|&e| score(prep, chosen, e, runs, c))
+        .collect();
+    scored.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
+    let mut evaluated = 0;
+    for s in scored.iter_mut() {
+        if evaluated >= c.cv_candidates {
+            break;
+        }
+        if s.significant(c) {
+            s.cv_gain = cv_gain(prep, chosen, s, runs);
+            evaluated += 1;
+        }
+    }
+    let winner = scored
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.cv_gain.is_some_and(|g| g >= c.min_cv_gain))
+        .max_by(|a, b| {
+            a.1.cv_gain
+                .unwrap_or(0.0)
+                .total_cmp(&b.1.cv_gain.unwrap_or(0.0))
+        })
+        .map(|(i, _)| i);
+    Step { scored, winner }
+}
+
+/// Candidates that re-describe a chosen term: a second actuator effect of
+/// the same kind, or C(ν) from M next to its own products.
+fn conflicts(e: &Effect, taken: &[Effect]) -> bool {
+    taken.iter().any(|t| match (t, e) {
+        (Effect::CoriolisFromM, Effect::CoriolisProduct { .. })
+        | (Effect::CoriolisProduct { .. }, Effect::CoriolisFromM) => true,
+        _ => t.shape().is_some() && e.shape() == t.shape() && t.dof() == e.dof(),
+    })
+}
