@@ -11,7 +11,7 @@
 //! With `EKF_COMPARE_OUT=path`, the 6-DOF final estimate is written there as
 //! JSON for the side-by-side check.
 
-use criterion::{Criterion, black_box, criterion_group, criterion_main};
+use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::DMatrix;
 use seatrial_core::estimation::NoProgress;
 use seatrial_core::estimation::ekf::{
@@ -20,6 +20,7 @@ use seatrial_core::estimation::ekf::{
 };
 use seatrial_core::rng::SplitMix64;
 use seatrial_core::simulation::dp_ship::{DpShip, TrialConfig, paper, simulate_campaign};
+use std::hint::black_box;
 
 /// Six states, 48 parameters: θ = [A (row-major, 36); b (6); c (6)].
 const NX: usize = 6;

@@ -22,10 +22,18 @@
 
 use nalgebra::DMatrix;
 
+/// y += a·x on contiguous columns (vectorizes).
+#[inline]
+pub(crate) fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
+    }
+}
+
 /// Φ·P·Φᵀ + Q in place, blockwise. `phi_x[i]` is n × n, `phi_theta[i]` is
 /// n × p; `q_x[i]` is run i's process-noise diagonal (n), `q_theta` θ's (p).
-/// `at` is scratch of dim × (N·n).
-#[allow(clippy::too_many_arguments)]
+/// `at` is scratch of dim × (N·n). Zero entries of Φ are skipped: a model's
+/// Φ_θ is often sparse (each state depends on a few parameters).
 pub(crate) fn predict(
     p: &mut DMatrix<f64>,
     n: usize,
@@ -34,21 +42,48 @@ pub(crate) fn predict(
     q_x: &[&[f64]],
     q_theta: &[f64],
     at: &mut DMatrix<f64>,
-    phi_t: &mut (DMatrix<f64>, DMatrix<f64>),
 ) {
     let runs = phi_x.len();
+    let dim = p.nrows();
     let off = runs * n;
-    let np = p.nrows() - off;
-    // (P·Φᵀ)[:, run i], from the old P.
-    for i in 0..runs {
-        phi_x[i].transpose_to(&mut phi_t.0);
-        phi_theta[i].transpose_to(&mut phi_t.1);
-        let mut a = at.columns_mut(i * n, n);
-        a.gemm(1.0, &p.columns(i * n, n), &phi_t.0, 0.0);
-        if np > 0 {
-            a.gemm(1.0, &p.columns(off, np), &phi_t.1, 1.0);
+    let np = dim - off;
+    // (P·Φᵀ)[:, run i] = P[:, run i]·Φ_ixᵀ + P[:, θ]·Φ_iθᵀ, from the old P,
+    // column by column as sums of P's (contiguous) columns.
+    {
+        let ps = p.as_slice();
+        let ats = at.as_mut_slice();
+        for i in 0..runs {
+            for c in 0..n {
+                let col = &mut ats[(i * n + c) * dim..(i * n + c + 1) * dim];
+                col.fill(0.0);
+                for l in 0..n {
+                    let a = phi_x[i][(c, l)];
+                    if a != 0.0 {
+                        axpy(col, a, &ps[(i * n + l) * dim..(i * n + l + 1) * dim]);
+                    }
+                }
+                for l in 0..np {
+                    let a = phi_theta[i][(c, l)];
+                    if a != 0.0 {
+                        axpy(col, a, &ps[(off + l) * dim..(off + l + 1) * dim]);
+                    }
+                }
+            }
         }
     }
+    let mut blk = vec![0.0; n * n];
+    let phi_tt: Vec<Vec<f64>> = phi_theta
+        .iter()
+        .map(|f| {
+            let mut t = vec![0.0; n * np];
+            for r in 0..n {
+                for l in 0..np {
+                    t[r * np + l] = f[(r, l)];
+                }
+            }
+            t
+        })
+        .collect();
     for i in 0..runs {
         // θ rows and columns of run i.
         for c in 0..n {
@@ -58,21 +93,32 @@ pub(crate) fn predict(
                 p[(i * n + c, off + r)] = v;
             }
         }
-        // Run blocks j ≥ i, mirrored to (i, j).
+        // Run blocks j ≥ i, mirrored to (i, j):
+        // P⁺[j, i] = Φ_jx·(PΦᵀ)[run j, run i] + Φ_jθ·(PΦᵀ)[θ, run i].
         for j in i..runs {
-            let mut blk = phi_x[j].clone() * at.view((j * n, i * n), (n, n));
-            if np > 0 {
-                blk.gemm(1.0, &phi_theta[j], &at.view((off, i * n), (np, n)), 1.0);
-            }
-            if i == j {
-                // Φ·P·Φᵀ is symmetric; rounding is split evenly.
-                let t = blk.transpose();
-                blk += t;
-                blk *= 0.5;
+            for c in 0..n {
+                let a_col = &at.as_slice()[(i * n + c) * dim..(i * n + c + 1) * dim];
+                let a_theta = &a_col[off..];
+                for r in 0..n {
+                    let mut v = 0.0;
+                    for l in 0..n {
+                        v += phi_x[j][(r, l)] * a_col[j * n + l];
+                    }
+                    // Row r of Φ_jθ, made contiguous in `phi_tt`.
+                    let row = &phi_tt[j][r * np..(r + 1) * np];
+                    v += row.iter().zip(a_theta).map(|(f, a)| f * a).sum::<f64>();
+                    blk[c * n + r] = v;
+                }
             }
             for c in 0..n {
                 for r in 0..n {
-                    let v = blk[(r, c)];
+                    // Φ·P·Φᵀ is symmetric: on diagonal blocks rounding is
+                    // split evenly.
+                    let v = if i == j {
+                        0.5 * (blk[c * n + r] + blk[r * n + c])
+                    } else {
+                        blk[c * n + r]
+                    };
                     p[(j * n + r, i * n + c)] = v;
                     p[(i * n + c, j * n + r)] = v;
                 }
@@ -90,23 +136,45 @@ pub(crate) fn predict(
 }
 
 /// P ← P + K·Wᵀ + W·Kᵀ on the upper triangle, then mirrored (the Joseph form
-/// with W = K·S/2 − U; see the module doc). `k` and `w` are dim × M.
+/// with W = K·S/2 − U; see the module doc). `k` and `w` are dim × M. Columns
+/// of K and W are taken three at a time so each column of P is loaded and
+/// stored once per six products.
 pub(crate) fn symmetric_rank2_update(p: &mut DMatrix<f64>, k: &DMatrix<f64>, w: &DMatrix<f64>) {
     let dim = p.nrows();
-    let m = k.ncols();
+    let m = k.ncols().min(w.ncols());
     let ks = k.as_slice();
     let ws = w.as_slice();
     let ps = p.as_mut_slice();
+    let kcol = |l: usize, len: usize| &ks[l * dim..l * dim + len];
+    let wcol = |l: usize, len: usize| &ws[l * dim..l * dim + len];
     for c in 0..dim {
-        let col = &mut ps[c * dim..c * dim + c + 1];
-        for l in 0..m {
-            let kc = ks[l * dim + c];
-            let wc = ws[l * dim + c];
-            let kl = &ks[l * dim..l * dim + c + 1];
-            let wl = &ws[l * dim..l * dim + c + 1];
-            for ((pr, &kr), &wr) in col.iter_mut().zip(kl).zip(wl) {
-                *pr += kr * wc + wr * kc;
+        let len = c + 1;
+        let col = &mut ps[c * dim..c * dim + len];
+        let mut l = 0;
+        while l + 3 <= m {
+            let (k0, k1, k2) = (kcol(l, len), kcol(l + 1, len), kcol(l + 2, len));
+            let (w0, w1, w2) = (wcol(l, len), wcol(l + 1, len), wcol(l + 2, len));
+            let (a0, a1, a2) = (
+                ws[l * dim + c],
+                ws[(l + 1) * dim + c],
+                ws[(l + 2) * dim + c],
+            );
+            let (b0, b1, b2) = (
+                ks[l * dim + c],
+                ks[(l + 1) * dim + c],
+                ks[(l + 2) * dim + c],
+            );
+            for r in 0..len {
+                col[r] +=
+                    k0[r] * a0 + w0[r] * b0 + k1[r] * a1 + w1[r] * b1 + k2[r] * a2 + w2[r] * b2;
             }
+            l += 3;
+        }
+        while l < m {
+            let (kc, wc) = (ks[l * dim + c], ws[l * dim + c]);
+            axpy(col, wc, kcol(l, len));
+            axpy(col, kc, wcol(l, len));
+            l += 1;
         }
     }
     for c in 0..dim {

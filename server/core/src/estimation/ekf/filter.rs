@@ -10,7 +10,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::covariance::{predict, symmetric_rank2_update};
+use super::covariance::{axpy, predict, symmetric_rank2_update};
 use super::error::{EkfError, check_finite, check_len, check_variances};
 use super::model::RunModel;
 use crate::estimation::Progress;
@@ -178,7 +178,7 @@ pub fn parallel_ekf(
     let mut out = EkfOutput {
         theta: DVector::zeros(p),
         theta_cov: DMatrix::zeros(p, p),
-        theta_trace: DMatrix::zeros(steps, p),
+        theta_trace: DMatrix::zeros(0, p),
         states: len.iter().map(|&l| DMatrix::zeros(l, n)).collect(),
         innovations: len.iter().map(|&l| DMatrix::zeros(l, m)).collect(),
         covariance: DMatrix::zeros(0, 0),
@@ -188,12 +188,12 @@ pub fn parallel_ekf(
     let mut phi_x: Vec<DMatrix<f64>> = vec![DMatrix::identity(n, n); nr];
     let mut phi_theta: Vec<DMatrix<f64>> = vec![DMatrix::zeros(n, p); nr];
     let mut at = DMatrix::zeros(dim, off);
-    let mut phi_t = (DMatrix::zeros(n, n), DMatrix::zeros(p, n));
-    let ht = h.transpose();
+
     let zero_q = vec![0.0; n];
     let mut x_next = vec![0.0; n];
     let mut u_buf = vec![0.0; model.n_inputs()];
     let mut update = UpdateWorkspace::new(dim, nr * m);
+    let mut trace: Vec<f64> = Vec::with_capacity(steps * p);
 
     for k in 0..steps {
         if k % PROGRESS_EVERY == 0 {
@@ -205,7 +205,6 @@ pub fn parallel_ekf(
             &mut pm,
             &mut xi,
             h,
-            &ht,
             &active,
             n,
             &settings.r,
@@ -221,9 +220,8 @@ pub fn parallel_ekf(
                 out.states[i][(k, c)] = xi[i * n + c];
             }
         }
-        for c in 0..p {
-            out.theta_trace[(k, c)] = xi[off + c];
-        }
+        // Row-major while filtering (contiguous), transposed at the end.
+        trace.extend_from_slice(&xi.as_slice()[off..]);
         if k + 1 == steps {
             break;
         }
@@ -260,21 +258,22 @@ pub fn parallel_ekf(
             &q_runs,
             &settings.q_theta,
             &mut at,
-            &mut phi_t,
         );
     }
     progress.update(1.0, label)?;
+    out.theta_trace = DMatrix::from_row_slice(steps, p, &trace);
     out.theta = xi.rows(off, p).into_owned();
     out.theta_cov = pm.view((off, off), (p, p)).into_owned();
     out.covariance = pm;
     Ok(out)
 }
 
-/// Scratch of the joint measurement update.
+/// Scratch of the joint measurement update (dim × M, M = N·m at most).
 struct UpdateWorkspace {
     u: DMatrix<f64>,
     k: DMatrix<f64>,
     w: DMatrix<f64>,
+    s: DMatrix<f64>,
     innovation: Vec<f64>,
 }
 
@@ -284,6 +283,7 @@ impl UpdateWorkspace {
             u: DMatrix::zeros(dim, m_max),
             k: DMatrix::zeros(dim, m_max),
             w: DMatrix::zeros(dim, m_max),
+            s: DMatrix::zeros(m_max, m_max),
             innovation: vec![0.0; m_max],
         }
     }
@@ -296,7 +296,6 @@ impl UpdateWorkspace {
         pm: &mut DMatrix<f64>,
         xi: &mut DVector<f64>,
         h: &DMatrix<f64>,
-        ht: &DMatrix<f64>,
         active: &[usize],
         n: usize,
         r: &[f64],
@@ -311,31 +310,67 @@ impl UpdateWorkspace {
             return Ok(());
         }
         if self.u.ncols() != mm {
-            self.u = DMatrix::zeros(dim, mm);
-            self.k = DMatrix::zeros(dim, mm);
-            self.w = DMatrix::zeros(dim, mm);
+            // Fewer runs left: resize once per change.
+            *self = UpdateWorkspace::new(dim, mm);
         }
         // U = P·Hᵀ: only run i's columns of P meet H_i.
-        for (slot, &i) in active.iter().enumerate() {
-            self.u
-                .columns_mut(slot * m, m)
-                .gemm(1.0, &pm.columns(i * n, n), ht, 0.0);
-        }
-        // S = H·U + R.
-        let mut s = DMatrix::zeros(mm, mm);
-        for (slot, &i) in active.iter().enumerate() {
-            s.rows_mut(slot * m, m)
-                .gemm(1.0, h, &self.u.rows(i * n, n), 0.0);
-            for j in 0..m {
-                s[(slot * m + j, slot * m + j)] += r[j];
+        {
+            let ps = pm.as_slice();
+            let us = self.u.as_mut_slice();
+            for (slot, &i) in active.iter().enumerate() {
+                for j in 0..m {
+                    let col = &mut us[(slot * m + j) * dim..(slot * m + j + 1) * dim];
+                    col.fill(0.0);
+                    for c in 0..n {
+                        let a = h[(j, c)];
+                        if a != 0.0 {
+                            axpy(col, a, &ps[(i * n + c) * dim..(i * n + c + 1) * dim]);
+                        }
+                    }
+                }
             }
         }
-        let s = (&s + s.transpose()) * 0.5;
-        let chol = s.clone().cholesky().ok_or(EkfError::Diverged { step })?;
-        // Kᵀ = S⁻¹·Uᵀ.
-        let kt = chol.solve(&self.u.transpose());
-        kt.transpose_to(&mut self.k);
-        // Innovation e = z − H·x̂ (angles wrapped).
+        // S = H·U + R (symmetrized).
+        for (slot, &i) in active.iter().enumerate() {
+            for b in 0..mm {
+                for j in 0..m {
+                    let mut v = 0.0;
+                    for c in 0..n {
+                        v += h[(j, c)] * self.u[(i * n + c, b)];
+                    }
+                    self.s[(slot * m + j, b)] = v;
+                }
+            }
+            for (j, rj) in r.iter().enumerate() {
+                self.s[(slot * m + j, slot * m + j)] += rj;
+            }
+        }
+        for a in 0..mm {
+            for b in 0..a {
+                let v = 0.5 * (self.s[(a, b)] + self.s[(b, a)]);
+                self.s[(a, b)] = v;
+                self.s[(b, a)] = v;
+            }
+        }
+        let s_inv = self
+            .s
+            .clone()
+            .cholesky()
+            .ok_or(EkfError::Diverged { step })?
+            .inverse();
+        // K = U·S⁻¹, column by column.
+        {
+            let us = self.u.as_slice();
+            let ks = self.k.as_mut_slice();
+            for l in 0..mm {
+                let col = &mut ks[l * dim..(l + 1) * dim];
+                col.fill(0.0);
+                for j in 0..mm {
+                    axpy(col, s_inv[(j, l)], &us[j * dim..(j + 1) * dim]);
+                }
+            }
+        }
+        // Innovation e = z − H·x̂ (angles wrapped), then ξ += K·e.
         for (slot, &i) in active.iter().enumerate() {
             for j in 0..m {
                 let hx: f64 = (0..n).map(|c| h[(j, c)] * xi[i * n + c]).sum();
@@ -346,11 +381,28 @@ impl UpdateWorkspace {
                 self.innovation[slot * m + j] = e;
             }
         }
-        let e = DVector::from_column_slice(&self.innovation[..mm]);
-        xi.gemv(1.0, &self.k, &e, 1.0);
+        {
+            let ks = self.k.as_slice();
+            let x = xi.as_mut_slice();
+            for l in 0..mm {
+                axpy(x, self.innovation[l], &ks[l * dim..(l + 1) * dim]);
+            }
+        }
         // W = K·S/2 − U, then P += K·Wᵀ + W·Kᵀ (Joseph form).
-        self.w.copy_from(&self.u);
-        self.w.gemm(0.5, &self.k, &s, -1.0);
+        {
+            let ks = self.k.as_slice();
+            let us = self.u.as_slice();
+            let ws = self.w.as_mut_slice();
+            for l in 0..mm {
+                let col = &mut ws[l * dim..(l + 1) * dim];
+                for (wv, &uv) in col.iter_mut().zip(&us[l * dim..(l + 1) * dim]) {
+                    *wv = -uv;
+                }
+                for j in 0..mm {
+                    axpy(col, 0.5 * self.s[(j, l)], &ks[j * dim..(j + 1) * dim]);
+                }
+            }
+        }
         symmetric_rank2_update(pm, &self.k, &self.w);
         Ok(())
     }

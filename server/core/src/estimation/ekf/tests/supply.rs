@@ -75,12 +75,12 @@ fn staged_parallel_ekf_recovers_the_supply_vessel() {
     };
     let id = identify_dp_ship(&cfg, &stages(&runs), &mut sink).unwrap();
     let mut worst: f64 = 0.0;
-    for i in 0..9 {
+    for (i, name) in THETA_NAMES.iter().enumerate() {
         let err = (id.theta[i] - paper::THETA[i]) / paper::THETA[i];
         eprintln!(
             "θ″{} {:>6} {:>10.6} truth {:>10.6} err {:>7.3} % σ {:.2e}",
             i + 1,
-            THETA_NAMES[i],
+            name,
             id.theta[i],
             paper::THETA[i],
             100.0 * err,
