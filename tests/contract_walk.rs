@@ -22,6 +22,68 @@ async fn job(app: &TestApp, settings: Value) -> String {
     r.json["id"].as_str().unwrap().to_string()
 }
 
+/// A stored one-DOF LPV model (the identify job itself is proven in
+/// api_models; here the model routes only need something to serve).
+async fn stored_model(app: &TestApp, cid: &str, vid: &str) -> String {
+    use seatrial::storage::models::{Lineage, NewModel, insert};
+    use seatrial_core::identification::document::{
+        LpvDoc, LpvPoint, Method, ModelDocument, ModelKind,
+    };
+    let one = vec![vec![1.0]];
+    let doc = ModelDocument {
+        kind: ModelKind::Lpv,
+        method: Method::LambdaKf,
+        dofs: vec![seatrial_core::planning::Dof::Surge],
+        inputs: vec!["γ_X".into()],
+        outputs: vec!["u".into()],
+        restoring: None,
+        lpv: Some(LpvDoc {
+            t_lambda_s: 1.0,
+            structure: "diagonal".into(),
+            coupling: vec![vec![true]],
+            points: vec![LpvPoint {
+                speed_mps: 0.5,
+                m: vec![vec![5800.0]],
+                m_std: vec![vec![50.0]],
+                d_bar: vec![vec![1500.0]],
+                d_bar_std: vec![vec![20.0]],
+                a: vec![vec![-1500.0 / 5800.0]],
+                a_std: one.clone(),
+                b: vec![vec![1.0 / 5800.0]],
+                b_std: one,
+                n_samples: 100,
+                run_ids: vec![],
+            }],
+        }),
+        dp_ship: None,
+        state_space: None,
+        parameters: vec![],
+        structure_findings: vec![],
+        notes: vec![],
+    };
+    let mut conn = app.state.db.acquire().await.unwrap();
+    let m = insert(
+        &mut conn,
+        NewModel {
+            lineage: Lineage::New,
+            campaign_id: cid.into(),
+            vessel_id: vid.into(),
+            kind: "lpv".into(),
+            method: "lambda_kf".into(),
+            name: "walk".into(),
+            settings: json!({}),
+            run_ids: vec![],
+            validation_run_ids: vec![],
+            job_id: None,
+            document: serde_json::to_value(&doc).unwrap(),
+            validation: json!([]),
+        },
+    )
+    .await
+    .unwrap();
+    m.id
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn every_documented_operation_is_exercised_and_answers() {
     let app = TestApp::with_jobs(common::jobs::registry(), common::jobs::config(1)).await;
@@ -68,6 +130,7 @@ async fn every_documented_operation_is_exercised_and_answers() {
         tokio::time::sleep(std::time::Duration::from_millis(10)).await;
     }
     let long = json!({ "n": 1000, "steps": 100, "step_ms": 50 });
+    let mid = stored_model(&app, &cid, &vid).await;
 
     let paths = app.spec["paths"].as_object().unwrap().clone();
     let mut walked = 0;
@@ -81,6 +144,8 @@ async fn every_documented_operation_is_exercised_and_answers() {
                 vec![&rid]
             } else if template.starts_with("/api/jobs/") {
                 vec![&jid]
+            } else if template.starts_with("/api/models/") {
+                vec![&mid]
             } else if template.contains("{id}") {
                 vec![&cid]
             } else {

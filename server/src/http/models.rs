@@ -117,9 +117,9 @@ pub struct ExportQuery {
 #[serde(untagged)]
 pub enum JsonExport {
     /// `format=json`.
-    Model(ModelView),
+    Model(Box<ModelView>),
     /// `format=fossen`.
-    Fossen(seatrial_core::identification::export::FossenParameterSet),
+    Fossen(Box<seatrial_core::identification::export::FossenParameterSet>),
 }
 
 fn attachment(body: String, content_type: &str, filename: String) -> Response {
