@@ -316,7 +316,13 @@ export async function campaignPage(view, id) {
 
   renderPlan();
   runs = await runsSection(runsHost, { campaign, plan, onRuns: (r) => { if (ident) ident.setRuns(r); } });
-  ident = await identifySection(identifyHost, { campaign, vessel, plan, runs: runs.runs() });
+  try {
+    ident = await identifySection(identifyHost, { campaign, vessel, plan, runs: runs.runs() });
+  } catch (err) {
+    // The rest of the page stays usable; the answer is shown where the section would be.
+    fill(identifyHost, h('h2', { class: 'section-title' }, 'Identification'),
+      h('p', { class: 'error-text', role: 'alert', 'data-testid': 'identify-load-error' }, `Could not load jobs and models: ${err.status ? `${err.status} · ` : ''}${err.message}`));
+  }
 
   return {
     key: `campaign:${id}`,
@@ -324,7 +330,7 @@ export async function campaignPage(view, id) {
     destroy() {
       destroyPlots();
       runs.destroy();
-      ident.destroy();
+      if (ident) ident.destroy();
     },
   };
 }
