@@ -8,6 +8,7 @@ pub mod export;
 pub mod health;
 pub mod jobs;
 pub mod json;
+pub mod models;
 pub mod plans;
 pub mod query;
 pub mod runs;
@@ -88,7 +89,8 @@ impl AppState {
         (name = "service", description = "Service health"),
         (name = "planning", description = "Vessels, campaigns, excitation plans and their exports"),
         (name = "runs", description = "Uploaded logs, their alignment and data-quality reports"),
-        (name = "jobs", description = "Background jobs (identification, discovery): submit, follow by polling or Server-Sent Events, cancel, retry")
+        (name = "jobs", description = "Background jobs (identification, discovery): submit, follow by polling or Server-Sent Events, cancel, retry"),
+        (name = "models", description = "Identified models: versions with provenance, matrices and parameters with uncertainties, validation, exports")
     )
 )]
 struct ApiDoc;
@@ -118,6 +120,9 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(jobs::cancel_job))
         .routes(routes!(jobs::retry_job))
         .routes(routes!(jobs::job_events))
+        .routes(routes!(models::list_models))
+        .routes(routes!(models::get_model))
+        .routes(routes!(models::export_model))
         // Uploads stream to disk under their own limit (counted in the handler).
         .merge(
             OpenApiRouter::new()

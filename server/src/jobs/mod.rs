@@ -105,6 +105,7 @@
 pub mod events;
 pub mod handler;
 pub mod heartbeat;
+pub mod identify;
 pub mod live;
 pub mod progress;
 pub mod registry;

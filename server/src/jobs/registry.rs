@@ -17,10 +17,10 @@ impl JobRegistry {
         Self::default()
     }
 
-    /// The production kinds. Empty until the identification and discovery
-    /// handlers exist: `POST /api/jobs` then answers 422 for every kind.
+    /// The production kinds: `identify` (campaign runs → a validated,
+    /// versioned model).
     pub fn production() -> Self {
-        Self::new()
+        Self::new().with("identify", super::identify::Identify)
     }
 
     /// Adds (or replaces) the handler of `kind`.

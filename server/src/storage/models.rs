@@ -4,7 +4,7 @@
 //! lineages query.
 
 use serde::Serialize;
-use sqlx::{Sqlite, Transaction};
+use sqlx::SqliteConnection;
 
 use super::{Db, new_id, now};
 
@@ -97,7 +97,7 @@ const SUMMARY: &str = "id, lineage_id, version, parent_id, campaign_id, vessel_i
 
 /// Stores a model inside the caller's transaction (so a job's success and its
 /// model commit together); versions are assigned here.
-pub async fn insert(tx: &mut Transaction<'_, Sqlite>, m: NewModel) -> anyhow::Result<ModelSummary> {
+pub async fn insert(tx: &mut SqliteConnection, m: NewModel) -> anyhow::Result<ModelSummary> {
     let id = new_id();
     let (lineage_id, version, parent_id) = match &m.lineage {
         Lineage::New => (id.clone(), 1_i64, None),
@@ -105,7 +105,7 @@ pub async fn insert(tx: &mut Transaction<'_, Sqlite>, m: NewModel) -> anyhow::Re
             let lineage: Option<(String,)> =
                 sqlx::query_as("SELECT lineage_id FROM model WHERE id = $1")
                     .bind(parent)
-                    .fetch_optional(&mut **tx)
+                    .fetch_optional(&mut *tx)
                     .await?;
             let Some((lineage_id,)) = lineage else {
                 anyhow::bail!("no model with id '{parent}' to version after");
@@ -113,7 +113,7 @@ pub async fn insert(tx: &mut Transaction<'_, Sqlite>, m: NewModel) -> anyhow::Re
             let (max,): (i64,) =
                 sqlx::query_as("SELECT COALESCE(MAX(version), 0) FROM model WHERE lineage_id = $1")
                     .bind(&lineage_id)
-                    .fetch_one(&mut **tx)
+                    .fetch_one(&mut *tx)
                     .await?;
             (lineage_id, max + 1, Some(parent.clone()))
         }
@@ -141,13 +141,13 @@ pub async fn insert(tx: &mut Transaction<'_, Sqlite>, m: NewModel) -> anyhow::Re
     .bind(m.document.to_string())
     .bind(m.validation.to_string())
     .bind(now())
-    .execute(&mut **tx)
+    .execute(&mut *tx)
     .await?;
     let summary = sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
         "SELECT {SUMMARY} FROM model WHERE id = $1"
     )))
     .bind(&id)
-    .fetch_one(&mut **tx)
+    .fetch_one(&mut *tx)
     .await?;
     Ok(summary)
 }

@@ -10,3 +10,4 @@
 pub mod dp_ship;
 pub mod integrate;
 pub mod rov;
+pub mod trials;

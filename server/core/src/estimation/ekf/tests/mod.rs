@@ -1,0 +1,2 @@
+mod generic;
+mod supply;

@@ -1,0 +1,708 @@
+//! A simulated sea-trial campaign: every planned experiment of a
+//! [`Plan`](crate::planning::Plan) flown by the ROV truth ([`RovTruth`]) and
+//! logged the way the vessel's logger would, so the demo and the end-to-end
+//! tests can upload realistic logs.
+//!
+//! # How a run is flown
+//!
+//! The schedule holds references at the controller rate f_c. Per modeled DOF:
+//!
+//! - `u_ref … r_ref`: a velocity reference ν_ref,i flown by the vessel's
+//!   controller, a PI per DOF ([`VelocityPi`]) at f_c producing the
+//!   commanded τ_i, slew-limited to the profile's `max_force_rate` and
+//!   clipped to `max_force`;
+//! - `tau_X … tau_N`: an open-loop force, applied as scheduled (clipped to
+//!   `max_force`).
+//!
+//! DOFs the profile does not model get τ = 0 (left passive) and are not
+//! logged. Thruster-actuated (DP) profiles are not flown here.
+//!
+//! The controller feeds back ν over ground as the navigation filter would
+//! estimate it (taken noise-free); the logger then records τ commanded, ν and
+//! η at the logger rate f_l = f_c / D (D a whole number) with seeded white
+//! measurement noise. Before t = 0 the vessel flies a lead-in holding the
+//! first references, so a run starts trimmed at its operating point, as after
+//! the set-up time between runs.
+//!
+//! The plant is integrated exactly as [`RovTruth::simulate`] does (RK4,
+//! τ held over each controller interval, the same actuators and current); a
+//! test replays the commanded τ through `simulate` and finds the same
+//! trajectory.
+
+use std::fmt;
+
+use nalgebra::{DMatrix, Matrix6, Vector3, Vector6};
+
+use super::integrate::rk4_step;
+use super::rov::current::CurrentProcess;
+use super::rov::damping::damping_force;
+use super::rov::kinematics::{eta_dot, rotation};
+use super::rov::{RovRecord, RovTruth, SimError};
+use crate::logs::schema::{LogRole, TIME_COLUMN, pose_column, required_columns};
+use crate::models::coriolis::coriolis_6dof;
+use crate::planning::vessel::{DofLimits, InputChannels, VesselKind};
+use crate::planning::{Dof, Experiment, ExperimentFamily, Plan, PlannedExperiment, VesselProfile};
+use crate::rng::{SplitMix64, mix};
+
+/// Closed-loop bandwidth ω_c of the velocity PI in units of 1/T̂: the nominal
+/// loop settles twice as fast as the open-loop DOF. Kept modest because the
+/// profile's limits give the mass only roughly (for the Surveyor, m̂ over-
+/// estimates the true roll inertia ≈ 9×, which raises the real loop gain).
+pub const BANDWIDTH_PER_TIME_CONSTANT: f64 = 2.0;
+/// Default lead-in in units of the largest modeled time constant T̂ (≈ 99 %
+/// settled).
+pub const LEAD_IN_TIME_CONSTANTS: f64 = 5.0;
+/// Smallest |cos θ| before the Euler-angle kinematics counts as singular
+/// (as in [`RovTruth::simulate`]).
+const COS_THETA_MIN: f64 = 1e-6;
+
+/// Why a run could not be flown; names the field at fault.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TrialError {
+    /// An input is missing, inconsistent or out of range.
+    Invalid {
+        /// The field, e.g. `settings.noise.nu[v]` or `schedule.columns[2]`.
+        field: String,
+        /// What is wrong, in words.
+        reason: String,
+    },
+    /// The truth simulator refused the parameters or diverged.
+    Simulation {
+        /// Code of the experiment being flown.
+        code: String,
+        /// The simulator's error.
+        source: SimError,
+    },
+}
+
+impl TrialError {
+    fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
+        TrialError::Invalid {
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// The field at fault (`truth…` for simulator errors).
+    pub fn field(&self) -> String {
+        match self {
+            TrialError::Invalid { field, .. } => field.clone(),
+            TrialError::Simulation { .. } => "truth".into(),
+        }
+    }
+}
+
+impl fmt::Display for TrialError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            TrialError::Invalid { field, reason } => write!(f, "{field}: {reason}"),
+            TrialError::Simulation { code, source } => write!(f, "{code}: {source}"),
+        }
+    }
+}
+
+impl std::error::Error for TrialError {}
+
+/// Standard deviations of the white measurement noise the logger adds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeasurementNoise {
+    /// On u v w (m/s) and p q r (rad/s).
+    pub nu: [f64; 6],
+    /// On x y z (m) and φ θ ψ (rad).
+    pub eta: [f64; 6],
+}
+
+impl MeasurementNoise {
+    /// No noise.
+    pub const NONE: MeasurementNoise = MeasurementNoise {
+        nu: [0.0; 6],
+        eta: [0.0; 6],
+    };
+}
+
+impl Default for MeasurementNoise {
+    /// A work-class ROV's navigation: DVL velocities ±1 cm/s, gyro rates
+    /// ±0.005 rad/s, USBL position ±0.5 m, depth sensor ±5 cm, attitude
+    /// ±0.002 rad, heading ±0.005 rad.
+    fn default() -> Self {
+        MeasurementNoise {
+            nu: [0.01, 0.01, 0.01, 0.005, 0.005, 0.005],
+            eta: [0.5, 0.5, 0.05, 0.002, 0.002, 0.005],
+        }
+    }
+}
+
+/// How to fly and log.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrialSettings {
+    /// Measurement noise of the logger.
+    pub noise: MeasurementNoise,
+    /// Seed of the measurement noise ([`fly_campaign`] derives one per run).
+    pub seed: u64,
+    /// Cut every run after this many seconds (demos, tests); `None` = full.
+    pub max_duration_s: Option<f64>,
+    /// Unlogged lead-in holding the first references (s); `None` =
+    /// [`LEAD_IN_TIME_CONSTANTS`] × the largest modeled time constant.
+    pub lead_in_s: Option<f64>,
+    /// RK4 steps per controller interval.
+    pub substeps: usize,
+}
+
+impl Default for TrialSettings {
+    fn default() -> Self {
+        TrialSettings {
+            noise: MeasurementNoise::default(),
+            seed: 0,
+            max_duration_s: None,
+            lead_in_s: None,
+            substeps: 5,
+        }
+    }
+}
+
+impl TrialSettings {
+    /// Checks the settings; errors name the field.
+    pub fn validate(&self) -> Result<(), TrialError> {
+        for d in Dof::ALL {
+            let i = d.index();
+            for (name, v) in [
+                (
+                    format!("settings.noise.nu[{}]", d.velocity_symbol()),
+                    self.noise.nu[i],
+                ),
+                (
+                    format!("settings.noise.eta[{}]", pose_column(d)),
+                    self.noise.eta[i],
+                ),
+            ] {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(TrialError::invalid(
+                        name,
+                        format!("must be a finite standard deviation ≥ 0 (got {v})"),
+                    ));
+                }
+            }
+        }
+        if let Some(m) = self.max_duration_s
+            && !(m.is_finite() && m > 0.0)
+        {
+            return Err(TrialError::invalid(
+                "settings.max_duration_s",
+                format!("must be a finite number of seconds > 0 (got {m})"),
+            ));
+        }
+        if let Some(l) = self.lead_in_s
+            && !(l.is_finite() && l >= 0.0)
+        {
+            return Err(TrialError::invalid(
+                "settings.lead_in_s",
+                format!("must be a finite number of seconds ≥ 0 (got {l})"),
+            ));
+        }
+        if self.substeps == 0 || self.substeps > 1000 {
+            return Err(TrialError::invalid(
+                "settings.substeps",
+                format!("must be between 1 and 1000 (got {})", self.substeps),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The velocity controller of one DOF: a discrete PI designed on the nominal
+/// first-order model m̂ ν̇ + d̂ ν = τ taken from the profile's limits alone
+/// (truth-independent):
+///
+/// - d̂ = τ_max / ν_max (the force that holds the largest velocity),
+///   m̂ = T̂ d̂ with T̂ the profile's time constant;
+/// - τ = K_p e + K_i ∫e, e = ν_ref − ν, with K_p = m̂ ω_c and
+///   K_i = K_p / T̂ = ω_c d̂: the integral zero cancels the nominal pole, so
+///   the nominal loop is ω_c / s and ν follows a step in ν_ref as
+///   1 − e^{−ω_c t}, with zero steady-state error for any constant
+///   reference, ω_c = [`BANDWIDTH_PER_TIME_CONSTANT`] / T̂. The nominal
+///   damping d̂ thus enters as the integral gain; there is no separate
+///   feed-forward, which with a rough m̂ would only add overshoot;
+/// - τ is slew-limited to `max_force_rate` and clipped to `max_force`; the
+///   integrator is frozen while the output is limited in the direction e
+///   pushes it (conditional-integration anti-windup).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VelocityPi {
+    /// K_p (N·s/m or N·m·s/rad).
+    pub kp: f64,
+    /// K_i (N/m or N·m/rad).
+    pub ki: f64,
+    /// |τ| ≤ this (N or N·m).
+    pub max_force: f64,
+    /// |Δτ| ≤ this per controller interval (N or N·m).
+    pub max_step: f64,
+    /// Controller interval h = 1/f_c (s).
+    pub h: f64,
+    /// ∫e dt.
+    integral: f64,
+    /// τ of the previous interval.
+    last: f64,
+}
+
+impl VelocityPi {
+    /// The controller of a DOF with `limits` at controller interval `h`.
+    pub fn design(limits: &DofLimits, h: f64) -> Self {
+        let d_hat = limits.max_force / limits.max_velocity;
+        let m_hat = limits.time_constant_s * d_hat;
+        let omega_c = BANDWIDTH_PER_TIME_CONSTANT / limits.time_constant_s;
+        let kp = m_hat * omega_c;
+        VelocityPi {
+            kp,
+            ki: kp / limits.time_constant_s,
+            max_force: limits.max_force,
+            max_step: limits.max_force_rate * h,
+            h,
+            integral: 0.0,
+            last: 0.0,
+        }
+    }
+
+    /// Closed-loop bandwidth ω_c = K_i / d̂ of the nominal loop (rad/s).
+    pub fn bandwidth(&self, limits: &DofLimits) -> f64 {
+        self.ki * limits.max_velocity / limits.max_force
+    }
+
+    /// τ for this interval from the reference and the measured velocity.
+    pub fn step(&mut self, nu_ref: f64, nu: f64) -> f64 {
+        let e = nu_ref - nu;
+        let wanted = self.kp * e + self.ki * self.integral;
+        let tau = wanted
+            .clamp(self.last - self.max_step, self.last + self.max_step)
+            .clamp(-self.max_force, self.max_force);
+        // Integrate unless limited and e would drive the output further out.
+        if tau == wanted || e * (wanted - tau) < 0.0 {
+            self.integral += e * self.h;
+        }
+        self.last = tau;
+        tau
+    }
+}
+
+/// What drives one DOF during a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Drive {
+    /// Velocity reference ν_ref flown by the PI (schedule column index).
+    Velocity(usize),
+    /// Open-loop τ (schedule column index).
+    Force(usize),
+    /// Not modeled: τ = 0.
+    Passive,
+}
+
+/// One flown experiment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlownRun {
+    /// Position in the run order, from 1.
+    pub seq: u32,
+    /// Experiment code, e.g. `DYN-1.5kn-sway-r1`.
+    pub code: String,
+    /// Family.
+    pub family: ExperimentFamily,
+    /// Grid speed (m/s); none for the validation run.
+    pub grid_speed_mps: Option<f64>,
+    /// How each DOF (index `Dof::index()`) was driven.
+    pub drives: [Drive; 6],
+    /// ν_ref at the logged samples (N × 6; zero where not velocity-driven).
+    pub nu_ref: DMatrix<f64>,
+    /// The logged run at the logger rate, with the noise-free truth.
+    pub record: RovRecord,
+    /// The log as uploaded: the profile's single-file columns
+    /// ([`required_columns`]) in the project's CSV convention.
+    pub csv: String,
+}
+
+/// Flies one planned experiment with `truth` and logs it for `profile`.
+pub fn fly_experiment(
+    profile: &VesselProfile,
+    truth: &RovTruth,
+    planned: &PlannedExperiment,
+    settings: &TrialSettings,
+) -> Result<FlownRun, TrialError> {
+    let ex = &planned.experiment;
+    let sim_err = |source| TrialError::Simulation {
+        code: ex.code.clone(),
+        source,
+    };
+    check_profile(profile)?;
+    settings.validate()?;
+    truth.validate().map_err(sim_err)?;
+    let drives = drives(profile, planned)?;
+    let sched = &planned.schedule;
+    let fc = profile.controller_rate_hz;
+    let h = 1.0 / fc;
+    let decimation = decimation(profile)?;
+
+    let full = sched.len();
+    let n_run = match settings.max_duration_s {
+        Some(m) => full.min(((m * fc) + 1e-9).floor() as usize + 1),
+        None => full,
+    };
+    let t_max = profile
+        .dofs
+        .iter()
+        .map(|&d| profile.limit(d).time_constant_s)
+        .fold(0.0, f64::max);
+    let lead_in = settings.lead_in_s.unwrap_or(LEAD_IN_TIME_CONSTANTS * t_max);
+    let n_lead = (lead_in * fc).round() as usize;
+    let n = n_lead + n_run;
+    let reference = |c: usize, k: usize| sched.values[c][k.saturating_sub(n_lead)];
+
+    let mut pis: Vec<Option<VelocityPi>> = Dof::ALL
+        .iter()
+        .map(|&d| match drives[d.index()] {
+            Drive::Velocity(_) => Some(VelocityPi::design(profile.limit(d), h)),
+            _ => None,
+        })
+        .collect();
+
+    // Plant: the same right-hand side as RovTruth::simulate.
+    let m_inv: Matrix6<f64> = truth.m.cholesky().map(|c| c.inverse()).ok_or_else(|| {
+        sim_err(SimError::InertiaNotSpd {
+            reason: "Cholesky factorization failed".into(),
+        })
+    })?;
+    let tether = truth.tether.load();
+    let acts = &truth.actuators;
+    let lagged: [bool; 6] = std::array::from_fn(|i| acts.lagged(i));
+    let mut f = |x: &[f64], u: &[f64], dx: &mut [f64]| {
+        let nu_r = Vector6::from_column_slice(&x[0..6]);
+        let eta = Vector6::from_column_slice(&x[6..12]);
+        let nu = nu_r + body_current(&eta, &Vector3::new(u[6], u[7], u[8]));
+        let mut tau = Vector6::zeros();
+        for i in 0..6 {
+            if lagged[i] {
+                tau[i] = x[12 + i];
+                dx[12 + i] = (u[i] - x[12 + i]) / acts.time_constants[i];
+            } else {
+                tau[i] = u[i];
+                dx[12 + i] = 0.0;
+            }
+        }
+        let mut rhs = tau + tether
+            - damping_force(&truth.damping, &truth.quadratic_damping, &nu_r)
+            - truth.restoring.g(eta[3], eta[4]);
+        if truth.coriolis {
+            rhs -= coriolis_6dof(&truth.m, &nu_r) * nu_r;
+        }
+        let nu_dot = m_inv * rhs;
+        let e_dot = eta_dot(&eta, &nu);
+        dx[0..6].copy_from_slice(nu_dot.as_slice());
+        dx[6..12].copy_from_slice(e_dot.as_slice());
+    };
+
+    // Start at the first velocity references (trimmed at the grid speed).
+    let mut current = CurrentProcess::new(&truth.current);
+    let mut nu0 = Vector6::zeros();
+    for (i, d) in drives.iter().enumerate() {
+        if let Drive::Velocity(c) = d {
+            nu0[i] = reference(*c, 0);
+        }
+    }
+    let eta0 = Vector6::zeros();
+    let nu_r0 = nu0 - body_current(&eta0, &current.ned());
+    let mut x = [0.0; 18];
+    x[0..6].copy_from_slice(nu_r0.as_slice());
+
+    let n_log = n_run.div_ceil(decimation);
+    let mut rec = RovRecord::zeros(n_log, h * decimation as f64);
+    let mut nu_ref = DMatrix::zeros(n_log, 6);
+    let mut tau_cmd = DMatrix::zeros(n, 6);
+    let h_int = h / settings.substeps as f64;
+    let mut u = [0.0; 9];
+    for k in 0..n {
+        let eta = Vector6::from_column_slice(&x[6..12]);
+        let v_ned = current.ned();
+        let nu = Vector6::from_column_slice(&x[0..6]) + body_current(&eta, &v_ned);
+        for (i, d) in drives.iter().enumerate() {
+            tau_cmd[(k, i)] = match *d {
+                Drive::Velocity(c) => pis[i]
+                    .as_mut()
+                    .map_or(0.0, |pi| pi.step(reference(c, k), nu[i])),
+                Drive::Force(c) => {
+                    let l = profile.limit(Dof::ALL[i]).max_force;
+                    reference(c, k).clamp(-l, l)
+                }
+                Drive::Passive => 0.0,
+            };
+        }
+        let shaped = acts.shaped(&tau_cmd, k);
+        if k >= n_lead && (k - n_lead).is_multiple_of(decimation) {
+            let j = (k - n_lead) / decimation;
+            for i in 0..6 {
+                rec.nu_true[(j, i)] = nu[i];
+                rec.eta_true[(j, i)] = eta[i];
+                rec.tau_commanded[(j, i)] = tau_cmd[(k, i)];
+                rec.tau_applied[(j, i)] = if lagged[i] { x[12 + i] } else { shaped[i] };
+                if let Drive::Velocity(c) = drives[i] {
+                    nu_ref[(j, i)] = reference(c, k);
+                }
+            }
+            for i in 0..3 {
+                rec.current_ned[(j, i)] = v_ned[i];
+            }
+        }
+        if k + 1 == n {
+            break;
+        }
+        u[0..6].copy_from_slice(&shaped);
+        for _ in 0..settings.substeps {
+            u[6..9].copy_from_slice(current.ned().as_slice());
+            rk4_step(&mut f, &mut x, &u, h_int);
+            current.advance(h_int);
+        }
+        let t = (k as f64 + 1.0 - n_lead as f64) * h;
+        if !x.iter().all(|v| v.is_finite()) {
+            return Err(sim_err(SimError::Diverged {
+                t,
+                reason: "the state is no longer finite (unstable parameters or too coarse an internal step)",
+            }));
+        }
+        if x[10].cos().abs() < COS_THETA_MIN {
+            return Err(sim_err(SimError::Diverged {
+                t,
+                reason: "pitch reached ±90°, where the Euler-angle kinematics T(Θ) is singular",
+            }));
+        }
+    }
+
+    // Measurement noise: 12 draws per logged sample in a fixed order (ν then
+    // η), as RovTruth::simulate draws them; the measured heading is wrapped
+    // to (−π, π] like a compass's.
+    let mut rng = SplitMix64::new(settings.seed);
+    rec.nu.copy_from(&rec.nu_true);
+    rec.eta.copy_from(&rec.eta_true);
+    for k in 0..n_log {
+        for i in 0..6 {
+            rec.nu[(k, i)] += settings.noise.nu[i] * rng.normal();
+        }
+        for i in 0..6 {
+            rec.eta[(k, i)] += settings.noise.eta[i] * rng.normal();
+        }
+        rec.eta[(k, 5)] = wrap_pi(rec.eta[(k, 5)]);
+    }
+    let csv = profile_csv(profile, &rec);
+    Ok(FlownRun {
+        seq: ex.seq,
+        code: ex.code.clone(),
+        family: ex.family,
+        grid_speed_mps: ex.grid_speed_mps,
+        drives,
+        nu_ref,
+        record: rec,
+        csv,
+    })
+}
+
+/// Flies every experiment of `plan` that `filter` accepts, in run order.
+/// Run `seq` uses the noise seed mix(`settings.seed` ⊕ mix(seq)), so runs
+/// carry independent noise and a campaign is reproducible from one seed.
+pub fn fly_campaign(
+    profile: &VesselProfile,
+    truth: &RovTruth,
+    plan: &Plan,
+    settings: &TrialSettings,
+    filter: impl Fn(&Experiment) -> bool,
+) -> Result<Vec<FlownRun>, TrialError> {
+    plan.experiments
+        .iter()
+        .filter(|p| filter(&p.experiment))
+        .map(|p| {
+            let s = TrialSettings {
+                seed: run_seed(settings.seed, p.experiment.seq),
+                ..*settings
+            };
+            fly_experiment(profile, truth, p, &s)
+        })
+        .collect()
+}
+
+/// Noise seed of run `seq` in [`fly_campaign`].
+pub fn run_seed(seed: u64, seq: u32) -> u64 {
+    mix(seed ^ mix(u64::from(seq)))
+}
+
+fn check_profile(profile: &VesselProfile) -> Result<(), TrialError> {
+    profile
+        .validate()
+        .map_err(|e| TrialError::invalid(format!("profile.{}", e.field), e.to_string()))?;
+    if profile.kind != VesselKind::Rov6 {
+        return Err(TrialError::invalid(
+            "profile.kind",
+            "only ROV profiles are flown by the ROV truth; DP vessels need their own simulator",
+        ));
+    }
+    if !matches!(profile.inputs, InputChannels::GeneralizedForces) {
+        return Err(TrialError::invalid(
+            "profile.inputs",
+            "the ROV truth takes generalized forces τ; thruster-command profiles are not supported",
+        ));
+    }
+    Ok(())
+}
+
+/// Logger decimation D = f_c / f_l, a whole number ≥ 1.
+fn decimation(profile: &VesselProfile) -> Result<usize, TrialError> {
+    let ratio = profile.controller_rate_hz / profile.logger_rate_hz;
+    if ratio >= 1.0 - 1e-9 && (ratio - ratio.round()).abs() < 1e-9 {
+        Ok(ratio.round() as usize)
+    } else {
+        Err(TrialError::invalid(
+            "profile.logger_rate_hz",
+            format!(
+                "the controller rate ({} Hz) must be a whole multiple of the logger rate ({} Hz) to log it",
+                profile.controller_rate_hz, profile.logger_rate_hz
+            ),
+        ))
+    }
+}
+
+/// Which schedule column drives each DOF.
+fn drives(profile: &VesselProfile, planned: &PlannedExperiment) -> Result<[Drive; 6], TrialError> {
+    let s = &planned.schedule;
+    if (s.sample_rate_hz - profile.controller_rate_hz).abs() > 1e-9 * profile.controller_rate_hz {
+        return Err(TrialError::invalid(
+            "schedule.sample_rate_hz",
+            format!(
+                "the schedule is sampled at {} Hz but the controller runs at {} Hz",
+                s.sample_rate_hz, profile.controller_rate_hz
+            ),
+        ));
+    }
+    if s.columns.len() != s.values.len() {
+        return Err(TrialError::invalid(
+            "schedule.values",
+            format!(
+                "{} columns named but {} sampled",
+                s.columns.len(),
+                s.values.len()
+            ),
+        ));
+    }
+    let n = s.len();
+    if n == 0 {
+        return Err(TrialError::invalid(
+            "schedule.values",
+            "the schedule is empty",
+        ));
+    }
+    let mut out = [Drive::Passive; 6];
+    for (c, name) in s.columns.iter().enumerate() {
+        let field = format!("schedule.columns[{c}]");
+        let drive = Dof::ALL.iter().find_map(|&d| {
+            if *name == format!("{}_ref", d.velocity_symbol()) {
+                Some((d, Drive::Velocity(c)))
+            } else if name == d.force_column() {
+                Some((d, Drive::Force(c)))
+            } else {
+                None
+            }
+        });
+        let Some((d, drive)) = drive else {
+            return Err(TrialError::invalid(
+                field,
+                format!(
+                    "'{name}' is neither a velocity reference (u_ref…r_ref) nor a force (tau_X…tau_N)"
+                ),
+            ));
+        };
+        if !profile.dofs.contains(&d) {
+            return Err(TrialError::invalid(
+                field,
+                format!(
+                    "'{name}' drives {}, which the profile does not model",
+                    d.name()
+                ),
+            ));
+        }
+        if out[d.index()] != Drive::Passive {
+            return Err(TrialError::invalid(
+                field,
+                format!("{} is driven by two columns", d.name()),
+            ));
+        }
+        if s.values[c].len() != n {
+            return Err(TrialError::invalid(
+                format!("schedule.values[{c}]"),
+                format!(
+                    "{} samples, but the first column has {n}",
+                    s.values[c].len()
+                ),
+            ));
+        }
+        if let Some(k) = s.values[c].iter().position(|v| !v.is_finite()) {
+            return Err(TrialError::invalid(
+                format!("schedule.values[{c}][{k}]"),
+                "must be a finite number",
+            ));
+        }
+        out[d.index()] = drive;
+    }
+    if let Some(d) = profile
+        .dofs
+        .iter()
+        .find(|d| out[d.index()] == Drive::Passive)
+    {
+        return Err(TrialError::invalid(
+            "schedule.columns",
+            format!("no reference for the modeled DOF {}", d.name()),
+        ));
+    }
+    Ok(out)
+}
+
+/// ν_c = [Rᵀ(Θ) V_c; 0₃].
+fn body_current(eta: &Vector6<f64>, v_ned: &Vector3<f64>) -> Vector6<f64> {
+    let v = rotation(eta[3], eta[4], eta[5]).transpose() * v_ned;
+    Vector6::new(v.x, v.y, v.z, 0.0, 0.0, 0.0)
+}
+
+fn wrap_pi(a: f64) -> f64 {
+    let w = a.rem_euclid(std::f64::consts::TAU);
+    if w > std::f64::consts::PI {
+        w - std::f64::consts::TAU
+    } else {
+        w
+    }
+}
+
+/// The single-file log of `profile`'s columns, numbers in Rust's shortest
+/// round-trip form (as [`RovRecord::to_csv`]).
+fn profile_csv(profile: &VesselProfile, rec: &RovRecord) -> String {
+    let cols = required_columns(profile, LogRole::Single, None);
+    let source: Vec<(&DMatrix<f64>, usize)> = cols
+        .iter()
+        .skip(1)
+        .filter_map(|c| {
+            Dof::ALL.iter().find_map(|&d| {
+                if c == d.force_column() {
+                    Some((&rec.tau_commanded, d.index()))
+                } else if c == d.velocity_symbol() {
+                    Some((&rec.nu, d.index()))
+                } else if c == pose_column(d) {
+                    Some((&rec.eta, d.index()))
+                } else {
+                    None
+                }
+            })
+        })
+        .collect();
+    debug_assert_eq!(cols.first().map(String::as_str), Some(TIME_COLUMN));
+    let mut out = cols.join(",");
+    out.push('\n');
+    for k in 0..rec.len() {
+        out.push_str(&rec.t[k].to_string());
+        for (m, i) in &source {
+            out.push(',');
+            out.push_str(&m[(k, *i)].to_string());
+        }
+        out.push('\n');
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;

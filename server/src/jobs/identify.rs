@@ -1,0 +1,252 @@
+//! The `identify` job: a campaign's accepted runs → a validated, versioned
+//! model. Methods: `lambda_kf` (LPV by the λ-filter Kalman method, thesis
+//! sec. 2.5), `n4sid` (black-box comparison), `parallel_ekf` (DP ships,
+//! Fossen et al. 1995). The numerics are the core's
+//! [`seatrial_core::identification`]; this file loads, calls and stores.
+
+use std::path::PathBuf;
+
+use seatrial_core::estimation::Progress;
+use seatrial_core::identification::{
+    IdentifyError, Identified, LambdaCampaignSettings, N4sidCampaignSettings, RunInput,
+    identify_lambda_campaign, identify_n4sid_campaign,
+};
+use seatrial_core::planning::VesselProfile;
+use serde::de::DeserializeOwned;
+use sqlx::SqliteConnection;
+
+use super::handler::{BoxFuture, Compute, JobContext, JobFailure, JobHandler, Persist, compute};
+use crate::error::ApiError;
+use crate::processing::{self, RunMeta, RunSummary, thruster_force_columns};
+use crate::storage::jobs::{Job, JobRequest};
+use crate::storage::models::{self, Lineage, NewModel};
+use crate::storage::{campaigns, plans, runs, vessels};
+
+/// Methods of `identify`, with what they fit.
+pub const METHODS: [&str; 2] = ["lambda_kf", "n4sid"];
+
+/// The `identify` handler.
+pub struct Identify;
+
+/// Parses `settings` for a method, naming the field on error.
+fn parse_settings<T: DeserializeOwned>(v: &serde_json::Value) -> Result<T, (String, String)> {
+    serde_path_to_error::deserialize(v).map_err(|e| {
+        let path = e.path().to_string();
+        let field = if path == "." { "settings".to_string() } else { format!("settings.{path}") };
+        (field, e.inner().to_string())
+    })
+}
+
+fn check_method(vessel: &VesselProfile, method: &str) -> Result<(), String> {
+    match (method, vessel.kind) {
+        ("lambda_kf" | "n4sid", _) => Ok(()),
+        (m, _) => Err(format!("unknown method '{m}'; use one of {}", METHODS.join(", "))),
+    }
+}
+
+/// Generalized-force columns the methods regress on, in DOF order.
+fn force_inputs(vessel: &VesselProfile) -> Vec<String> {
+    let derived = thruster_force_columns(vessel);
+    if derived.is_empty() {
+        vessel.dofs.iter().map(|d| d.force_column().to_string()).collect()
+    } else {
+        derived
+    }
+}
+
+/// A run as stored, ready to be re-read on the worker.
+struct StoredRun {
+    id: String,
+    name: String,
+    files: Vec<(String, PathBuf)>,
+    meta: RunMeta,
+    family: Option<seatrial_core::planning::ExperimentFamily>,
+    grid_speed_mps: Option<f64>,
+}
+
+impl JobHandler for Identify {
+    fn check<'a>(
+        &'a self,
+        cx: &'a JobContext,
+        req: &'a JobRequest,
+    ) -> BoxFuture<'a, Result<(), ApiError>> {
+        Box::pin(async move {
+            let Some(cid) = &req.campaign_id else {
+                return Err(ApiError::invalid("campaign_id", "identify needs the campaign whose runs to use"));
+            };
+            let campaign = campaigns::get(&cx.db, cid)
+                .await?
+                .ok_or_else(|| ApiError::missing("campaign_id", format!("no campaign with id '{cid}'")))?;
+            let vessel = vessels::get(&cx.db, &campaign.vessel_id)
+                .await?
+                .ok_or_else(|| ApiError::missing("campaign_id", "the campaign's vessel is gone"))?;
+            let method = req.method.as_deref().unwrap_or("lambda_kf");
+            check_method(&vessel.profile, method).map_err(|m| ApiError::invalid("method", m))?;
+            let parsed = match method {
+                "lambda_kf" => parse_settings::<LambdaCampaignSettings>(&req.settings).map(|_| ()),
+                _ => parse_settings::<N4sidCampaignSettings>(&req.settings).map(|_| ()),
+            };
+            parsed.map_err(|(field, msg)| ApiError::invalid(field, msg))?;
+            if req.run_ids.is_empty() {
+                let accepted = runs::list(&cx.db, cid).await?.iter().filter(|r| r.status == "accepted").count();
+                if accepted < 2 {
+                    return Err(ApiError::invalid(
+                        "run_ids",
+                        format!("the campaign has {accepted} accepted run(s); identification needs estimation runs and a held-out validation run"),
+                    ));
+                }
+            }
+            Ok(())
+        })
+    }
+
+    fn load<'a>(
+        &'a self,
+        cx: &'a JobContext,
+        job: &'a Job,
+    ) -> BoxFuture<'a, Result<Compute, JobFailure>> {
+        Box::pin(async move {
+            let req = &job.request;
+            let cid = req
+                .campaign_id
+                .clone()
+                .ok_or_else(|| JobFailure::field("campaign_id", "missing"))?;
+            let campaign = campaigns::get(&cx.db, &cid)
+                .await?
+                .ok_or_else(|| JobFailure::field("campaign_id", "the campaign was deleted"))?;
+            let vessel = vessels::get(&cx.db, &campaign.vessel_id)
+                .await?
+                .ok_or_else(|| JobFailure::field("campaign_id", "the vessel was deleted"))?;
+            let all = runs::list(&cx.db, &cid).await?;
+            let chosen: Vec<_> = if req.run_ids.is_empty() {
+                all.into_iter().filter(|r| r.status == "accepted").collect()
+            } else {
+                let mut v = Vec::new();
+                for id in &req.run_ids {
+                    v.push(
+                        all.iter()
+                            .find(|r| &r.id == id)
+                            .cloned()
+                            .ok_or_else(|| JobFailure::field("run_ids", format!("run '{id}' is gone")))?,
+                    );
+                }
+                v
+            };
+            let mut stored = Vec::new();
+            for r in chosen {
+                let planned = match &r.experiment_id {
+                    Some(eid) => plans::experiment(&cx.db, &cid, eid).await?.map(|(e, _)| e.experiment),
+                    None => None,
+                };
+                let summary = r.summary.clone().unwrap_or_default();
+                let meta = RunMeta {
+                    experiment_id: None,
+                    name: None,
+                    shared_channel: summary
+                        .pointer("/alignment/shared_channel")
+                        .and_then(|v| v.as_str())
+                        .map(str::to_string),
+                    rate_hz: summary.get("sample_rate_hz").and_then(|v| v.as_f64()),
+                };
+                stored.push(StoredRun {
+                    id: r.id.clone(),
+                    name: r.name.clone(),
+                    files: r
+                        .files
+                        .iter()
+                        .map(|f| (f.role.clone(), cx.blobs.path(&f.sha256)))
+                        .collect(),
+                    meta,
+                    family: planned.as_ref().map(|e| e.family),
+                    grid_speed_mps: planned.as_ref().and_then(|e| e.grid_speed_mps),
+                });
+            }
+            let method = req.method.clone().unwrap_or_else(|| "lambda_kf".into());
+            let settings = req.settings.clone();
+            let profile = vessel.profile.clone();
+            let grid = campaign.grid_speeds_mps.clone();
+            let (campaign_id, vessel_id) = (campaign.id.clone(), campaign.vessel_id.clone());
+            let name = format!("{} — {}", profile.name, method);
+            let lineage = models::latest_of_method(&cx.db, &cid, &method_name(&method))
+                .await?
+                .map(|m| Lineage::After(m.id))
+                .unwrap_or(Lineage::New);
+            Ok(compute(move |progress: &mut dyn Progress| {
+                progress.update(0.0, "reading runs")?;
+                let mut inputs = Vec::new();
+                for s in &stored {
+                    let mut summary = RunSummary::default();
+                    let record = processing::load_record(&profile, &s.files, &s.meta, &mut summary)
+                        .map_err(|e| JobFailure::field(format!("runs[{}]", s.id), e.message))?;
+                    inputs.push(RunInput {
+                        run_id: s.id.clone(),
+                        name: s.name.clone(),
+                        family: s.family,
+                        grid_speed_mps: s.grid_speed_mps,
+                        record,
+                    });
+                }
+                let mut sub = seatrial_core::estimation::SubProgress::new(progress, 0.05, 0.95);
+                let forces = force_inputs(&profile);
+                let out: Result<Identified, IdentifyError> = match method.as_str() {
+                    "lambda_kf" => {
+                        let s: LambdaCampaignSettings = parse_settings(&settings)
+                            .map_err(|(f, m)| JobFailure::field(f, m))?;
+                        identify_lambda_campaign(&profile, &grid, &forces, &inputs, &s, &mut sub)
+                    }
+                    _ => {
+                        let s: N4sidCampaignSettings = parse_settings(&settings)
+                            .map_err(|(f, m)| JobFailure::field(f, m))?;
+                        identify_n4sid_campaign(&profile, &forces, &inputs, &s, &mut sub)
+                    }
+                };
+                let out = out.map_err(|e| match e {
+                    IdentifyError::Cancelled => JobFailure::Cancelled,
+                    e => JobFailure::field(e.field().to_string(), e.to_string()),
+                })?;
+                Ok(NewModelOutput(NewModel {
+                    lineage,
+                    campaign_id,
+                    vessel_id,
+                    kind: serde_json::to_value(out.document.kind)
+                        .ok()
+                        .and_then(|v| v.as_str().map(str::to_string))
+                        .unwrap_or_default(),
+                    method: out.document.method.name().to_string(),
+                    name,
+                    settings: out.settings_used,
+                    run_ids: out.estimation_run_ids,
+                    validation_run_ids: out.validation_run_ids,
+                    job_id: None,
+                    document: serde_json::to_value(&out.document)
+                        .map_err(|e| JobFailure::new(e.to_string()))?,
+                    validation: serde_json::to_value(&out.validation)
+                        .map_err(|e| JobFailure::new(e.to_string()))?,
+                }))
+            }))
+        })
+    }
+}
+
+/// Stored method name of a request's method.
+fn method_name(method: &str) -> String {
+    method.to_string()
+}
+
+/// A model to store when the job succeeds.
+pub struct NewModelOutput(pub NewModel);
+
+impl Persist for NewModelOutput {
+    fn persist<'a>(
+        self: Box<Self>,
+        conn: &'a mut SqliteConnection,
+        job: &'a Job,
+    ) -> BoxFuture<'a, anyhow::Result<serde_json::Value>> {
+        Box::pin(async move {
+            let mut m = self.0;
+            m.job_id = Some(job.id.clone());
+            let saved = models::insert(conn, m).await?;
+            Ok(serde_json::json!({ "model_id": saved.id, "version": saved.version, "lineage_id": saved.lineage_id }))
+        })
+    }
+}
