@@ -3,7 +3,7 @@
 // speeds, one validation run), an identification started from the campaign
 // page and followed live to completion, the model page (parameters with ±,
 // fits, predicted-vs-measured and autocorrelation plots, exports, ZOH), and
-// cancelling a queued job.
+// errors: a refused request and a failed job. Cancelling: models-queue.test.mjs.
 //
 //   cd web && npm ci && node --test tests/models.test.mjs
 //
@@ -11,12 +11,9 @@
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { harness, tid, inked, dragZoom } from './harness.mjs';
+import { harness, tid, inked, dragZoom, uploadRun } from './harness.mjs';
 import { simulate, csv, ALL_COLUMNS, D } from './sim.mjs';
 import { SURVEYOR_ROV } from '../templates.js';
-
-// One worker: a second job waits in the queue while the first one runs.
-process.env.SEATRIAL_JOB_WORKERS = '1';
 
 const KN = 1852 / 3600;
 const H = harness();
@@ -24,16 +21,7 @@ let cid;
 let plan;
 const uploaded = []; // {id, code}
 
-async function upload(log, meta) {
-  const form = new FormData();
-  form.append('meta', JSON.stringify(meta));
-  form.append('file', new Blob([log], { type: 'text/csv' }), `${meta.name}.csv`);
-  const res = await fetch(`${H.base}/api/campaigns/${cid}/runs`, { method: 'POST', body: form });
-  const json = await res.json();
-  assert.equal(res.status, 201, JSON.stringify(json));
-  assert.equal(json.status, 'accepted', JSON.stringify(json));
-  return json;
-}
+const upload = (log, meta) => uploadRun(H, cid, log, meta);
 
 before(async () => {
   await H.start();
@@ -192,54 +180,38 @@ test('identify from the campaign page, follow the job, read the model page', asy
   });
 });
 
-test('a queued job cancelled from the UI shows cancelled; retry queues it again', async () => {
-  await H.withPage([], async (page) => {
-    await page.goto(`${H.base}/#/campaigns/${cid}`);
-    await page.getByRole('form', { name: 'Identify a model' }).waitFor();
-    const before = await page.locator(tid('job-row')).count();
-    const start = page.getByRole('button', { name: 'Start identification' });
-    // Two jobs: with one worker the second waits in the queue.
-    await start.click();
-    await page.waitForFunction((n) => document.querySelectorAll('[data-testid="job-row"]').length === n + 1, before);
-    await page.getByLabel('Method').selectOption('n4sid');
-    await start.click();
-    await page.waitForFunction((n) => document.querySelectorAll('[data-testid="job-row"]').length === n + 2, before);
-    const second = page.locator(tid('job-row')).first();
-    const first = page.locator(tid('job-row')).nth(1);
-    assert.match(await second.textContent(), /N4SID/);
-    await second.getByRole('button', { name: 'Cancel' }).click();
-    await page.locator(`${tid('job-row')}[data-state="cancelled"]`).first().waitFor();
-    assert.equal(await second.getAttribute('data-state'), 'cancelled');
-    assert.match(await second.locator(tid('job-state')).textContent(), /cancelled/);
-    assert.equal(await second.getByRole('button', { name: 'Cancel' }).count(), 0);
-    // The running one can be cancelled too: it stops at its next progress report.
-    if (await first.getAttribute('data-state') !== 'succeeded') {
-      await first.getByRole('button', { name: 'Cancel' }).click().catch(() => {});
-    }
-    await page.waitForFunction(() => {
-      const r = document.querySelectorAll('[data-testid="job-row"]')[1];
-      return ['cancelled', 'succeeded'].includes(r.dataset.state);
-    }, null, { timeout: 120000 });
-    // Retry the cancelled one: queued again, then it runs to the end.
-    await second.getByRole('button', { name: 'Retry' }).click();
-    await page.waitForFunction(() => document.querySelector('[data-testid="job-row"]').dataset.state !== 'cancelled');
-    await page.locator(`${tid('job-row')}:first-child[data-state="succeeded"]`).waitFor({ timeout: 180000 });
-    assert.equal(await second.locator(tid('job-model-link')).count(), 1);
-  });
-});
-
-test('a refused request is shown next to the form, naming the field', async () => {
+test('bad answers are shown: a refused request names its field next to the form, a failed job says why', async () => {
   await H.withPage([{ method: 'POST', status: 422, path: /^\/api\/jobs$/ }], async (page) => {
     await page.goto(`${H.base}/#/campaigns/${cid}`);
     await page.getByRole('form', { name: 'Identify a model' }).waitFor();
-    // Hold out every run: nothing is left to estimate from.
-    for (const box of await page.locator(tid('identify-holdout')).all()) await box.check();
-    assert.match(await page.textContent(tid('identify-roles')), /0 to estimate from, 5 held out/);
+
+    // A request the server refuses at submission: a method this server does
+    // not know (sent as if chosen) answers 422 naming `method`.
+    await page.route('**/api/jobs', (route) => (route.request().method() === 'POST'
+      ? route.continue({ postData: JSON.stringify({ ...JSON.parse(route.request().postData()), method: 'no_such_method' }) })
+      : route.continue()));
+    const before = await page.locator(tid('job-row')).count();
     await page.getByRole('button', { name: 'Start identification' }).click();
     const err = page.locator(tid('identify-error-text'));
     await err.waitFor();
     assert.equal(await err.getAttribute('data-status'), '422');
-    assert.match(await err.locator(tid('identify-error-field')).textContent(), /run_ids|settings/);
-    assert.ok((await err.textContent()).length > 20);
+    assert.equal(await err.locator(tid('identify-error-field')).textContent(), 'method');
+    assert.match(await err.textContent(), /unknown method 'no_such_method'/);
+    const fieldErr = page.locator(`${tid('field-error')}[data-for="method"]`);
+    assert.match(await fieldErr.textContent(), /unknown method/);
+    assert.equal(await page.getByLabel('Method').getAttribute('aria-invalid'), 'true');
+    assert.equal(await page.locator(tid('job-row')).count(), before, 'nothing was queued');
+    await page.unroute('**/api/jobs');
+
+    // A job that fails: every run held out leaves nothing to estimate from.
+    for (const box of await page.locator(tid('identify-holdout')).all()) await box.check();
+    assert.match(await page.textContent(tid('identify-roles')), /0 to estimate from, 5 held out/);
+    await page.getByRole('button', { name: 'Start identification' }).click();
+    assert.equal(await page.locator(tid('field-error')).count(), 0, 'the previous error is cleared');
+    const row = page.locator(tid('job-row')).first();
+    await page.locator(`${tid('job-row')}:first-child[data-state="failed"]`).waitFor({ timeout: 60000 });
+    assert.match(await row.locator(tid('job-error')).textContent(), /no estimation run.*\[run_ids\]/);
+    assert.equal(await row.getByRole('button', { name: 'Retry' }).count(), 1);
+    assert.equal(await row.getByRole('button', { name: 'Cancel' }).count(), 0);
   });
 });
