@@ -26,7 +26,8 @@ pub struct ModelFilter {
 
 /// Models, newest first (metadata only).
 #[utoipa::path(get, path = "/api/models", tag = "models", params(ModelFilter),
-    responses((status = 200, description = "Models, newest first", body = [ModelSummary])))]
+    responses((status = 200, description = "Models, newest first", body = [ModelSummary]),
+              (status = 400, description = "Malformed query parameter", body = ErrorBody)))]
 pub async fn list_models(
     State(s): State<AppState>,
     ApiQuery(f): ApiQuery<ModelFilter>,
@@ -50,7 +51,7 @@ pub struct ModelView {
     /// The model: matrices, parameters with standard deviations.
     pub document: ModelDocument,
     /// Validation reports per held-out run.
-    #[schema(value_type = Object)]
+    #[schema(value_type = Vec<seatrial_core::identification::RunValidation>)]
     pub validation: serde_json::Value,
     /// ZOH-discretized Φ, Γ at the requested `h` (only with `?h=`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -65,8 +66,9 @@ pub struct ModelQuery {
 }
 
 fn view(m: StoredModel) -> ApiResult<ModelView> {
-    let document: ModelDocument = serde_json::from_value(m.document)
-        .map_err(|e| ApiError::Internal(anyhow::anyhow!("stored model document unreadable: {e}")))?;
+    let document: ModelDocument = serde_json::from_value(m.document).map_err(|e| {
+        ApiError::Internal(anyhow::anyhow!("stored model document unreadable: {e}"))
+    })?;
     Ok(ModelView {
         model: m.summary,
         settings: m.settings,
@@ -83,6 +85,7 @@ fn view(m: StoredModel) -> ApiResult<ModelView> {
 #[utoipa::path(get, path = "/api/models/{id}", tag = "models",
     params(("id" = String, Path, description = "Model id"), ModelQuery),
     responses((status = 200, description = "The model", body = ModelView),
+              (status = 400, description = "Malformed query parameter (`h` not a number)", body = ErrorBody),
               (status = 404, description = "No such model", body = ErrorBody),
               (status = 422, description = "`h` unusable (not positive; a subspace model's own h differs)", body = ErrorBody)))]
 pub async fn get_model(
@@ -107,6 +110,18 @@ pub struct ExportQuery {
     pub format: Option<String>,
 }
 
+/// What a JSON export holds: the whole model (`json`) or its Fossen-form
+/// parameter set (`fossen`). Documentation only.
+#[derive(Serialize, utoipa::ToSchema)]
+#[allow(dead_code)]
+#[serde(untagged)]
+pub enum JsonExport {
+    /// `format=json`.
+    Model(ModelView),
+    /// `format=fossen`.
+    Fossen(seatrial_core::identification::export::FossenParameterSet),
+}
+
 fn attachment(body: String, content_type: &str, filename: String) -> Response {
     (
         [
@@ -126,7 +141,7 @@ fn attachment(body: String, content_type: &str, filename: String) -> Response {
     params(("id" = String, Path, description = "Model id"), ExportQuery),
     responses(
         (status = 200, description = "The export: JSON (`json`, `fossen`) or CSV (`csv`)", content(
-            (ModelView = "application/json"),
+            (JsonExport = "application/json"),
             (String = "text/csv"))),
         (status = 400, description = "Unknown format", body = ErrorBody),
         (status = 404, description = "No such model", body = ErrorBody),
@@ -137,7 +152,11 @@ pub async fn export_model(
     ApiQuery(q): ApiQuery<ExportQuery>,
 ) -> ApiResult<Response> {
     let m = found(models::get(&s.db, &id).await?, "model", &id)?;
-    let stem = format!("{}-v{}", m.summary.name.replace([' ', '/', '"'], "_"), m.summary.version);
+    let stem = format!(
+        "{}-v{}",
+        m.summary.name.replace([' ', '/', '"'], "_"),
+        m.summary.version
+    );
     let v = view(m)?;
     match q.format.as_deref().unwrap_or("json") {
         "json" => Ok(attachment(

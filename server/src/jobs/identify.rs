@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use seatrial_core::estimation::Progress;
 use seatrial_core::identification::{
-    IdentifyError, Identified, LambdaCampaignSettings, N4sidCampaignSettings, RunInput,
+    Identified, IdentifyError, LambdaCampaignSettings, N4sidCampaignSettings, RunInput,
     identify_lambda_campaign, identify_n4sid_campaign,
 };
 use seatrial_core::planning::VesselProfile;
@@ -32,7 +32,11 @@ pub struct Identify;
 fn parse_settings<T: DeserializeOwned>(v: &serde_json::Value) -> Result<T, (String, String)> {
     serde_path_to_error::deserialize(v).map_err(|e| {
         let path = e.path().to_string();
-        let field = if path == "." { "settings".to_string() } else { format!("settings.{path}") };
+        let field = if path == "." {
+            "settings".to_string()
+        } else {
+            format!("settings.{path}")
+        };
         (field, e.inner().to_string())
     })
 }
@@ -40,7 +44,10 @@ fn parse_settings<T: DeserializeOwned>(v: &serde_json::Value) -> Result<T, (Stri
 fn check_method(vessel: &VesselProfile, method: &str) -> Result<(), String> {
     match (method, vessel.kind) {
         ("lambda_kf" | "n4sid", _) => Ok(()),
-        (m, _) => Err(format!("unknown method '{m}'; use one of {}", METHODS.join(", "))),
+        (m, _) => Err(format!(
+            "unknown method '{m}'; use one of {}",
+            METHODS.join(", ")
+        )),
     }
 }
 
@@ -48,7 +55,11 @@ fn check_method(vessel: &VesselProfile, method: &str) -> Result<(), String> {
 fn force_inputs(vessel: &VesselProfile) -> Vec<String> {
     let derived = thruster_force_columns(vessel);
     if derived.is_empty() {
-        vessel.dofs.iter().map(|d| d.force_column().to_string()).collect()
+        vessel
+            .dofs
+            .iter()
+            .map(|d| d.force_column().to_string())
+            .collect()
     } else {
         derived
     }
@@ -72,11 +83,14 @@ impl JobHandler for Identify {
     ) -> BoxFuture<'a, Result<(), ApiError>> {
         Box::pin(async move {
             let Some(cid) = &req.campaign_id else {
-                return Err(ApiError::invalid("campaign_id", "identify needs the campaign whose runs to use"));
+                return Err(ApiError::invalid(
+                    "campaign_id",
+                    "identify needs the campaign whose runs to use",
+                ));
             };
-            let campaign = campaigns::get(&cx.db, cid)
-                .await?
-                .ok_or_else(|| ApiError::missing("campaign_id", format!("no campaign with id '{cid}'")))?;
+            let campaign = campaigns::get(&cx.db, cid).await?.ok_or_else(|| {
+                ApiError::missing("campaign_id", format!("no campaign with id '{cid}'"))
+            })?;
             let vessel = vessels::get(&cx.db, &campaign.vessel_id)
                 .await?
                 .ok_or_else(|| ApiError::missing("campaign_id", "the campaign's vessel is gone"))?;
@@ -88,11 +102,17 @@ impl JobHandler for Identify {
             };
             parsed.map_err(|(field, msg)| ApiError::invalid(field, msg))?;
             if req.run_ids.is_empty() {
-                let accepted = runs::list(&cx.db, cid).await?.iter().filter(|r| r.status == "accepted").count();
+                let accepted = runs::list(&cx.db, cid)
+                    .await?
+                    .iter()
+                    .filter(|r| r.status == "accepted")
+                    .count();
                 if accepted < 2 {
                     return Err(ApiError::invalid(
                         "run_ids",
-                        format!("the campaign has {accepted} accepted run(s); identification needs estimation runs and a held-out validation run"),
+                        format!(
+                            "the campaign has {accepted} accepted run(s); identification needs estimation runs and a held-out validation run"
+                        ),
                     ));
                 }
             }
@@ -123,19 +143,18 @@ impl JobHandler for Identify {
             } else {
                 let mut v = Vec::new();
                 for id in &req.run_ids {
-                    v.push(
-                        all.iter()
-                            .find(|r| &r.id == id)
-                            .cloned()
-                            .ok_or_else(|| JobFailure::field("run_ids", format!("run '{id}' is gone")))?,
-                    );
+                    v.push(all.iter().find(|r| &r.id == id).cloned().ok_or_else(|| {
+                        JobFailure::field("run_ids", format!("run '{id}' is gone"))
+                    })?);
                 }
                 v
             };
             let mut stored = Vec::new();
             for r in chosen {
                 let planned = match &r.experiment_id {
-                    Some(eid) => plans::experiment(&cx.db, &cid, eid).await?.map(|(e, _)| e.experiment),
+                    Some(eid) => plans::experiment(&cx.db, &cid, eid)
+                        .await?
+                        .map(|(e, _)| e.experiment),
                     None => None,
                 };
                 let summary = r.summary.clone().unwrap_or_default();
@@ -190,13 +209,13 @@ impl JobHandler for Identify {
                 let forces = force_inputs(&profile);
                 let out: Result<Identified, IdentifyError> = match method.as_str() {
                     "lambda_kf" => {
-                        let s: LambdaCampaignSettings = parse_settings(&settings)
-                            .map_err(|(f, m)| JobFailure::field(f, m))?;
+                        let s: LambdaCampaignSettings =
+                            parse_settings(&settings).map_err(|(f, m)| JobFailure::field(f, m))?;
                         identify_lambda_campaign(&profile, &grid, &forces, &inputs, &s, &mut sub)
                     }
                     _ => {
-                        let s: N4sidCampaignSettings = parse_settings(&settings)
-                            .map_err(|(f, m)| JobFailure::field(f, m))?;
+                        let s: N4sidCampaignSettings =
+                            parse_settings(&settings).map_err(|(f, m)| JobFailure::field(f, m))?;
                         identify_n4sid_campaign(&profile, &forces, &inputs, &s, &mut sub)
                     }
                 };
@@ -246,7 +265,9 @@ impl Persist for NewModelOutput {
             let mut m = self.0;
             m.job_id = Some(job.id.clone());
             let saved = models::insert(conn, m).await?;
-            Ok(serde_json::json!({ "model_id": saved.id, "version": saved.version, "lineage_id": saved.lineage_id }))
+            Ok(
+                serde_json::json!({ "model_id": saved.id, "version": saved.version, "lineage_id": saved.lineage_id }),
+            )
         })
     }
 }

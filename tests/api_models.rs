@@ -1,0 +1,249 @@
+//! Identification end to end through REST: a planned ROV campaign is flown
+//! by the truth simulator, its logs uploaded, an `identify` job runs to
+//! completion in the background, and the stored model is fetched, exported,
+//! discretized and versioned. Every response is checked against openapi.yaml.
+
+mod common;
+
+use std::time::Duration;
+
+use common::sim::multipart;
+use common::{TestApp, rov_profile};
+use seatrial::jobs::{JobRegistry, JobsConfig};
+use seatrial_core::planning::{CampaignSpec, generate_plan};
+use seatrial_core::simulation::rov::RovTruth;
+use seatrial_core::simulation::trials::{TrialSettings, fly_experiment};
+use serde_json::{Value, json};
+
+async fn app() -> TestApp {
+    TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await
+}
+
+/// Creates the Surveyor and a campaign on 1 and 2 kn with recursive and
+/// validation experiments, flies every planned experiment (≤ 240 s each)
+/// through a linear truth, and uploads the logs linked to their experiments.
+async fn flown_campaign(app: &TestApp) -> String {
+    let r = app
+        .call("POST", "/api/vessels", &[], Some(rov_profile()))
+        .await;
+    let vid = r.json["id"].as_str().unwrap().to_string();
+    let spec = json!({
+        "vessel_id": vid,
+        "name": "identification trial",
+        "grid": { "unit": "kn", "speeds": [1.0, 2.0] },
+        "families": ["recursive", "validation"],
+        "repetitions": 2,
+        "seed": 11
+    });
+    let r = app
+        .call("POST", "/api/campaigns", &[], Some(spec.clone()))
+        .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let cid = r.json["id"].as_str().unwrap().to_string();
+    let plan = app
+        .call("POST", "/api/campaigns/{id}/plan", &[&cid], None)
+        .await;
+    assert_eq!(plan.status, 201, "{}", plan.text);
+    // The same plan, generated in-process to fly it (plans are deterministic).
+    let profile = seatrial_core::planning::examples::surveyor_rov();
+    let mut core_spec = spec.clone();
+    core_spec.as_object_mut().unwrap().remove("vessel_id");
+    let core_spec: CampaignSpec = serde_json::from_value(core_spec).unwrap();
+    let core_plan = generate_plan(&profile, &core_spec).unwrap();
+    let mut truth = RovTruth::surveyor_like();
+    truth.restoring = Default::default();
+    let settings = TrialSettings {
+        max_duration_s: Some(240.0),
+        seed: 3,
+        ..TrialSettings::default()
+    };
+    for planned in &core_plan.experiments {
+        let code = &planned.experiment.code;
+        let eid = plan.json["experiments"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["code"] == *code)
+            .and_then(|e| e["id"].as_str())
+            .unwrap_or_else(|| panic!("experiment {code} not in the stored plan"))
+            .to_string();
+        let flown = fly_experiment(&profile, &truth, planned, &settings).unwrap();
+        let meta = json!({ "experiment_id": eid }).to_string();
+        let (ct, body) = multipart(&[
+            ("meta", None, &meta),
+            ("file", Some(&format!("{code}.csv")), &flown.csv),
+        ]);
+        let r = app
+            .raw(
+                "POST",
+                &format!("/api/campaigns/{cid}/runs"),
+                Some((&ct, body)),
+            )
+            .await;
+        assert_eq!(r.status, 201, "{code}: {}", r.text);
+    }
+    cid
+}
+
+async fn wait_for(app: &TestApp, job_id: &str) -> Value {
+    for _ in 0..600 {
+        let r = app.call("GET", "/api/jobs/{id}", &[job_id], None).await;
+        let state = r.json["state"].as_str().unwrap_or("").to_string();
+        if ["succeeded", "failed", "cancelled", "interrupted"].contains(&state.as_str()) {
+            return r.json;
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    panic!("job {job_id} did not finish in 60 s");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn identify_job_stores_a_validated_versioned_lpv_model() {
+    let app = app().await;
+    let cid = flown_campaign(&app).await;
+    let submit =
+        json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf", "settings": {} });
+    let r = app
+        .call("POST", "/api/jobs", &[], Some(submit.clone()))
+        .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let job = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    assert_eq!(job["state"], "succeeded", "{job}");
+    assert_eq!(job["progress"], 1.0);
+    let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+
+    let m = app.call("GET", "/api/models/{id}", &[&mid], None).await;
+    assert_eq!(m.status, 200, "{}", m.text);
+    let doc = &m.json["document"];
+    assert_eq!(doc["kind"], "lpv");
+    let points = doc["lpv"]["points"].as_array().unwrap();
+    assert_eq!(points.len(), 2, "one sub-model per grid speed");
+    // M of the truth is speed independent: surge mass 5800 kg at both points.
+    for p in points {
+        let m11 = p["m"][0][0].as_f64().unwrap();
+        assert!(
+            (m11 - 5800.0).abs() < 0.15 * 5800.0,
+            "M[surge,surge] = {m11}"
+        );
+        assert!(p["m_std"][0][0].as_f64().unwrap() > 0.0);
+    }
+    assert_eq!(m.json["model"]["version"], 1);
+    assert!(!m.json["validation_run_ids"].as_array().unwrap().is_empty());
+    // Validation on the held-out run: fits for every channel, residual tests.
+    let rep = &m.json["validation"][0]["report"];
+    for ch in rep["channels"].as_array().unwrap() {
+        let fit = ch["fit_one_step"].as_f64().unwrap();
+        assert!(fit > 0.5, "{}: 1-step fit {fit}", ch["output"]);
+        assert!(ch["fit_simulation"].is_number() || ch["fit_simulation"].is_null());
+    }
+
+    // ZOH matrices at the controller's h.
+    let d = app
+        .call("GET", "/api/models/{id}?h=0.05", &[&mid], None)
+        .await;
+    assert_eq!(d.status, 200, "{}", d.text);
+    assert_eq!(d.json["discrete"]["points"].as_array().unwrap().len(), 2);
+    let bad = app
+        .call("GET", "/api/models/{id}?h=-1", &[&mid], None)
+        .await;
+    assert_eq!(bad.status, 422);
+    assert_eq!(bad.json["field"], "h");
+    let bad = app
+        .call("GET", "/api/models/{id}?h=abc", &[&mid], None)
+        .await;
+    assert_eq!(bad.status, 400, "{}", bad.text);
+
+    // Exports.
+    let csv = app
+        .call("GET", "/api/models/{id}/export?format=csv", &[&mid], None)
+        .await;
+    assert_eq!(csv.status, 200);
+    assert!(
+        csv.text
+            .starts_with("group,symbol,grid_speed_mps,value,std,unit\n")
+    );
+    assert!(csv.text.lines().count() > 12);
+    let fossen = app
+        .call(
+            "GET",
+            "/api/models/{id}/export?format=fossen",
+            &[&mid],
+            None,
+        )
+        .await;
+    assert_eq!(fossen.status, 200, "{}", fossen.text);
+    assert_eq!(fossen.json["points"].as_array().unwrap().len(), 2);
+    assert_eq!(fossen.json["points"][0]["M"].as_array().unwrap().len(), 6);
+    let unknown = app
+        .call("GET", "/api/models/{id}/export?format=xlsx", &[&mid], None)
+        .await;
+    assert_eq!(unknown.status, 400);
+    assert_eq!(unknown.json["field"], "format");
+
+    // Re-identification continues the lineage as version 2.
+    let r = app.call("POST", "/api/jobs", &[], Some(submit)).await;
+    let job2 = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    assert_eq!(job2["result"]["version"], 2, "{job2}");
+    let list = app
+        .call("GET", "/api/models?campaign_id={id}", &[&cid], None)
+        .await;
+    assert_eq!(list.json.as_array().unwrap().len(), 2);
+    assert_eq!(list.json[0]["parent_id"], mid.as_str());
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn n4sid_job_and_bad_requests_name_the_field() {
+    let app = app().await;
+    let cid = flown_campaign(&app).await;
+    let bad = |body: Value| {
+        let app = &app;
+        async move { app.call("POST", "/api/jobs", &[], Some(body)).await }
+    };
+    let r = bad(json!({ "kind": "identify", "campaign_id": cid, "method": "least_squares" })).await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["field"].as_str()),
+        (422, Some("method")),
+        "{}",
+        r.text
+    );
+    let r = bad(json!({ "kind": "identify", "campaign_id": cid, "settings": { "structure": "triangular" } })).await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["field"].as_str()),
+        (422, Some("settings.structure")),
+        "{}",
+        r.text
+    );
+    let r = bad(json!({ "kind": "identify", "method": "n4sid" })).await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["field"].as_str()),
+        (422, Some("campaign_id")),
+        "{}",
+        r.text
+    );
+    // A job that fails in the numerics names the setting too.
+    let r =
+        bad(json!({ "kind": "identify", "campaign_id": cid, "settings": { "t_lambda_s": 0.01 } }))
+            .await;
+    assert_eq!(r.status, 202);
+    let job = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    assert_eq!(job["state"], "failed");
+    assert_eq!(job["error"]["field"], "settings.t_lambda_s", "{job}");
+
+    let r = bad(json!({ "kind": "identify", "campaign_id": cid, "method": "n4sid", "settings": { "order": 6 } })).await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let job = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    assert_eq!(job["state"], "succeeded", "{job}");
+    let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+    let m = app.call("GET", "/api/models/{id}", &[&mid], None).await;
+    assert_eq!(m.json["document"]["state_space"]["order"], 6);
+    let f = app
+        .call(
+            "GET",
+            "/api/models/{id}/export?format=fossen",
+            &[&mid],
+            None,
+        )
+        .await;
+    assert_eq!(f.status, 422, "a black box has no Fossen form");
+    assert_eq!(f.json["field"], "format");
+}
