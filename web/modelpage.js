@@ -160,7 +160,8 @@ export async function modelPage(view, id) {
       });
       const zc = c.one_step && c.one_step.zero_crossings;
       return h('div', { class: 'channel-block', 'data-testid': 'channel-block', 'data-channel': c.output },
-        h('h4', null, h('span', { class: 'mono' }, c.output), ' ', h('span', { class: `badge ${c.residuals_white ? 'good' : 'weak'}` }, c.verdict)),
+        h('h4', null, h('span', { class: 'mono' }, c.output), ' ', h('span', { class: `badge ${c.residuals_white ? 'good' : 'weak'}` }, c.residuals_white ? 'residuals white' : 'residuals correlated'),
+          h('span', { class: 'verdict-line', 'data-testid': 'channel-verdict-line' }, c.verdict)),
         (c.findings || []).length ? h('ul', { class: 'findings', 'data-testid': 'channel-findings' }, c.findings.map((f) => h('li', null, f))) : null,
         h('div', { class: 'plot-grid pvm-grid' },
           h('div', { class: 'plot-card' }, h('h3', null, 'Predicted vs measured ', h('span', { class: 'hint' }, `fit 1-step ${fitText(c.fit_one_step)} · ${rep.k}-step ${fitText(c.fit_k_step)} · simulation ${fitText(c.fit_simulation)}`)), pvm),
