@@ -70,6 +70,16 @@ export const api = {
   run: (rid) => request('GET', `/api/runs/${enc(rid)}`),
   quality: (rid) => request('GET', urls.quality(rid)),
   coverage: (id) => request('GET', `/api/campaigns/${enc(id)}/coverage`),
+  // Background jobs (identification, discovery) and the models they store.
+  jobs: (campaignId) => request('GET', `/api/jobs${campaignId ? `?campaign_id=${enc(campaignId)}` : ''}`),
+  job: (jid) => request('GET', `/api/jobs/${enc(jid)}`),
+  submitJob: (body) => request('POST', '/api/jobs', body),
+  cancelJob: (jid) => request('POST', `/api/jobs/${enc(jid)}/cancel`),
+  retryJob: (jid) => request('POST', `/api/jobs/${enc(jid)}/retry`),
+  models: (campaignId) => request('GET', `/api/models${campaignId ? `?campaign_id=${enc(campaignId)}` : ''}`),
+  lineage: (lineageId) => request('GET', `/api/models?lineage_id=${enc(lineageId)}`),
+  // `hSample`: add the ZOH-discretized Φ, Γ at this sample time.
+  model: (mid, hSample) => request('GET', `/api/models/${enc(mid)}${hSample != null ? `?h=${enc(hSample)}` : ''}`),
 };
 
 /**
@@ -126,4 +136,7 @@ export const urls = {
   raw: (rid, role) => `/api/runs/${enc(rid)}/raw${role && role !== 'file' ? `?file=${enc(role)}` : ''}`,
   quality: (rid) => `/api/runs/${enc(rid)}/quality`,
   run: (rid) => `#/runs/${enc(rid)}`,
+  model: (mid) => `#/models/${enc(mid)}`,
+  jobEvents: (jid) => `/api/jobs/${enc(jid)}/events`,
+  modelExport: (mid, format) => `/api/models/${enc(mid)}/export?format=${enc(format)}`,
 };

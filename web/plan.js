@@ -10,6 +10,7 @@ import { h, fill, banner, clearBanner } from './forms.js';
 import { DURATIONS, gridText } from './campaigns.js';
 import { schedulePlot, psdPlot, destroyPlots } from './plots.js';
 import { runsSection } from './runs.js';
+import { identifySection } from './identify.js';
 
 const isExcitedWithAnalysis = (c) => c.excited && c.analysis;
 
@@ -79,7 +80,9 @@ export async function campaignPage(view, id) {
   const exportLinks = h('span', { class: 'actions' });
   const planHost = h('section', { class: 'plan', 'aria-label': 'Plan' });
   const runsHost = h('section', { class: 'runs', 'aria-label': 'Runs', 'data-testid': 'runs-section' });
+  const identifyHost = h('section', { class: 'identification', 'aria-label': 'Identification', 'data-testid': 'identify-section' });
   let runs = null; // the Runs section's controller
+  let ident = null; // the Identification section's controller
 
   const c = campaign;
   const durs = c.durations || {};
@@ -98,6 +101,7 @@ export async function campaignPage(view, id) {
       h('dt', null, 'Durations'), h('dd', null, DURATIONS.filter((d) => durs[d.key] != null).map((d) => `${d.label.toLowerCase()} ${fmt(durs[d.key])} s`).join(' · ') || 'defaults'),
       h('dt', null, 'Seed'), h('dd', { class: 'mono' }, c.seed ?? 'default')),
     runsHost,
+    identifyHost,
     h('h2', { class: 'section-title' }, 'Plan'),
     planHost);
 
@@ -113,6 +117,7 @@ export async function campaignPage(view, id) {
       if (location.hash !== `#/campaigns/${id}`) history.replaceState(null, '', `#/campaigns/${id}`);
       renderPlan();
       if (runs) await runs.setPlan(plan);
+      if (ident) ident.setPlan(plan);
     } catch (err) {
       banner(`${err.status ? `${err.status} · ` : ''}${err.message}${err.field ? ` [${err.field}]` : ''}`);
     } finally {
@@ -310,7 +315,14 @@ export async function campaignPage(view, id) {
   }
 
   renderPlan();
-  runs = await runsSection(runsHost, { campaign, plan });
+  runs = await runsSection(runsHost, { campaign, plan, onRuns: (r) => { if (ident) ident.setRuns(r); } });
+  try {
+    ident = await identifySection(identifyHost, { campaign, vessel, plan, runs: runs.runs() });
+  } catch (err) {
+    // The rest of the page stays usable; the answer is shown where the section would be.
+    fill(identifyHost, h('h2', { class: 'section-title' }, 'Identification'),
+      h('p', { class: 'error-text', role: 'alert', 'data-testid': 'identify-load-error' }, `Could not load jobs and models: ${err.status ? `${err.status} · ` : ''}${err.message}`));
+  }
 
   return {
     key: `campaign:${id}`,
@@ -318,6 +330,7 @@ export async function campaignPage(view, id) {
     destroy() {
       destroyPlots();
       runs.destroy();
+      if (ident) ident.destroy();
     },
   };
 }

@@ -80,7 +80,7 @@ export function rawLinks(run, attrs = {}) {
 /**
  * Builds the Runs section into `host`. Returns {setPlan(plan), destroy()}.
  */
-export async function runsSection(host, { campaign, plan: plan0 }) {
+export async function runsSection(host, { campaign, plan: plan0, onRuns = null }) {
   const id = campaign.id;
   let plan = plan0;
   let runs = [];
@@ -416,6 +416,7 @@ export async function runsSection(host, { campaign, plan: plan0 }) {
     ]);
     runs = r;
     coverage = c;
+    if (onRuns) onRuns(runs);
     renderRuns();
     renderCoverage();
     renderExperiments();
@@ -428,6 +429,7 @@ export async function runsSection(host, { campaign, plan: plan0 }) {
     h('div', { class: 'runs-layout' }, h('div', { class: 'runs-left' }, form, listBox), covBox));
 
   return {
+    runs: () => runs,
     async setPlan(p) {
       plan = p;
       await refresh();

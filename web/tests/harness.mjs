@@ -145,3 +145,15 @@ export async function dragZoom(page, hostSel, a, b) {
   await page.mouse.up();
   return over;
 }
+
+/** Upload a one-file run through the API (test set-up); asserts it was accepted. */
+export async function uploadRun(h, campaignId, log, meta) {
+  const form = new FormData();
+  form.append('meta', JSON.stringify(meta));
+  form.append('file', new Blob([log], { type: 'text/csv' }), `${meta.name || 'run'}.csv`);
+  const res = await fetch(`${h.base}/api/campaigns/${campaignId}/runs`, { method: 'POST', body: form });
+  const json = await res.json();
+  assert.equal(res.status, 201, JSON.stringify(json));
+  assert.equal(json.status, 'accepted', JSON.stringify(json));
+  return json;
+}

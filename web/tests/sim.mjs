@@ -27,15 +27,16 @@ export const FORCES = ['tau_X', 'tau_Y', 'tau_Z', 'tau_K', 'tau_M', 'tau_N'];
 export const VELS = ['u', 'v', 'w', 'p', 'q', 'r'];
 export const POSE = ['x', 'y', 'z', 'phi', 'theta', 'psi'];
 export const ALL_COLUMNS = [...FORCES, ...VELS, ...POSE];
-const TC = [4.0, 3.0, 3.0, 1.5, 1.5, 2.0];
-const D = [2000, 4000, 4000, 3000, 3000, 3000];
+export const TC = [4.0, 3.0, 3.0, 1.5, 1.5, 2.0];
+export const D = [2000, 4000, 4000, 3000, 3000, 3000];
 
 /**
  * Simulates `duration` s at `fs` Hz. `amp[i]` is the force amplitude of DOF i
  * (0 holds it still); forces switch every `clock` s. `force[i]`, if given, is
  * a function k → τ_i (e.g. a planned schedule) that replaces the random force.
+ * `surge` is the forward speed (m/s) the surge bias force holds.
  */
-export function simulate({ seed, fs, duration, amp, clock, noise, force = [] }) {
+export function simulate({ seed, fs, duration, amp, clock, noise, force = [], surge = 0.5 }) {
   const n = Math.floor(duration * fs);
   const h = 1 / fs;
   const rng = new Rng(seed);
@@ -43,7 +44,7 @@ export function simulate({ seed, fs, duration, amp, clock, noise, force = [] }) 
   for (let i = 0; i < 6; i += 1) {
     const hold = Math.max(Math.round(clock * fs), 1);
     let level = 0;
-    let v = i === 0 ? 0.5 : 0;
+    let v = i === 0 ? surge : 0;
     let pos = i === 2 ? 20 : 0;
     const a = Math.exp(-h / TC[i]);
     const tau = new Float64Array(n);
@@ -51,7 +52,7 @@ export function simulate({ seed, fs, duration, amp, clock, noise, force = [] }) 
     const eta = new Float64Array(n);
     for (let k = 0; k < n; k += 1) {
       if (k % hold === 0) level = rng.uniform() < 0.5 ? -amp[i] : amp[i];
-      const bias = i === 0 ? 0.5 * D[0] : 0;
+      const bias = i === 0 ? surge * D[0] : 0;
       const f = force[i] ? force[i](k) : bias + level;
       tau[k] = f;
       nu[k] = v + noise * rng.normal();

@@ -1,0 +1,247 @@
+// Model page (#/models/{id}): provenance (method, settings, runs, software,
+// version and lineage), structure findings and notes, the parameter table with
+// standard deviations, the validation on each held-out run (fits, predicted vs
+// measured, residual autocorrelation, verdict and findings), exports, and the
+// ZOH-discretized Φ, Γ at a chosen sample time.
+
+import { api, urls } from './api.js';
+import { fmt, fmtDate, fmtKn } from './format.js';
+import { h, fill, labelled, num, clearErrors, showFieldError } from './forms.js';
+import { METHOD_LABEL, KIND_LABEL_MODEL, errLine } from './identify.js';
+import { predictionPlot, autocorrelationPlot, zoomGroup } from './modelplots.js';
+import { exact } from './runplots.js';
+
+/** Unit of an output channel (the log contract). */
+function outUnit(name) {
+  if (['u', 'v', 'w'].includes(name)) return 'm/s';
+  if (['p', 'q', 'r'].includes(name)) return 'rad/s';
+  if (['x', 'y', 'z'].includes(name)) return 'm';
+  if (['phi', 'theta', 'psi'].includes(name)) return 'rad';
+  return '';
+}
+
+/** NRMSE fit (1 perfect, 0 no better than the mean) as a percentage. */
+export function fitText(v) {
+  if (v == null || !Number.isFinite(v)) return '–';
+  return `${fmt(v * 100, 1)} %`;
+}
+const fitClass = (v) => (v == null ? '' : v >= 0.8 ? 'fit-good' : v >= 0.5 ? 'fit-weak' : 'fit-bad');
+
+function speedText(mps) {
+  return mps == null ? '–' : `${fmtKn(mps)} kn (${fmt(mps)} m/s)`;
+}
+
+function settingText(v) {
+  if (v == null) return '–';
+  if (Array.isArray(v)) return v.length ? v.map((x) => (typeof x === 'object' ? JSON.stringify(x) : String(x))).join(', ') : '[]';
+  if (typeof v === 'object') return JSON.stringify(v);
+  return String(v);
+}
+
+function matrixTable(rows, { rowNames = [], colNames = [], testid } = {}) {
+  return h('table', { class: 'grid-table compact matrix', 'data-testid': testid },
+    colNames.length ? h('thead', null, h('tr', null, h('th', null, ''), colNames.map((c) => h('th', { class: 'num mono' }, c)))) : null,
+    h('tbody', null, rows.map((r, i) => h('tr', null,
+      h('th', { class: 'mono' }, rowNames[i] ?? String(i + 1)),
+      r.map((v) => h('td', { class: 'num mono', title: String(v) }, exact(v)))))));
+}
+
+/** The model page. Returns a controller whose mount() draws the plots. */
+export async function modelPage(view, id) {
+  const mv = await api.model(id);
+  const { model, document: doc } = mv;
+  const [runs, lineage] = await Promise.all([
+    api.runs(model.campaign_id).catch(() => []),
+    api.lineage(model.lineage_id).catch(() => [model]),
+  ]);
+  const runName = new Map(runs.map((r) => [r.id, r.name]));
+  const runLink = (rid) => h('a', { href: urls.run(rid), 'data-testid': 'provenance-run' }, runName.get(rid) || rid);
+  const validation = Array.isArray(mv.validation) ? mv.validation : (mv.validation && mv.validation.runs) || [];
+  const parent = model.parent_id ? lineage.find((x) => x.id === model.parent_id) : null;
+  const versions = lineage.slice().sort((a, b) => a.version - b.version);
+
+  // ---- provenance -------------------------------------------------------------
+  const settings = mv.settings && typeof mv.settings === 'object' ? mv.settings : {};
+  const provenance = h('dl', { class: 'summary', 'data-testid': 'provenance' },
+    h('dt', null, 'Method'), h('dd', { 'data-testid': 'model-method' }, METHOD_LABEL[model.method] || model.method, h('span', { class: 'muted' }, ` · ${KIND_LABEL_MODEL[model.kind] || model.kind}`)),
+    h('dt', null, 'Settings'), h('dd', { 'data-testid': 'model-settings' }, Object.keys(settings).length
+      ? h('ul', { class: 'plain' }, Object.entries(settings).map(([k, v]) => h('li', null, h('span', { class: 'mono' }, k), ': ', h('span', { class: 'mono' }, settingText(v)))))
+      : 'defaults'),
+    h('dt', null, 'Estimation runs'), h('dd', { 'data-testid': 'model-runs' }, mv.run_ids.length ? mv.run_ids.map((r, i) => [i ? ', ' : '', runLink(r)]) : '–'),
+    h('dt', null, 'Validation runs'), h('dd', { 'data-testid': 'model-validation-runs' }, mv.validation_run_ids.length ? mv.validation_run_ids.map((r, i) => [i ? ', ' : '', runLink(r)]) : '–'),
+    h('dt', null, 'Version'), h('dd', { 'data-testid': 'model-version' }, `v${model.version}`,
+      h('span', { class: 'muted' }, ` of lineage ${model.lineage_id}`),
+      versions.length > 1 ? h('span', null, ' · versions: ', versions.map((x, i) => [i ? ', ' : '', x.id === model.id ? h('b', null, `v${x.version}`) : h('a', { href: urls.model(x.id) }, `v${x.version}`)])) : null),
+    h('dt', null, 'Parent'), h('dd', { 'data-testid': 'model-parent' }, model.parent_id ? h('a', { href: urls.model(model.parent_id) }, parent ? `v${parent.version} · ${parent.name}` : model.parent_id) : 'none (first version)'),
+    h('dt', null, 'Software'), h('dd', { class: 'mono', 'data-testid': 'model-software' }, model.software_version),
+    h('dt', null, 'Identified'), h('dd', null, fmtDate(model.created_at), model.job_id ? h('span', { class: 'muted' }, ` · job ${model.job_id}`) : null));
+
+  const findings = (doc.structure_findings || []).length
+    ? h('ul', { class: 'warnings', 'data-testid': 'structure-findings', role: 'note', 'aria-label': 'Structure findings' },
+      doc.structure_findings.map((f) => h('li', null, '⚠ ', f)))
+    : h('p', { class: 'hint', 'data-testid': 'structure-findings-none' }, 'No physical-structure findings (M symmetric positive definite, D̄ dissipative where checked).');
+  const notes = (doc.notes || []).length
+    ? h('ul', { class: 'notes', 'data-testid': 'model-notes' }, doc.notes.map((n) => h('li', null, n)))
+    : null;
+
+  // ---- parameters ---------------------------------------------------------------
+  const params = doc.parameters || [];
+  const speeds = [...new Set(params.map((p) => p.grid_speed_mps).filter((x) => x != null))].sort((a, b) => a - b);
+  const pState = { sort: null, dir: 1, group: speeds.length > 1 };
+  const pBody = h('tbody');
+  const pHead = h('tr');
+  const COLS = [
+    ['group', 'Group', (p) => p.group], ['symbol', 'Symbol', (p) => p.symbol], ['speed', 'Speed', (p) => p.grid_speed_mps ?? -1],
+    ['value', 'Value', (p) => p.value], ['std', '± std', (p) => p.std ?? -1], ['rel', 'std / |value|', (p) => (p.std != null && p.value ? p.std / Math.abs(p.value) : -1)], ['unit', 'Unit', (p) => p.unit],
+  ];
+  const groupBox = h('input', { type: 'checkbox', checked: pState.group, 'data-testid': 'param-group', onChange: (e) => { pState.group = e.target.checked; renderParams(); } });
+
+  function paramRow(p) {
+    const rel = p.std != null && p.value ? p.std / Math.abs(p.value) : null;
+    return h('tr', { 'data-testid': 'param-row', class: rel != null && rel > 0.5 ? 'uncertain' : null, title: rel != null && rel > 0.5 ? 'standard deviation above half the estimate' : null },
+      h('td', null, p.group),
+      h('td', { class: 'mono' }, p.symbol),
+      h('td', { class: 'num' }, p.grid_speed_mps == null ? '–' : `${fmtKn(p.grid_speed_mps)} kn`),
+      h('td', { class: 'num mono', title: String(p.value) }, exact(p.value)),
+      h('td', { class: 'num mono', 'data-testid': 'param-std' }, p.std == null ? '–' : `± ${exact(p.std)}`),
+      h('td', { class: 'num' }, rel == null ? '–' : `${fmt(rel * 100, 1)} %`),
+      h('td', null, p.unit));
+  }
+
+  function renderParams() {
+    fill(pHead, COLS.map(([key, label]) => h('th', {
+      class: ['value', 'std', 'rel', 'speed'].includes(key) ? 'num' : null,
+      'aria-sort': pState.sort === key ? (pState.dir > 0 ? 'ascending' : 'descending') : 'none',
+    }, h('button', {
+      type: 'button', class: 'sort', 'data-testid': `param-sort-${key}`,
+      onClick: () => { if (pState.sort === key) pState.dir = -pState.dir; else { pState.sort = key; pState.dir = 1; } renderParams(); },
+    }, label, pState.sort === key ? (pState.dir > 0 ? ' ▲' : ' ▼') : ''))));
+    let list = params.slice();
+    if (pState.sort) {
+      const get = COLS.find((c) => c[0] === pState.sort)[2];
+      list.sort((a, b) => { const x = get(a); const y = get(b); return (x < y ? -1 : x > y ? 1 : 0) * pState.dir; });
+    }
+    if (!pState.group) { fill(pBody, list.map(paramRow)); return; }
+    const groups = [...speeds.map((s) => [s, list.filter((p) => p.grid_speed_mps === s)]), [null, list.filter((p) => p.grid_speed_mps == null)]];
+    fill(pBody, groups.filter(([, ps]) => ps.length).map(([s, ps]) => [
+      h('tr', { class: 'group-head', 'data-testid': 'param-group-head' }, h('th', { colspan: String(COLS.length) }, s == null ? 'Not scheduled on speed' : `Grid point ${speedText(s)}`, h('span', { class: 'hint' }, ` · ${ps.length} parameters`))),
+      ps.map(paramRow)]));
+  }
+
+  const paramSection = params.length
+    ? h('div', null,
+      h('div', { class: 'filters' }, h('label', { class: 'check' }, groupBox, ' group by grid speed'), h('span', { class: 'hint' }, 'click a column to sort · rows with std above half the value are marked')),
+      h('div', { class: 'table-scroll' }, h('table', { class: 'grid-table compact params-table', 'data-testid': 'param-table' }, h('thead', null, pHead), pBody)))
+    : h('p', { class: 'empty', 'data-testid': 'no-params' }, 'This model has no parameter table.');
+
+  // ---- validation -----------------------------------------------------------------
+  const plotJobs = []; // drawn in mount(), when the hosts have a width
+  const valSections = validation.map((rv, ri) => {
+    const rep = rv.report || {};
+    const chans = rep.channels || [];
+    const group = zoomGroup();
+    const sync = `val-${ri}`;
+    const fitRows = chans.map((c) => h('tr', { 'data-testid': 'fit-row', 'data-channel': c.output },
+      h('td', { class: 'mono' }, c.output),
+      h('td', { class: `num ${fitClass(c.fit_one_step)}`, 'data-testid': 'fit-one-step' }, fitText(c.fit_one_step)),
+      h('td', { class: `num ${fitClass(c.fit_k_step)}`, 'data-testid': 'fit-k-step' }, fitText(c.fit_k_step)),
+      h('td', { class: `num ${fitClass(c.fit_simulation)}`, 'data-testid': 'fit-simulation' }, fitText(c.fit_simulation)),
+      h('td', null, c.residuals_white ? h('span', { class: 'badge good' }, 'white') : h('span', { class: 'badge weak' }, 'correlated')),
+      h('td', { class: 'verdict-text', 'data-testid': 'channel-verdict' }, c.verdict)));
+    const chanBlocks = chans.map((c, ci) => {
+      const pvm = h('div', { class: 'plot', 'data-testid': 'pvm-plot', 'data-channel': c.output });
+      const acf = h('div', { class: 'plot', 'data-testid': 'acf-plot', 'data-channel': c.output });
+      const ac = c.one_step && c.one_step.autocorrelation;
+      plotJobs.push(() => {
+        if (c.plot && c.plot.time_s && c.plot.time_s.length) predictionPlot(`pvm:${ri}:${ci}`, pvm, c.plot, { k: rep.k, unit: `${c.output} [${outUnit(c.output)}]`, sync, group });
+        else fill(pvm, h('p', { class: 'empty' }, 'No plot series in the report.'));
+        if (ac && ac.lags && ac.lags.length) autocorrelationPlot(`acf:${ri}:${ci}`, acf, ac);
+        else fill(acf, h('p', { class: 'empty' }, 'No autocorrelation in the report.'));
+      });
+      const zc = c.one_step && c.one_step.zero_crossings;
+      return h('div', { class: 'channel-block', 'data-testid': 'channel-block', 'data-channel': c.output },
+        h('h4', null, h('span', { class: 'mono' }, c.output), ' ', h('span', { class: `badge ${c.residuals_white ? 'good' : 'weak'}` }, c.residuals_white ? 'residuals white' : 'residuals correlated'),
+          h('span', { class: 'verdict-line', 'data-testid': 'channel-verdict-line' }, c.verdict)),
+        (c.findings || []).length ? h('ul', { class: 'findings', 'data-testid': 'channel-findings' }, c.findings.map((f) => h('li', null, f))) : null,
+        h('div', { class: 'plot-grid pvm-grid' },
+          h('div', { class: 'plot-card' }, h('h3', null, 'Predicted vs measured ', h('span', { class: 'hint' }, `fit 1-step ${fitText(c.fit_one_step)} · ${rep.k}-step ${fitText(c.fit_k_step)} · simulation ${fitText(c.fit_simulation)}`)), pvm),
+          h('div', { class: 'plot-card' }, h('h3', null, 'Residual autocorrelation ', h('span', { class: 'hint' },
+            ac ? `1-step errors; ${ac.lags_outside.length} lag${ac.lags_outside.length === 1 ? '' : 's'} outside the ${Math.round(ac.confidence * 100)} % band (${fmt(ac.fraction_outside * 100, 1)} %, expected ${fmt(ac.expected_fraction * 100, 1)} %)${zc ? ` · ${zc.count} zero crossings (expected ${fmt(zc.expected, 0)})` : ''}` : '')), acf)));
+    });
+    return h('section', { class: 'card validation', 'data-testid': 'validation-run', 'data-run-id': rv.run_id, 'aria-label': `Validation on ${rv.run_name || rv.run_id}` },
+      h('h3', null, 'Validation on ', h('a', { href: urls.run(rv.run_id) }, rv.run_name || rv.run_id),
+        h('span', { class: 'hint' }, ` · ${rep.n_samples} samples at ${exact(rep.sample_time_s)} s · k = ${rep.k} · drag to zoom (all channels follow), double-click to reset`)),
+      h('div', { class: 'table-x' }, h('table', { class: 'grid-table compact fit-table', 'data-testid': 'fit-table' },
+        h('thead', null, h('tr', null, h('th', null, 'Channel'), h('th', { class: 'num', title: 'NRMSE fit of ŷ(t|t−1): 100 % perfect, 0 % no better than the mean' }, '1-step fit'),
+          h('th', { class: 'num', title: `NRMSE fit of ŷ(t|t−${rep.k})` }, `${rep.k}-step fit`), h('th', { class: 'num', title: 'NRMSE fit of the free-run simulation' }, 'Simulation fit'),
+          h('th', null, 'Residuals'), h('th', null, 'Verdict'))),
+        h('tbody', null, fitRows))),
+      chanBlocks);
+  });
+
+  // ---- exports ----------------------------------------------------------------------
+  const fossenReason = model.kind === 'state_space' ? 'A black-box state-space model has no Fossen form (no M, D, g(η)).' : null;
+  const exportsBox = h('div', { class: 'actions', role: 'group', 'aria-label': 'Export', 'data-testid': 'exports' },
+    h('a', { class: 'btn', href: urls.modelExport(id, 'json'), download: '', 'data-testid': 'export-json' }, '↓ JSON'),
+    h('a', { class: 'btn', href: urls.modelExport(id, 'csv'), download: '', 'data-testid': 'export-csv' }, '↓ Parameters CSV'),
+    fossenReason
+      ? h('button', { type: 'button', class: 'btn', disabled: true, title: fossenReason, 'aria-describedby': 'fossen-reason', 'data-testid': 'export-fossen' }, '↓ Fossen form')
+      : h('a', { class: 'btn', href: urls.modelExport(id, 'fossen'), download: '', 'data-testid': 'export-fossen' }, '↓ Fossen form'),
+    fossenReason ? h('span', { class: 'hint', id: 'fossen-reason', 'data-testid': 'fossen-reason' }, fossenReason) : null);
+
+  // ---- ZOH ---------------------------------------------------------------------------
+  const hIn = h('input', { type: 'number', step: 'any', min: '0', 'data-field': 'h', 'data-testid': 'zoh-h', class: 'short', value: '' });
+  const zohOut = h('div', { class: 'zoh-out', 'data-testid': 'zoh-result', 'aria-live': 'polite' });
+  const zohForm = h('form', { class: 'row zoh-form', novalidate: true, 'data-testid': 'zoh-form', onSubmit: discretize },
+    labelled('Sample time h [s]', hIn, 'e.g. the controller period'),
+    h('button', { type: 'submit', class: 'btn', 'data-testid': 'zoh-submit' }, 'Discretize (ZOH)'));
+
+  async function discretize(ev) {
+    ev.preventDefault();
+    clearErrors(zohForm);
+    const hv = num(hIn.value);
+    if (hv == null || !Number.isFinite(hv) || hv <= 0) { showFieldError(zohForm, 'h', 'a sample time in seconds above 0'); return; }
+    fill(zohOut, h('p', { class: 'loading' }, h('span', { class: 'spinner', 'aria-hidden': 'true' }), 'Discretizing…'));
+    try {
+      const r = await api.model(id, hv);
+      const d = r.discrete;
+      if (!d) throw new Error('the server answered without the discretized model');
+      fill(zohOut, h('p', { class: 'hint' }, `ν(k+1) = Φ ν(k) + Γ γ(k), h = ${exact(d.h)} s, zero-order hold on the input.`),
+        d.points.map((p) => h('div', { class: 'zoh-point', 'data-testid': 'zoh-point' },
+          h('h4', null, p.speed_mps != null ? `Grid point ${speedText(p.speed_mps)}` : 'Operating point'),
+          h('div', { class: 'matrix-pair' },
+            h('div', null, h('b', null, 'Φ'), matrixTable(p.phi, { rowNames: doc.outputs, colNames: doc.outputs, testid: 'zoh-phi' })),
+            h('div', null, h('b', null, 'Γ'), matrixTable(p.gamma, { rowNames: doc.outputs, colNames: doc.inputs, testid: 'zoh-gamma' }))))));
+    } catch (err) {
+      fill(zohOut);
+      if (err.field === 'h') showFieldError(zohForm, 'h', err.message, err.limit);
+      else fill(zohOut, h('p', { class: 'error-text', role: 'alert', 'data-testid': 'zoh-error' }, errLine(err)));
+    }
+  }
+
+  fill(view,
+    h('nav', { class: 'crumbs muted', 'aria-label': 'Breadcrumb' }, h('a', { href: `#/campaigns/${model.campaign_id}`, 'data-testid': 'model-campaign-link' }, '← campaign')),
+    h('div', { class: 'page-head' },
+      h('div', null,
+        h('h1', { 'data-testid': 'model-title' }, model.name, h('span', { class: 'badge neutral' }, `v${model.version}`)),
+        h('div', { class: 'muted' }, `${METHOD_LABEL[model.method] || model.method} · ${(doc.dofs || []).join(', ')} · inputs ${(doc.inputs || []).join(', ')} → outputs ${(doc.outputs || []).join(', ')}`)),
+      exportsBox),
+    provenance,
+    h('h2', { class: 'section-title' }, 'Findings'),
+    findings,
+    notes,
+    h('h2', { class: 'section-title' }, 'Parameters ', h('span', { class: 'hint' }, `${params.length} estimates with their standard deviations`)),
+    paramSection,
+    h('h2', { class: 'section-title' }, 'Validation ', h('span', { class: 'hint' }, 'on runs the model was not fitted to')),
+    valSections.length ? valSections : h('p', { class: 'empty', 'data-testid': 'no-validation' }, 'No validation report.'),
+    h('h2', { class: 'section-title' }, 'Discrete-time model'),
+    zohForm,
+    zohOut);
+  if (params.length) renderParams();
+
+  return {
+    key: `model:${id}`,
+    mount() { for (const f of plotJobs) f(); },
+    destroy() {},
+  };
+}
