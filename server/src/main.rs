@@ -60,14 +60,17 @@ async fn main() -> anyhow::Result<()> {
         );
     }
     let db = seatrial::storage::open(&args.db).await?;
-    if args.demo && seatrial::demo::seed_if_empty(&db).await? {
-        tracing::info!("seeded the demo campaigns");
-    }
     let blob_dir = args.blob_dir.clone().unwrap_or_else(|| {
         args.db
             .parent()
             .map_or_else(|| PathBuf::from("blobs"), |d| d.join("blobs"))
     });
+    if args.demo {
+        let blobs = seatrial::storage::blobs::BlobStore::open(&blob_dir)?;
+        if seatrial::demo::seed_if_empty(&db, &blobs).await? {
+            tracing::info!("seeded the demo campaigns (the ROV campaign flown in simulation)");
+        }
+    }
     let config = JobsConfig {
         workers: args
             .job_workers
