@@ -189,6 +189,47 @@ async fn identify_job_stores_a_validated_versioned_lpv_model() {
         .await;
     assert_eq!(list.json.as_array().unwrap().len(), 2);
     assert_eq!(list.json[0]["parent_id"], mid.as_str());
+
+    // Side by side on the held-out run: same data, same method → same fits.
+    let mid2 = job2["result"]["model_id"].as_str().unwrap().to_string();
+    let val = m.json["validation_run_ids"][0]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let c = app
+        .call(
+            "GET",
+            "/api/models/compare?a={a}&b={b}&run_id={r}",
+            &[&mid, &mid2, &val],
+            None,
+        )
+        .await;
+    assert_eq!(c.status, 200, "{}", c.text);
+    let (fa, fb) = (&c.json["models"][0], &c.json["models"][1]);
+    assert_eq!(fa["run_used_for_estimation"], false);
+    let fit = |m: &Value| m["report"]["channels"][0]["fit_one_step"].as_f64().unwrap();
+    assert!((fit(fa) - fit(fb)).abs() < 1e-12);
+    // And equal to the validation stored at identification.
+    let stored = m.json["validation"][0]["report"]["channels"][0]["fit_one_step"]
+        .as_f64()
+        .unwrap();
+    assert!((fit(fa) - stored).abs() < 1e-9, "{} vs {stored}", fit(fa));
+    let r = app
+        .call(
+            "GET",
+            "/api/models/compare?a={a}&b={b}&run_id={r}",
+            &["nope", &mid2, &val],
+            None,
+        )
+        .await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["field"].as_str()),
+        (404, Some("a"))
+    );
+    let r = app
+        .call("GET", "/api/models/compare?a={a}", &[&mid], None)
+        .await;
+    assert_eq!(r.status, 400, "{}", r.text);
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

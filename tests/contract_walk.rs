@@ -195,6 +195,15 @@ async fn every_documented_operation_is_exercised_and_answers() {
                         .await;
                     r
                 }
+                ("get", "/api/models/compare") => {
+                    app.call(
+                        "GET",
+                        "/api/models/compare?a={a}&b={b}&run_id={r}",
+                        &[&mid, &mid, &rid],
+                        None,
+                    )
+                    .await
+                }
                 ("post", "/api/vessels") => {
                     app.call("POST", template, &args, Some(rov_profile())).await
                 }

@@ -121,6 +121,7 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(jobs::retry_job))
         .routes(routes!(jobs::job_events))
         .routes(routes!(models::list_models))
+        .routes(routes!(models::compare_models))
         .routes(routes!(models::get_model))
         .routes(routes!(models::export_model))
         // Uploads stream to disk under their own limit (counted in the handler).

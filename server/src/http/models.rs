@@ -11,9 +11,14 @@ use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv}
 use serde::{Deserialize, Serialize};
 
 use super::query::ApiQuery;
-use super::{AppState, found};
+use super::{AppState, blocking, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
+use crate::jobs::identify;
+use crate::processing::{self, RunMeta, RunSummary};
 use crate::storage::models::{self, ModelSummary, StoredModel};
+use crate::storage::{campaigns, runs, vessels};
+use seatrial_core::identification::RunInput;
+use seatrial_core::identification::predictor::validate_on_run;
 
 /// Filters of the model list.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
@@ -183,4 +188,144 @@ pub async fn export_model(
             format!("unknown export format '{other}'; use json, csv or fossen"),
         )),
     }
+}
+
+/// Which models to compare on which run.
+#[derive(Debug, Deserialize, utoipa::IntoParams)]
+pub struct CompareQuery {
+    /// First model.
+    pub a: String,
+    /// Second model.
+    pub b: String,
+    /// The run both are validated on (best one neither was estimated from).
+    pub run_id: String,
+    /// Horizon of the k-step predictions (default 10).
+    pub k: Option<usize>,
+}
+
+/// One model's validation in a comparison.
+#[derive(Debug, Serialize, utoipa::ToSchema)]
+pub struct ComparedModel {
+    /// The model.
+    pub model: ModelSummary,
+    /// True when the run was among the model's estimation runs (its fits
+    /// then flatter it).
+    pub run_used_for_estimation: bool,
+    /// Fits, residual tests and plot series on the run.
+    #[schema(value_type = seatrial_core::validation::ValidationReport)]
+    pub report: serde_json::Value,
+}
+
+/// Two models side by side on the same run.
+#[derive(Debug, Serialize, utoipa::ToSchema)]
+pub struct Comparison {
+    /// The run.
+    pub run_id: String,
+    /// Its name.
+    pub run_name: String,
+    /// The two models, in the order asked.
+    pub models: Vec<ComparedModel>,
+}
+
+/// Validate two models on the same run, side by side (1-step, k-step and
+/// simulation fits; residual tests).
+#[utoipa::path(get, path = "/api/models/compare", tag = "models", params(CompareQuery),
+    responses((status = 200, description = "Both validations", body = Comparison),
+              (status = 400, description = "Missing or malformed query parameter", body = ErrorBody),
+              (status = 404, description = "No such model or run", body = ErrorBody),
+              (status = 422, description = "The run cannot validate a model (vessel, columns, kind)", body = ErrorBody)))]
+pub async fn compare_models(
+    State(s): State<AppState>,
+    ApiQuery(q): ApiQuery<CompareQuery>,
+) -> ApiResult<Json<Comparison>> {
+    let mut stored = Vec::new();
+    for (field, id) in [("a", &q.a), ("b", &q.b)] {
+        let m = models::get(&s.db, id)
+            .await?
+            .ok_or_else(|| ApiError::missing(field, format!("no model with id '{id}'")))?;
+        stored.push(m);
+    }
+    let run = runs::get(&s.db, &q.run_id)
+        .await?
+        .ok_or_else(|| ApiError::missing("run_id", format!("no run with id '{}'", q.run_id)))?;
+    if run.status != "accepted" {
+        return Err(ApiError::invalid(
+            "run_id",
+            format!("run '{}' was {}", run.id, run.status),
+        ));
+    }
+    let campaign = found(
+        campaigns::get(&s.db, &run.campaign_id).await?,
+        "campaign",
+        &run.campaign_id,
+    )?;
+    for (field, m) in [("a", &stored[0]), ("b", &stored[1])] {
+        if m.summary.vessel_id != campaign.vessel_id {
+            return Err(ApiError::invalid(
+                field,
+                "the model belongs to another vessel than the run",
+            ));
+        }
+    }
+    let vessel = found(
+        vessels::get(&s.db, &campaign.vessel_id).await?,
+        "vessel",
+        &campaign.vessel_id,
+    )?;
+    let summary = run.summary.clone().unwrap_or_default();
+    let meta = RunMeta {
+        shared_channel: summary
+            .pointer("/alignment/shared_channel")
+            .and_then(|v| v.as_str())
+            .map(str::to_string),
+        rate_hz: summary.get("sample_rate_hz").and_then(|v| v.as_f64()),
+        ..RunMeta::default()
+    };
+    let files: Vec<_> = run
+        .files
+        .iter()
+        .map(|f| (f.role.clone(), s.blobs.path(&f.sha256)))
+        .collect();
+    let k = q.k.unwrap_or(10).max(1);
+    let docs: Vec<ModelDocument> = stored
+        .iter()
+        .map(|m| view(m.clone()).map(|v| v.document))
+        .collect::<Result<_, _>>()?;
+    let profile = vessel.profile.clone();
+    let (run_id, run_name) = (run.id.clone(), run.name.clone());
+    let reports = blocking(move || -> Result<Vec<serde_json::Value>, ApiError> {
+        let mut summary = RunSummary::default();
+        let record = processing::load_record(&profile, &files, &meta, &mut summary)
+            .map_err(|e| ApiError::invalid("run_id", e.message))?;
+        let input = RunInput {
+            run_id: run_id.clone(),
+            name: run_name.clone(),
+            family: None,
+            grid_speed_mps: None,
+            record,
+        };
+        let forces = identify::force_inputs(&profile);
+        docs.iter()
+            .zip(["a", "b"])
+            .map(|(doc, field)| {
+                let rep = validate_on_run(doc, &input, &forces, k)
+                    .map_err(|e| ApiError::invalid(field, e.to_string()))?;
+                serde_json::to_value(&rep).map_err(|e| ApiError::Internal(e.into()))
+            })
+            .collect()
+    })
+    .await??;
+    Ok(Json(Comparison {
+        run_id: run.id.clone(),
+        run_name: run.name.clone(),
+        models: stored
+            .into_iter()
+            .zip(reports)
+            .map(|(m, report)| ComparedModel {
+                run_used_for_estimation: m.run_ids.contains(&run.id),
+                model: m.summary,
+                report,
+            })
+            .collect(),
+    }))
 }

@@ -52,7 +52,7 @@ fn check_method(vessel: &VesselProfile, method: &str) -> Result<(), String> {
 }
 
 /// Generalized-force columns the methods regress on, in DOF order.
-fn force_inputs(vessel: &VesselProfile) -> Vec<String> {
+pub fn force_inputs(vessel: &VesselProfile) -> Vec<String> {
     let derived = thruster_force_columns(vessel);
     if derived.is_empty() {
         vessel

@@ -96,6 +96,8 @@ pub struct RestoringDoc {
     pub parameters: Vec<ParameterRow>,
     /// Static runs and segments used.
     pub evidence: Vec<String>,
+    /// The parameters g(η) is evaluated with (γ = τ − g(η) on new runs).
+    pub params: crate::estimation::restoring::RestoringParams,
 }
 
 /// One LPV sub-model: M ν̇ + D̄ ν = γ at a forward speed.
@@ -192,6 +194,12 @@ pub struct StateSpaceDoc {
     /// Continuous-time B.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub b_continuous: Option<Matrix>,
+    /// Operating point of the inputs: the model maps u − u₀.
+    #[serde(default)]
+    pub u_offset: Vec<f64>,
+    /// Operating point of the outputs: the model predicts y − y₀.
+    #[serde(default)]
+    pub y_offset: Vec<f64>,
 }
 
 /// The identified model.

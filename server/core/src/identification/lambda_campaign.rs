@@ -256,6 +256,7 @@ pub fn identify_lambda_campaign(
                         roles.statics.len(),
                         est.moment_correlation
                     )],
+                    params: *p,
                 };
                 restoring = Some((*p, doc));
             }

@@ -9,6 +9,7 @@
 //! - [`document`]: the stored/served model: matrices, parameters with std.
 //! - [`discrete`]: ZOH matrices at a chosen h.
 //! - [`export`]: parameter CSV and the Fossen-form parameter set.
+//! - [`predictor`]: a stored model back as a predictor; validation on any run.
 //! - [`outcome`], [`error`]: what an identification returns.
 
 pub mod dataset;
@@ -19,6 +20,7 @@ pub mod export;
 pub mod lambda_campaign;
 pub mod n4sid_campaign;
 pub mod outcome;
+pub mod predictor;
 pub mod roles;
 
 pub use dataset::{DatasetError, RunInput, Segment, segments};

@@ -231,6 +231,8 @@ pub fn identify_n4sid_campaign(
             singular_values: model.singular_values.clone(),
             a_continuous: a_c,
             b_continuous: b_c,
+            u_offset: u_mean.clone(),
+            y_offset: y_mean.clone(),
         }),
         parameters,
         structure_findings: vec![],

@@ -253,3 +253,53 @@ fn n4sid_campaign_fits_held_out_data_about_the_mean_operating_point() {
     // Every discrete pole of a stable vessel lies inside the unit circle.
     assert!(out.document.parameters.iter().all(|p| p.value < 1.0));
 }
+
+#[test]
+fn a_stored_model_validates_on_a_run_as_it_did_at_identification() {
+    use super::predictor::validate_on_run;
+    let (_, grid, runs) = campaign();
+    let profile = surveyor_rov();
+    let inputs: Vec<String> = profile
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
+    for method in ["lambda", "n4sid"] {
+        let out = if method == "lambda" {
+            identify_lambda_campaign(
+                &profile,
+                &grid,
+                &inputs,
+                &runs,
+                &Default::default(),
+                &mut NoProgress,
+            )
+        } else {
+            super::n4sid_campaign::identify_n4sid_campaign(
+                &profile,
+                &inputs,
+                &runs,
+                &Default::default(),
+                &mut NoProgress,
+            )
+        }
+        .unwrap();
+        // Through JSON, as the store keeps it.
+        let doc: super::document::ModelDocument =
+            serde_json::from_value(serde_json::to_value(&out.document).unwrap()).unwrap();
+        let again = validate_on_run(&doc, &runs[4], &inputs, 10).unwrap();
+        for (a, b) in again
+            .channels
+            .iter()
+            .zip(&out.validation[0].report.channels)
+        {
+            assert!(
+                (a.fit_one_step.unwrap() - b.fit_one_step.unwrap()).abs() < 1e-9,
+                "{method} {}: {:?} vs {:?}",
+                a.output,
+                a.fit_one_step,
+                b.fit_one_step
+            );
+        }
+    }
+}

@@ -1,0 +1,152 @@
+//! A stored model back as a predictor, and a run as that model's validation
+//! record — so any model can be validated on any run later (side-by-side
+//! comparison of two models on the same run).
+
+use nalgebra::DMatrix;
+
+use super::dataset::{RunInput, segments};
+use super::document::{ModelDocument, ModelKind, from_rows};
+use super::error::IdentifyError;
+use crate::estimation::n4sid::{N4sidModel, NoiseCovariances, Weighting};
+use crate::logs::schema::pose_column;
+use crate::models::{LinearVesselModel, LpvModel};
+use crate::planning::dof::Dof;
+use crate::validation::{
+    Predictor, ValidationRecord, ValidationReport, ValidationSettings, validate,
+};
+
+fn matrix(rows: &super::document::Matrix, what: &str) -> Result<DMatrix<f64>, IdentifyError> {
+    from_rows(rows).ok_or_else(|| IdentifyError::invalid("document", format!("{what} is ragged")))
+}
+
+/// The predictor of a stored model.
+pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyError> {
+    match doc.kind {
+        ModelKind::Lpv => {
+            let lpv = doc
+                .lpv
+                .as_ref()
+                .ok_or_else(|| IdentifyError::invalid("document.lpv", "missing"))?;
+            let mut models = Vec::new();
+            for p in &lpv.points {
+                models.push(
+                    LinearVesselModel::new(
+                        doc.dofs.clone(),
+                        matrix(&p.m, "M")?,
+                        matrix(&p.d_bar, "D̄")?,
+                    )
+                    .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?,
+                );
+            }
+            let speeds = lpv.points.iter().map(|p| p.speed_mps).collect();
+            Ok(Box::new(LpvModel::new(speeds, models).map_err(|e| {
+                IdentifyError::invalid("document.lpv", e.to_string())
+            })?))
+        }
+        ModelKind::StateSpace => {
+            let s = doc
+                .state_space
+                .as_ref()
+                .ok_or_else(|| IdentifyError::invalid("document.state_space", "missing"))?;
+            let (a, c) = (matrix(&s.phi, "Φ")?, matrix(&s.c, "C")?);
+            let (n, l) = (a.nrows(), c.nrows());
+            Ok(Box::new(N4sidModel {
+                a,
+                b: matrix(&s.gamma, "Γ")?,
+                c,
+                d: matrix(&s.d, "D")?,
+                k: matrix(&s.k, "K")?,
+                h: s.h,
+                order: s.order,
+                horizon: 0,
+                weighting: Weighting::default(),
+                singular_values: s.singular_values.clone(),
+                noise: NoiseCovariances {
+                    q: DMatrix::zeros(n, n),
+                    s: DMatrix::zeros(n, l),
+                    r: DMatrix::zeros(l, l),
+                },
+                innovation_covariance: DMatrix::zeros(l, l),
+                state_covariance: DMatrix::zeros(n, n),
+                hankel_columns: 0,
+                output_names: doc.outputs.clone(),
+            }))
+        }
+        ModelKind::DpShip => Err(IdentifyError::invalid(
+            "document.kind",
+            "validating a stored DP-ship model on new runs is not available yet",
+        )),
+    }
+}
+
+/// The longest valid block of `run` as the model's validation data:
+/// γ = τ − g(η) and ν for an LPV model, deviations from the operating point
+/// for a subspace model. `inputs` are the force columns in DOF order.
+pub fn validation_data(
+    doc: &ModelDocument,
+    run: &RunInput,
+    inputs: &[String],
+) -> Result<(f64, DMatrix<f64>, DMatrix<f64>), IdentifyError> {
+    let n = doc.dofs.len();
+    let outputs: Vec<String> = doc
+        .dofs
+        .iter()
+        .map(|d| d.velocity_symbol().to_string())
+        .collect();
+    let restoring = doc.restoring.as_ref().map(|r| r.params);
+    let mut cols = inputs.to_vec();
+    if restoring.is_some() {
+        cols.extend(Dof::ALL.iter().map(|d| pose_column(*d).to_string()));
+    }
+    let segs = segments(run, &cols, &outputs, 50)
+        .map_err(|e| IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string()))?;
+    let seg = segs
+        .iter()
+        .max_by_key(|s| s.y.nrows())
+        .expect("segments is non-empty");
+    let tau = seg.u.columns(0, n).into_owned();
+    match doc.kind {
+        ModelKind::StateSpace => {
+            let s = doc.state_space.as_ref().expect("checked by predictor()");
+            let shift = |m: &DMatrix<f64>, off: &[f64]| {
+                DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| {
+                    m[(i, j)] - off.get(j).copied().unwrap_or(0.0)
+                })
+            };
+            Ok((seg.h, shift(&tau, &s.u_offset), shift(&seg.y, &s.y_offset)))
+        }
+        _ => {
+            let gamma = match restoring {
+                Some(r) => r
+                    .gamma(&tau, &seg.u.columns(n, 6).into_owned())
+                    .map_err(|e| {
+                        IdentifyError::invalid(format!("runs[{}]", run.run_id), e.to_string())
+                    })?,
+                None => tau,
+            };
+            Ok((seg.h, gamma, seg.y.clone()))
+        }
+    }
+}
+
+/// Validates a stored model on one run.
+pub fn validate_on_run(
+    doc: &ModelDocument,
+    run: &RunInput,
+    inputs: &[String],
+    k: usize,
+) -> Result<ValidationReport, IdentifyError> {
+    let model = predictor(doc)?;
+    let (h, u, y) = validation_data(doc, run, inputs)?;
+    let settings = ValidationSettings {
+        k,
+        input_names: doc.inputs.clone(),
+        ..ValidationSettings::default()
+    };
+    validate(
+        model.as_ref(),
+        &ValidationRecord { h, u: &u, y: &y },
+        &settings,
+    )
+    .map_err(|e| IdentifyError::invalid(format!("runs[{}]", run.run_id), e.to_string()))
+}
