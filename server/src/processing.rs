@@ -39,6 +39,23 @@ pub struct RunMeta {
     pub rate_hz: Option<f64>,
 }
 
+impl RunMeta {
+    /// The options a stored run was read with, from its processing summary:
+    /// the rate it was resampled to and the channel its two files were
+    /// aligned on — so a later job reads the same record the report scored.
+    pub fn of_stored(summary: Option<&Value>) -> RunMeta {
+        let summary = summary.cloned().unwrap_or_default();
+        RunMeta {
+            shared_channel: summary
+                .pointer("/alignment/shared_channel")
+                .and_then(|v| v.as_str())
+                .map(str::to_string),
+            rate_hz: summary.get("sample_rate_hz").and_then(|v| v.as_f64()),
+            ..RunMeta::default()
+        }
+    }
+}
+
 /// A warning about a run, with the file (or step) it concerns.
 #[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
 pub struct RunWarning {

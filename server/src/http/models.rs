@@ -272,15 +272,7 @@ pub async fn compare_models(
         "vessel",
         &campaign.vessel_id,
     )?;
-    let summary = run.summary.clone().unwrap_or_default();
-    let meta = RunMeta {
-        shared_channel: summary
-            .pointer("/alignment/shared_channel")
-            .and_then(|v| v.as_str())
-            .map(str::to_string),
-        rate_hz: summary.get("sample_rate_hz").and_then(|v| v.as_f64()),
-        ..RunMeta::default()
-    };
+    let meta = RunMeta::of_stored(run.summary.as_ref());
     let files: Vec<_> = run
         .files
         .iter()

@@ -157,16 +157,7 @@ impl JobHandler for Identify {
                         .map(|(e, _)| e.experiment),
                     None => None,
                 };
-                let summary = r.summary.clone().unwrap_or_default();
-                let meta = RunMeta {
-                    experiment_id: None,
-                    name: None,
-                    shared_channel: summary
-                        .pointer("/alignment/shared_channel")
-                        .and_then(|v| v.as_str())
-                        .map(str::to_string),
-                    rate_hz: summary.get("sample_rate_hz").and_then(|v| v.as_f64()),
-                };
+                let meta = RunMeta::of_stored(r.summary.as_ref());
                 stored.push(StoredRun {
                     id: r.id.clone(),
                     name: r.name.clone(),

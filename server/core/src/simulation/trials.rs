@@ -31,15 +31,13 @@
 
 use std::fmt;
 
-use nalgebra::{DMatrix, Matrix6, Vector3, Vector6};
+use nalgebra::{DMatrix, Vector3, Vector6};
 
 use super::integrate::rk4_step;
 use super::rov::current::CurrentProcess;
-use super::rov::damping::damping_force;
-use super::rov::kinematics::{eta_dot, rotation};
+use super::rov::kinematics::rotation;
 use super::rov::{RovRecord, RovTruth, SimError};
 use crate::logs::schema::{LogRole, TIME_COLUMN, pose_column, required_columns};
-use crate::models::coriolis::coriolis_6dof;
 use crate::planning::vessel::{DofLimits, InputChannels, VesselKind};
 use crate::planning::{Dof, Experiment, ExperimentFamily, Plan, PlannedExperiment, VesselProfile};
 use crate::rng::{SplitMix64, mix};
@@ -359,40 +357,10 @@ pub fn fly_experiment(
         })
         .collect();
 
-    // Plant: the same right-hand side as RovTruth::simulate.
-    let m_inv: Matrix6<f64> = truth.m.cholesky().map(|c| c.inverse()).ok_or_else(|| {
-        sim_err(SimError::InertiaNotSpd {
-            reason: "Cholesky factorization failed".into(),
-        })
-    })?;
-    let tether = truth.tether.load();
+    // Plant: the truth's own right-hand side.
+    let mut f = truth.plant().map_err(sim_err)?;
     let acts = &truth.actuators;
     let lagged: [bool; 6] = std::array::from_fn(|i| acts.lagged(i));
-    let mut f = |x: &[f64], u: &[f64], dx: &mut [f64]| {
-        let nu_r = Vector6::from_column_slice(&x[0..6]);
-        let eta = Vector6::from_column_slice(&x[6..12]);
-        let nu = nu_r + body_current(&eta, &Vector3::new(u[6], u[7], u[8]));
-        let mut tau = Vector6::zeros();
-        for i in 0..6 {
-            if lagged[i] {
-                tau[i] = x[12 + i];
-                dx[12 + i] = (u[i] - x[12 + i]) / acts.time_constants[i];
-            } else {
-                tau[i] = u[i];
-                dx[12 + i] = 0.0;
-            }
-        }
-        let mut rhs = tau + tether
-            - damping_force(&truth.damping, &truth.quadratic_damping, &nu_r)
-            - truth.restoring.g(eta[3], eta[4]);
-        if truth.coriolis {
-            rhs -= coriolis_6dof(&truth.m, &nu_r) * nu_r;
-        }
-        let nu_dot = m_inv * rhs;
-        let e_dot = eta_dot(&eta, &nu);
-        dx[0..6].copy_from_slice(nu_dot.as_slice());
-        dx[6..12].copy_from_slice(e_dot.as_slice());
-    };
 
     // Start at the first velocity references (trimmed at the grid speed).
     let mut current = CurrentProcess::new(&truth.current);

@@ -97,6 +97,54 @@ fn body_current(eta: &Vector6<f64>, v_ned: &Vector3<f64>) -> Vector6<f64> {
     Vector6::new(v.x, v.y, v.z, 0.0, 0.0, 0.0)
 }
 
+/// ẋ = f(x, u) written into `dx`, as [`rk4_step`] takes it.
+pub(crate) trait Rhs: FnMut(&[f64], &[f64], &mut [f64]) {}
+
+impl<F: FnMut(&[f64], &[f64], &mut [f64])> Rhs for F {}
+
+impl RovTruth {
+    /// The right-hand side ẋ = f(x, u) of the truth, shared by every flight
+    /// of it (open-loop [`RovTruth::simulate`], closed-loop trials):
+    /// x = [ν_r (6), η (6), τ_a (6)], u = [τ shaped (6), V_c NED (3)].
+    pub(crate) fn plant(&self) -> Result<impl Rhs + '_, SimError> {
+        let m_inv: Matrix6<f64> =
+            self.m
+                .cholesky()
+                .map(|c| c.inverse())
+                .ok_or_else(|| SimError::InertiaNotSpd {
+                    reason: "Cholesky factorization failed".into(),
+                })?;
+        let tether = self.tether.load();
+        let acts = &self.actuators;
+        let lagged: [bool; 6] = std::array::from_fn(|i| acts.lagged(i));
+        Ok(move |x: &[f64], u: &[f64], dx: &mut [f64]| {
+            let nu_r = Vector6::from_column_slice(&x[0..6]);
+            let eta = Vector6::from_column_slice(&x[6..12]);
+            let nu = nu_r + body_current(&eta, &Vector3::new(u[6], u[7], u[8]));
+            let mut tau = Vector6::zeros();
+            for i in 0..6 {
+                if lagged[i] {
+                    tau[i] = x[12 + i];
+                    dx[12 + i] = (u[i] - x[12 + i]) / acts.time_constants[i];
+                } else {
+                    tau[i] = u[i];
+                    dx[12 + i] = 0.0;
+                }
+            }
+            let mut rhs = tau + tether
+                - damping_force(&self.damping, &self.quadratic_damping, &nu_r)
+                - self.restoring.g(eta[3], eta[4]);
+            if self.coriolis {
+                rhs -= coriolis_6dof(&self.m, &nu_r) * nu_r;
+            }
+            let nu_dot = m_inv * rhs;
+            let e_dot = eta_dot(&eta, &nu);
+            dx[0..6].copy_from_slice(nu_dot.as_slice());
+            dx[6..12].copy_from_slice(e_dot.as_slice());
+        })
+    }
+}
+
 impl RovTruth {
     /// Simulates the commanded τ (`tau_commanded`, N × 6, columns
     /// τ_X … τ_N, row k held over [t_k, t_{k+1})) from `cfg`'s initial state.
@@ -121,43 +169,9 @@ impl RovTruth {
         }
         finite("tau_commanded", tau_commanded.iter())?;
 
-        let m_inv: Matrix6<f64> =
-            self.m
-                .cholesky()
-                .map(|c| c.inverse())
-                .ok_or_else(|| SimError::InertiaNotSpd {
-                    reason: "Cholesky factorization failed".into(),
-                })?;
-        let tether = self.tether.load();
+        let mut f = self.plant()?;
         let acts = &self.actuators;
         let lagged: [bool; 6] = std::array::from_fn(|i| acts.lagged(i));
-
-        // x = [ν_r (6), η (6), τ_a (6)]; u = [τ shaped (6), V_c NED (3)].
-        let mut f = |x: &[f64], u: &[f64], dx: &mut [f64]| {
-            let nu_r = Vector6::from_column_slice(&x[0..6]);
-            let eta = Vector6::from_column_slice(&x[6..12]);
-            let nu = nu_r + body_current(&eta, &Vector3::new(u[6], u[7], u[8]));
-            let mut tau = Vector6::zeros();
-            for i in 0..6 {
-                if lagged[i] {
-                    tau[i] = x[12 + i];
-                    dx[12 + i] = (u[i] - x[12 + i]) / acts.time_constants[i];
-                } else {
-                    tau[i] = u[i];
-                    dx[12 + i] = 0.0;
-                }
-            }
-            let mut rhs = tau + tether
-                - damping_force(&self.damping, &self.quadratic_damping, &nu_r)
-                - self.restoring.g(eta[3], eta[4]);
-            if self.coriolis {
-                rhs -= coriolis_6dof(&self.m, &nu_r) * nu_r;
-            }
-            let nu_dot = m_inv * rhs;
-            let e_dot = eta_dot(&eta, &nu);
-            dx[0..6].copy_from_slice(nu_dot.as_slice());
-            dx[6..12].copy_from_slice(e_dot.as_slice());
-        };
 
         let mut current = CurrentProcess::new(&self.current);
         let eta0 = Vector6::from(cfg.eta0);

@@ -2,13 +2,14 @@
 //! response on its own nominal plant, replay through the truth simulator,
 //! force balances at steady state, limits, the log contract, noise and seeds.
 
-use nalgebra::{Matrix2, Vector2};
+use nalgebra::{Matrix2, Matrix6, Vector2};
 
 use super::*;
 use crate::logs::{ParseOptions, parse_log};
 use crate::planning::Quantity;
 use crate::planning::examples::{surveyor_campaign, surveyor_rov};
 use crate::planning::generate_plan;
+use crate::simulation::rov::damping::damping_force;
 use crate::simulation::rov::{Current, LinearDamping, SimConfig};
 
 fn quiet() -> TrialSettings {
