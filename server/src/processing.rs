@@ -203,6 +203,22 @@ pub fn thruster_force_columns(vessel: &VesselProfile) -> Vec<String> {
     }
 }
 
+/// The generalized force of each modelled DOF, in DOF order: the logged τ
+/// column, or the derived τ_T = T·u of a thruster-actuated vessel. What the
+/// quality report scores and the identification methods regress on.
+pub fn generalized_force_columns(vessel: &VesselProfile) -> Vec<String> {
+    let derived = thruster_force_columns(vessel);
+    if derived.is_empty() {
+        vessel
+            .dofs
+            .iter()
+            .map(|d| d.force_column().to_string())
+            .collect()
+    } else {
+        derived
+    }
+}
+
 /// The log column a planned schedule column should be compared with.
 fn logged_column(schedule_column: &str) -> String {
     match schedule_column.strip_suffix("_ref") {
@@ -292,17 +308,13 @@ pub fn process_run(
 ) -> Result<Processed, ProcessError> {
     let mut summary = RunSummary::default();
     let rec = load_record(vessel, files, meta, &mut summary)?;
-    let derived = thruster_force_columns(vessel);
     let dofs: Vec<DofChannels> = vessel
         .dofs
         .iter()
-        .enumerate()
-        .map(|(i, &d)| DofChannels {
+        .zip(generalized_force_columns(vessel))
+        .map(|(&d, input)| DofChannels {
             dof: d,
-            input: derived
-                .get(i)
-                .cloned()
-                .unwrap_or_else(|| d.force_column().to_string()),
+            input,
             output: d.velocity_symbol().to_string(),
         })
         .collect();

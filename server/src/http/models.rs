@@ -13,7 +13,6 @@ use serde::{Deserialize, Serialize};
 use super::query::ApiQuery;
 use super::{AppState, blocking, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
-use crate::jobs::identify;
 use crate::processing::{self, RunMeta, RunSummary};
 use crate::storage::models::{self, ModelSummary, StoredModel};
 use crate::storage::{campaigns, runs, vessels};
@@ -296,7 +295,7 @@ pub async fn compare_models(
             grid_speed_mps: None,
             record,
         };
-        let forces = identify::force_inputs(&profile);
+        let forces = processing::generalized_force_columns(&profile);
         docs.iter()
             .zip(["a", "b"])
             .map(|(doc, field)| {

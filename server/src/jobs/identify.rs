@@ -17,7 +17,7 @@ use sqlx::SqliteConnection;
 
 use super::handler::{BoxFuture, Compute, JobContext, JobFailure, JobHandler, Persist, compute};
 use crate::error::ApiError;
-use crate::processing::{self, RunMeta, RunSummary, thruster_force_columns};
+use crate::processing::{self, RunMeta, RunSummary, generalized_force_columns};
 use crate::storage::jobs::{Job, JobRequest};
 use crate::storage::models::{self, Lineage, NewModel};
 use crate::storage::{campaigns, plans, runs, vessels};
@@ -48,20 +48,6 @@ fn check_method(vessel: &VesselProfile, method: &str) -> Result<(), String> {
             "unknown method '{m}'; use one of {}",
             METHODS.join(", ")
         )),
-    }
-}
-
-/// Generalized-force columns the methods regress on, in DOF order.
-pub fn force_inputs(vessel: &VesselProfile) -> Vec<String> {
-    let derived = thruster_force_columns(vessel);
-    if derived.is_empty() {
-        vessel
-            .dofs
-            .iter()
-            .map(|d| d.force_column().to_string())
-            .collect()
-    } else {
-        derived
     }
 }
 
@@ -197,7 +183,7 @@ impl JobHandler for Identify {
                     });
                 }
                 let mut sub = seatrial_core::estimation::SubProgress::new(progress, 0.05, 0.95);
-                let forces = force_inputs(&profile);
+                let forces = generalized_force_columns(&profile);
                 let out: Result<Identified, IdentifyError> = match method.as_str() {
                     "lambda_kf" => {
                         let s: LambdaCampaignSettings =

@@ -14,6 +14,15 @@ use crate::timeseries::UniformRecord;
 
 const H: f64 = 0.1;
 
+/// τ columns of a force-actuated vessel, in DOF order.
+fn force_columns(profile: &crate::planning::VesselProfile) -> Vec<String> {
+    profile
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect()
+}
+
 /// τ: the trim force that holds `speed` in surge, plus a random-binary
 /// excitation in every DOF (clock 2 s) of `amp` times the DOF's force limit.
 fn excitation(truth: &RovTruth, speed: &[f64], amp: f64, seed: u64) -> DMatrix<f64> {
@@ -117,11 +126,7 @@ fn campaign() -> (RovTruth, Vec<f64>, Vec<RunInput>) {
 fn lpv_campaign_recovers_the_coupled_truth_and_validates_on_held_out_data() {
     let (truth, grid, runs) = campaign();
     let profile = surveyor_rov();
-    let inputs: Vec<String> = profile
-        .dofs
-        .iter()
-        .map(|d| d.force_column().to_string())
-        .collect();
+    let inputs = force_columns(&profile);
     let settings = LambdaCampaignSettings::default();
     let out = identify_lambda_campaign(&profile, &grid, &inputs, &runs, &settings, &mut NoProgress)
         .unwrap();
@@ -155,11 +160,7 @@ fn lpv_campaign_recovers_the_coupled_truth_and_validates_on_held_out_data() {
 fn diagonal_structure_is_worse_on_the_coupled_truth() {
     let (_, grid, runs) = campaign();
     let profile = surveyor_rov();
-    let inputs: Vec<String> = profile
-        .dofs
-        .iter()
-        .map(|d| d.force_column().to_string())
-        .collect();
+    let inputs = force_columns(&profile);
     let fit = |structure| {
         let s = LambdaCampaignSettings {
             structure,
@@ -192,11 +193,7 @@ fn diagonal_structure_is_worse_on_the_coupled_truth() {
 fn missing_validation_and_bad_settings_name_the_field() {
     let (_, grid, runs) = campaign();
     let profile = surveyor_rov();
-    let inputs: Vec<String> = profile
-        .dofs
-        .iter()
-        .map(|d| d.force_column().to_string())
-        .collect();
+    let inputs = force_columns(&profile);
     let e = identify_lambda_campaign(
         &profile,
         &grid,
@@ -228,11 +225,7 @@ fn n4sid_campaign_fits_held_out_data_about_the_mean_operating_point() {
     use super::n4sid_campaign::{N4sidCampaignSettings, identify_n4sid_campaign};
     let (_, _, runs) = campaign();
     let profile = surveyor_rov();
-    let inputs: Vec<String> = profile
-        .dofs
-        .iter()
-        .map(|d| d.force_column().to_string())
-        .collect();
+    let inputs = force_columns(&profile);
     let s = N4sidCampaignSettings {
         order: Some(6),
         ..Default::default()
@@ -259,11 +252,7 @@ fn a_stored_model_validates_on_a_run_as_it_did_at_identification() {
     use super::predictor::validate_on_run;
     let (_, grid, runs) = campaign();
     let profile = surveyor_rov();
-    let inputs: Vec<String> = profile
-        .dofs
-        .iter()
-        .map(|d| d.force_column().to_string())
-        .collect();
+    let inputs = force_columns(&profile);
     for method in ["lambda", "n4sid"] {
         let out = if method == "lambda" {
             identify_lambda_campaign(
