@@ -163,7 +163,7 @@ impl JobHandler for Identify {
             let grid = campaign.grid_speeds_mps.clone();
             let (campaign_id, vessel_id) = (campaign.id.clone(), campaign.vessel_id.clone());
             let name = format!("{} — {}", profile.name, method);
-            let lineage = models::latest_of_method(&cx.db, &cid, &method_name(&method))
+            let lineage = models::latest_of_method(&cx.db, &cid, &method)
                 .await?
                 .map(|m| Lineage::After(m.id))
                 .unwrap_or(Lineage::New);
@@ -222,11 +222,6 @@ impl JobHandler for Identify {
             }))
         })
     }
-}
-
-/// Stored method name of a request's method.
-fn method_name(method: &str) -> String {
-    method.to_string()
 }
 
 /// A model to store when the job succeeds.
