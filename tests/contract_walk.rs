@@ -53,6 +53,7 @@ async fn stored_model(app: &TestApp, cid: &str, vid: &str) -> String {
                 b_std: one,
                 n_samples: 100,
                 run_ids: vec![],
+                augmentation: None,
             }],
         }),
         dp_ship: None,

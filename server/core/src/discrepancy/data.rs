@@ -96,11 +96,11 @@ impl Baseline {
                 return Err(DiscoveryError::invalid(name, "must be finite"));
             }
         }
-        if self.m.clone().try_inverse().is_none() || (0..n).any(|i| self.m[(i, i)] <= 0.0) {
-            return Err(DiscoveryError::invalid(
-                "baseline.m",
-                "must be invertible with a positive diagonal",
-            ));
+        // A non-positive diagonal is allowed: an unphysical M (e.g. a roll
+        // inertia < 0 where a righting moment was left out) is exactly what
+        // discovery is asked to explain; the rows it touches are refitted.
+        if self.m.clone().try_inverse().is_none() {
+            return Err(DiscoveryError::invalid("baseline.m", "must be invertible"));
         }
         let r = &self.restoring;
         if ![r.w_minus_b, r.zg_w_minus_zb_b, r.tether_pitch_moment]

@@ -110,6 +110,7 @@ mod tests {
             b_std: vec![vec![0.0]],
             n_samples: 1,
             run_ids: vec![],
+            augmentation: None,
         };
         let doc = ModelDocument {
             kind: ModelKind::Lpv,

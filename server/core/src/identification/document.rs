@@ -126,6 +126,24 @@ pub struct LpvPoint {
     pub n_samples: usize,
     /// Runs used.
     pub run_ids: Vec<String>,
+    /// Physics added at this speed by missing-physics discovery; the point's
+    /// `m`, `d_bar` are then the refitted ones and the model is driven by
+    /// (τ, η) instead of γ.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub augmentation: Option<PointAugmentation>,
+}
+
+/// Terms added to an LPV sub-model by discovery (see
+/// [`crate::discrepancy::AugmentedModel`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct PointAugmentation {
+    /// The baseline's M, from which a Coriolis term's C(ν) is built.
+    pub m_ref: Matrix,
+    /// The baseline's D̄, through which a current acts.
+    pub d_ref: Matrix,
+    /// The added terms with coefficients, covariances and shapes.
+    pub terms: Vec<crate::discrepancy::ModelTerm>,
 }
 
 /// An LPV model on forward speed (thesis eq. 2.16–2.18).

@@ -167,6 +167,7 @@ mod tests {
                     b_std: id,
                     n_samples: 100,
                     run_ids: vec![],
+                    augmentation: None,
                 }],
             }),
             dp_ship: None,

@@ -468,6 +468,7 @@ pub fn identify_lambda_campaign(
             b_std: to_rows(&est.std_b),
             n_samples: est.n_samples,
             run_ids: runs_per_point[idx].clone(),
+            augmentation: None,
         });
         models.push(model);
     }

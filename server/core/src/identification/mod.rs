@@ -2,6 +2,9 @@
 //! they were) to a validated model document. Pure orchestration over the
 //! estimators of [`crate::estimation`] and [`crate::validation`].
 //!
+//! - [`discover_campaign`]: missing-physics discovery on a stored LPV model,
+//!   per grid speed, and the augmented model as its next version.
+//! - [`augmented`]: an LPV model with discovered terms as a predictor.
 //! - [`dataset`]: runs → segments (one per valid block, never concatenated).
 //! - [`roles`]: static, estimation and held-out validation runs.
 //! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method.
@@ -12,7 +15,9 @@
 //! - [`predictor`]: a stored model back as a predictor; validation on any run.
 //! - [`outcome`], [`error`]: what an identification returns.
 
+pub mod augmented;
 pub mod dataset;
+pub mod discover_campaign;
 pub mod discrete;
 pub mod document;
 pub mod error;
@@ -24,6 +29,7 @@ pub mod predictor;
 pub mod roles;
 
 pub use dataset::{DatasetError, RunInput, Segment, segments};
+pub use discover_campaign::{CampaignDiscovery, DiscoverCampaignSettings, discover_campaign};
 pub use document::{Method, ModelDocument, ModelKind, ParameterRow};
 pub use error::IdentifyError;
 pub use lambda_campaign::{LambdaCampaignSettings, identify_lambda_campaign};

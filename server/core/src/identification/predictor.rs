@@ -4,6 +4,7 @@
 
 use nalgebra::DMatrix;
 
+use super::augmented::{AugmentedLpv, is_augmented};
 use super::dataset::{RunInput, segments};
 use super::document::{ModelDocument, ModelKind, from_rows};
 use super::error::IdentifyError;
@@ -22,6 +23,7 @@ fn matrix(rows: &super::document::Matrix, what: &str) -> Result<DMatrix<f64>, Id
 /// The predictor of a stored model.
 pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyError> {
     match doc.kind {
+        ModelKind::Lpv if is_augmented(doc) => Ok(Box::new(AugmentedLpv::from_doc(doc)?)),
         ModelKind::Lpv => {
             let lpv = doc
                 .lpv
@@ -81,7 +83,8 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
 
 /// The longest valid block of `run` as the model's validation data:
 /// γ = τ − g(η) and ν for an LPV model, deviations from the operating point
-/// for a subspace model. `inputs` are the force columns in DOF order.
+/// for a subspace model, [τ | η] for a model with discovered terms.
+/// `inputs` are the force columns in DOF order.
 pub fn validation_data(
     doc: &ModelDocument,
     run: &RunInput,
@@ -94,8 +97,9 @@ pub fn validation_data(
         .map(|d| d.velocity_symbol().to_string())
         .collect();
     let restoring = doc.restoring.as_ref().map(|r| r.params);
+    let augmented = is_augmented(doc);
     let mut cols = inputs.to_vec();
-    if restoring.is_some() {
+    if restoring.is_some() || augmented {
         cols.extend(Dof::ALL.iter().map(|d| pose_column(*d).to_string()));
     }
     let segs = segments(run, &cols, &outputs, 50)
@@ -105,6 +109,9 @@ pub fn validation_data(
         .max_by_key(|s| s.y.nrows())
         .expect("segments is non-empty");
     let tau = seg.u.columns(0, n).into_owned();
+    if augmented {
+        return Ok((seg.h, seg.u.columns(0, n + 6).into_owned(), seg.y.clone()));
+    }
     match doc.kind {
         ModelKind::StateSpace => {
             let s = doc.state_space.as_ref().expect("checked by predictor()");

@@ -12,10 +12,10 @@ use crate::rng::SplitMix64;
 use crate::simulation::rov::{RovRecord, RovTruth, SimConfig};
 use crate::timeseries::UniformRecord;
 
-const H: f64 = 0.1;
+pub(crate) const H: f64 = 0.1;
 
 /// τ columns of a force-actuated vessel, in DOF order.
-fn force_columns(profile: &crate::planning::VesselProfile) -> Vec<String> {
+pub(crate) fn force_columns(profile: &crate::planning::VesselProfile) -> Vec<String> {
     profile
         .dofs
         .iter()
@@ -48,7 +48,12 @@ fn excitation(truth: &RovTruth, speed: &[f64], amp: f64, seed: u64) -> DMatrix<f
     tau
 }
 
-fn to_run(id: &str, family: ExperimentFamily, grid: Option<f64>, rec: &RovRecord) -> RunInput {
+pub(crate) fn to_run(
+    id: &str,
+    family: ExperimentFamily,
+    grid: Option<f64>,
+    rec: &RovRecord,
+) -> RunInput {
     let mut names = vec!["t".to_string()];
     let mut data = vec![rec.t.clone()];
     for (j, c) in ["tau_X", "tau_Y", "tau_Z", "tau_K", "tau_M", "tau_N"]
@@ -82,7 +87,7 @@ fn to_run(id: &str, family: ExperimentFamily, grid: Option<f64>, rec: &RovRecord
     }
 }
 
-fn simulate(truth: &RovTruth, speed: Vec<f64>, seed: u64) -> RovRecord {
+pub(crate) fn simulate(truth: &RovTruth, speed: Vec<f64>, seed: u64) -> RovRecord {
     let tau = excitation(truth, &speed, 0.25, seed);
     let cfg = SimConfig {
         h: H,
