@@ -5,102 +5,19 @@
 
 mod common;
 
-use std::time::Duration;
-
-use common::sim::multipart;
-use common::{TestApp, rov_profile};
+use common::TestApp;
+use common::flights::{flown_campaign, linear_truth, wait_for};
 use seatrial::jobs::{JobRegistry, JobsConfig};
-use seatrial_core::planning::{CampaignSpec, generate_plan};
-use seatrial_core::simulation::rov::RovTruth;
-use seatrial_core::simulation::trials::{TrialSettings, fly_experiment};
 use serde_json::{Value, json};
 
 async fn app() -> TestApp {
     TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await
 }
 
-/// Creates the Surveyor and a campaign on 1 and 2 kn with recursive and
-/// validation experiments, flies every planned experiment (≤ 240 s each)
-/// through a linear truth, and uploads the logs linked to their experiments.
-async fn flown_campaign(app: &TestApp) -> String {
-    let r = app
-        .call("POST", "/api/vessels", &[], Some(rov_profile()))
-        .await;
-    let vid = r.json["id"].as_str().unwrap().to_string();
-    let spec = json!({
-        "vessel_id": vid,
-        "name": "identification trial",
-        "grid": { "unit": "kn", "speeds": [1.0, 2.0] },
-        "families": ["recursive", "validation"],
-        "repetitions": 2,
-        "seed": 11
-    });
-    let r = app
-        .call("POST", "/api/campaigns", &[], Some(spec.clone()))
-        .await;
-    assert_eq!(r.status, 201, "{}", r.text);
-    let cid = r.json["id"].as_str().unwrap().to_string();
-    let plan = app
-        .call("POST", "/api/campaigns/{id}/plan", &[&cid], None)
-        .await;
-    assert_eq!(plan.status, 201, "{}", plan.text);
-    // The same plan, generated in-process to fly it (plans are deterministic).
-    let profile = seatrial_core::planning::examples::surveyor_rov();
-    let mut core_spec = spec.clone();
-    core_spec.as_object_mut().unwrap().remove("vessel_id");
-    let core_spec: CampaignSpec = serde_json::from_value(core_spec).unwrap();
-    let core_plan = generate_plan(&profile, &core_spec).unwrap();
-    let mut truth = RovTruth::surveyor_like();
-    truth.restoring = Default::default();
-    let settings = TrialSettings {
-        max_duration_s: Some(240.0),
-        seed: 3,
-        ..TrialSettings::default()
-    };
-    for planned in &core_plan.experiments {
-        let code = &planned.experiment.code;
-        let eid = plan.json["experiments"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|e| e["code"] == *code)
-            .and_then(|e| e["id"].as_str())
-            .unwrap_or_else(|| panic!("experiment {code} not in the stored plan"))
-            .to_string();
-        let flown = fly_experiment(&profile, &truth, planned, &settings).unwrap();
-        let meta = json!({ "experiment_id": eid }).to_string();
-        let (ct, body) = multipart(&[
-            ("meta", None, &meta),
-            ("file", Some(&format!("{code}.csv")), &flown.csv),
-        ]);
-        let r = app
-            .raw(
-                "POST",
-                &format!("/api/campaigns/{cid}/runs"),
-                Some((&ct, body)),
-            )
-            .await;
-        assert_eq!(r.status, 201, "{code}: {}", r.text);
-    }
-    cid
-}
-
-async fn wait_for(app: &TestApp, job_id: &str) -> Value {
-    for _ in 0..600 {
-        let r = app.call("GET", "/api/jobs/{id}", &[job_id], None).await;
-        let state = r.json["state"].as_str().unwrap_or("").to_string();
-        if ["succeeded", "failed", "cancelled", "interrupted"].contains(&state.as_str()) {
-            return r.json;
-        }
-        tokio::time::sleep(Duration::from_millis(100)).await;
-    }
-    panic!("job {job_id} did not finish in 60 s");
-}
-
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn identify_job_stores_a_validated_versioned_lpv_model() {
     let app = app().await;
-    let cid = flown_campaign(&app).await;
+    let cid = flown_campaign(&app, &linear_truth()).await;
     let submit =
         json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf", "settings": {} });
     let r = app
@@ -235,7 +152,7 @@ async fn identify_job_stores_a_validated_versioned_lpv_model() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn n4sid_job_and_bad_requests_name_the_field() {
     let app = app().await;
-    let cid = flown_campaign(&app).await;
+    let cid = flown_campaign(&app, &linear_truth()).await;
     let bad = |body: Value| {
         let app = &app;
         async move { app.call("POST", "/api/jobs", &[], Some(body)).await }

@@ -85,6 +85,28 @@ async fn stored_model(app: &TestApp, cid: &str, vid: &str) -> String {
     m.id
 }
 
+/// A stored discovery report (nothing named) on model `mid`.
+async fn stored_discrepancy(app: &TestApp, cid: &str, mid: &str) -> String {
+    use seatrial::storage::discrepancies::{NewDiscrepancy, insert};
+    let mut conn = app.state.db.acquire().await.unwrap();
+    insert(
+        &mut conn,
+        NewDiscrepancy {
+            model_id: mid.into(),
+            augmented_model_id: None,
+            campaign_id: cid.into(),
+            job_id: None,
+            settings: json!({}),
+            run_ids: vec![],
+            validation_run_ids: vec![],
+            summary: vec!["No missing physics named.".into()],
+            report: json!({ "summary": ["No missing physics named."], "effects": [], "points": [], "skipped": [] }),
+        },
+    )
+    .await
+    .unwrap()
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn every_documented_operation_is_exercised_and_answers() {
     let app = TestApp::with_jobs(common::jobs::registry(), common::jobs::config(1)).await;
@@ -132,6 +154,7 @@ async fn every_documented_operation_is_exercised_and_answers() {
     }
     let long = json!({ "n": 1000, "steps": 100, "step_ms": 50 });
     let mid = stored_model(&app, &cid, &vid).await;
+    let did = stored_discrepancy(&app, &cid, &mid).await;
 
     let paths = app.spec["paths"].as_object().unwrap().clone();
     let mut walked = 0;
@@ -145,6 +168,8 @@ async fn every_documented_operation_is_exercised_and_answers() {
                 vec![&rid]
             } else if template.starts_with("/api/jobs/") {
                 vec![&jid]
+            } else if template.starts_with("/api/discrepancies/") {
+                vec![&did]
             } else if template.starts_with("/api/models/") {
                 vec![&mid]
             } else if template.contains("{id}") {
@@ -226,5 +251,5 @@ async fn every_documented_operation_is_exercised_and_answers() {
             walked += 1;
         }
     }
-    assert!(walked >= 23, "walked {walked} operations");
+    assert!(walked >= 25, "walked {walked} operations");
 }

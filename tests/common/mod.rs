@@ -4,6 +4,7 @@
 
 #![allow(dead_code)]
 
+pub mod flights;
 pub mod jobs;
 pub mod sim;
 

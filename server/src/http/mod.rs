@@ -4,6 +4,7 @@
 //! itself and a test holds the two together.
 
 pub mod campaigns;
+pub mod discrepancies;
 pub mod export;
 pub mod health;
 pub mod jobs;
@@ -90,7 +91,8 @@ impl AppState {
         (name = "planning", description = "Vessels, campaigns, excitation plans and their exports"),
         (name = "runs", description = "Uploaded logs, their alignment and data-quality reports"),
         (name = "jobs", description = "Background jobs (identification, discovery): submit, follow by polling or Server-Sent Events, cancel, retry"),
-        (name = "models", description = "Identified models: versions with provenance, matrices and parameters with uncertainties, validation, exports")
+        (name = "models", description = "Identified models: versions with provenance, matrices and parameters with uncertainties, validation, exports"),
+        (name = "discovery", description = "Missing-physics discovery: where a model and the recordings part, the physics left out, the augmented model and the before/after proof")
     )
 )]
 struct ApiDoc;
@@ -124,6 +126,8 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(models::compare_models))
         .routes(routes!(models::get_model))
         .routes(routes!(models::export_model))
+        .routes(routes!(discrepancies::list_model_discrepancies))
+        .routes(routes!(discrepancies::get_discrepancy))
         // Uploads stream to disk under their own limit (counted in the handler).
         .merge(
             OpenApiRouter::new()

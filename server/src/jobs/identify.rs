@@ -29,7 +29,9 @@ pub const METHODS: [&str; 2] = ["lambda_kf", "n4sid"];
 pub struct Identify;
 
 /// Parses `settings` for a method, naming the field on error.
-fn parse_settings<T: DeserializeOwned>(v: &serde_json::Value) -> Result<T, (String, String)> {
+pub(super) fn parse_settings<T: DeserializeOwned>(
+    v: &serde_json::Value,
+) -> Result<T, (String, String)> {
     serde_path_to_error::deserialize(v).map_err(|e| {
         let path = e.path().to_string();
         let field = if path == "." {

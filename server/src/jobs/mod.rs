@@ -102,6 +102,7 @@
 //! stops claiming, lets the computations unwind, records nothing and ends
 //! their leases at once, so the next start re-queues them without waiting.
 
+pub mod discover;
 pub mod events;
 pub mod handler;
 pub mod heartbeat;
@@ -109,6 +110,7 @@ pub mod identify;
 pub mod live;
 pub mod progress;
 pub mod registry;
+pub mod run_inputs;
 pub mod runner;
 pub mod service;
 pub mod submit;

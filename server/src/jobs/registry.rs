@@ -18,9 +18,12 @@ impl JobRegistry {
     }
 
     /// The production kinds: `identify` (campaign runs → a validated,
-    /// versioned model).
+    /// versioned model) and `discover` (a model and its runs → the missing
+    /// physics, and the augmented model as its next version).
     pub fn production() -> Self {
-        Self::new().with("identify", super::identify::Identify)
+        Self::new()
+            .with("identify", super::identify::Identify)
+            .with("discover", super::discover::Discover)
     }
 
     /// Adds (or replaces) the handler of `kind`.

@@ -4,6 +4,7 @@
 
 pub mod blobs;
 pub mod campaigns;
+pub mod discrepancies;
 pub mod jobs;
 pub mod models;
 pub mod plans;

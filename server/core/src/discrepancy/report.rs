@@ -27,6 +27,7 @@ pub struct Estimate {
 /// Whether a hypothesis made it into the model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[cfg_attr(feature = "openapi", schema(as = HypothesisVerdict))]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
     /// Chosen: significant and improves held-out simulations.

@@ -108,13 +108,19 @@ fn discovery_error(e: DiscoveryError, speed: f64) -> IdentifyError {
     }
 }
 
-/// The valid blocks of a run as discovery records: τ in DOF order, ν, η.
+/// The valid blocks of a run as discovery records (τ in DOF order, ν, η),
+/// each with the grid point it belongs to. A run without a planned grid
+/// speed (the plan's validation runs step through the whole grid) is cut
+/// where its forward speed, smoothed over 10 s, moves to another grid
+/// point: discovery compares each sub-model with the part of the run it
+/// predicts.
 fn records(
     run: &RunInput,
     dofs: &[Dof],
     forces: &[String],
+    grid: &[f64],
     min_len: usize,
-) -> Result<Vec<Record>, IdentifyError> {
+) -> Result<Vec<(Record, usize)>, IdentifyError> {
     let n = dofs.len();
     let cols: Vec<String> = forces
         .iter()
@@ -127,22 +133,67 @@ fn records(
         .collect();
     let segs = segments(run, &cols, &outputs, min_len)
         .map_err(|e| IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string()))?;
-    let many = segs.len() > 1;
-    Ok(segs
-        .into_iter()
-        .enumerate()
-        .map(|(i, s)| Record {
-            name: if many {
-                format!("{} #{}", run.name, i + 1)
-            } else {
-                run.name.clone()
-            },
+    let surge = dofs.iter().position(|d| *d == Dof::Surge);
+    let mut out = Vec::new();
+    for (b, s) in segs.into_iter().enumerate() {
+        let rec = Record {
+            name: run.name.clone(),
             h: s.h,
             tau: s.u.columns(0, n).into_owned(),
             nu: s.y,
             eta: s.u.columns(n, 6).into_owned(),
-        })
-        .collect())
+        };
+        let block = if b > 0 {
+            format!(" #{}", b + 1)
+        } else {
+            String::new()
+        };
+        let pieces: Vec<(usize, usize, usize)> = match (run.grid_speed_mps, surge) {
+            (Some(v), _) => vec![(0, rec.len(), nearest_grid_index(grid, v))],
+            (None, None) => vec![(0, rec.len(), 0)],
+            (None, Some(j)) => pieces_by_speed(rec.nu.column(j).as_slice(), rec.h, grid),
+        };
+        let whole = pieces.len() == 1;
+        for (start, end, i) in pieces {
+            if end - start < min_len {
+                continue;
+            }
+            let name = if whole {
+                format!("{}{block}", run.name)
+            } else {
+                format!(
+                    "{}{block} @ {:.2} m/s ({:.0}–{:.0} s)",
+                    run.name,
+                    grid[i],
+                    start as f64 * rec.h,
+                    end as f64 * rec.h
+                )
+            };
+            out.push((rec.slice(start, end, name), i));
+        }
+    }
+    Ok(out)
+}
+
+/// Maximal stretches [start, end) over which the forward speed `u`,
+/// smoothed over 10 s, stays nearest one grid point.
+fn pieces_by_speed(u: &[f64], h: f64, grid: &[f64]) -> Vec<(usize, usize, usize)> {
+    let n = u.len();
+    let half = ((5.0 / h).round() as usize).max(1);
+    let mut prefix = vec![0.0; n + 1];
+    for k in 0..n {
+        prefix[k + 1] = prefix[k] + u[k];
+    }
+    let mut pieces: Vec<(usize, usize, usize)> = Vec::new();
+    for k in 0..n {
+        let (a, b) = (k.saturating_sub(half), (k + half + 1).min(n));
+        let i = nearest_grid_index(grid, (prefix[b] - prefix[a]) / (b - a) as f64);
+        match pieces.last_mut() {
+            Some(last) if last.2 == i => last.1 = k + 1,
+            _ => pieces.push((k, k + 1, i)),
+        }
+    }
+    pieces
 }
 
 /// The shortest record discovery accepts: the filter transient and the
@@ -233,7 +284,6 @@ pub fn discover_campaign(
 
     // Records per grid point. Static runs (attitude holds) went into g(η);
     // discovery looks at the dynamics.
-    let surge = doc.dofs.iter().position(|d| *d == Dof::Surge);
     let mut est: Vec<(Vec<Record>, Vec<String>)> = vec![Default::default(); grid.len()];
     let mut val: Vec<(Vec<Record>, Vec<String>)> = vec![Default::default(); grid.len()];
     for r in runs {
@@ -248,12 +298,7 @@ pub fn discover_campaign(
             continue;
         };
         let h = 1.0 / r.record.sample_rate_hz;
-        let recs = records(r, &doc.dofs, forces, min_record_len(&dset, h))?;
-        for rec in recs {
-            let speed = r
-                .grid_speed_mps
-                .unwrap_or_else(|| surge.map_or(grid[0], |j| rec.nu.column(j).mean()));
-            let i = nearest_grid_index(&grid, speed);
+        for (rec, i) in records(r, &doc.dofs, forces, &grid, min_record_len(&dset, h))? {
             if !bucket[i].1.contains(&r.run_id) {
                 bucket[i].1.push(r.run_id.clone());
             }
@@ -279,7 +324,7 @@ pub fn discover_campaign(
                 (true, false) => "no estimation run",
                 (false, true) => "no validation run",
             };
-            skipped.push(format!("{} m/s: {why} long enough to use", grid[i]));
+            skipped.push(format!("{:.2} m/s: {why} long enough to use", grid[i]));
             false
         })
         .collect();
@@ -363,8 +408,15 @@ fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
         }
     }
     let mut v: Vec<_> = by.into_values().collect();
-    v.sort_by(|a, b| b.grid_speeds_mps.len().cmp(&a.grid_speeds_mps.len()));
+    v.sort_by_key(|e| std::cmp::Reverse(e.grid_speeds_mps.len()));
     v
+}
+
+fn speeds_text(v: &[f64]) -> String {
+    v.iter()
+        .map(|s| format!("{s:.2}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn summarize(
@@ -396,11 +448,14 @@ fn summarize(
             "at every grid speed examined — a property of the vehicle".to_string()
         } else if k == 1 && n > 1 {
             format!(
-                "only at {} m/s — check those runs before trusting it",
+                "only at {:.2} m/s — check those runs before trusting it",
                 e.grid_speeds_mps[0]
             )
         } else {
-            format!("at {k} of {n} grid speeds ({:?} m/s)", e.grid_speeds_mps)
+            format!(
+                "at {k} of {n} grid speeds ({} m/s)",
+                speeds_text(&e.grid_speeds_mps)
+            )
         };
         out.push(format!("{}: named {scope}; {range}.", e.label));
     }
@@ -419,13 +474,14 @@ fn summarize(
     }
     for (dof, (speeds, lo, hi)) in &left {
         out.push(format!(
-            "{}: structure no candidate explains at {speeds:?} m/s ({lo:.0}–{hi:.0} dB above the noise floor); see the per-speed signatures.",
-            dof.name()
+            "{}: structure no candidate explains at {} m/s ({lo:.0}–{hi:.0} dB above the noise floor); see the per-speed signatures.",
+            dof.name(),
+            speeds_text(speeds)
         ));
     }
     for p in points {
         for a in &p.report.ambiguities {
-            out.push(format!("{} m/s: {}", p.grid_speed_mps, a.text));
+            out.push(format!("{:.2} m/s: {}", p.grid_speed_mps, a.text));
         }
     }
     if !skipped.is_empty() {
@@ -668,6 +724,23 @@ mod tests {
         assert!(out.report.effects.is_empty(), "{:?}", out.report.summary);
         assert!(out.augmented.is_none());
         assert!(out.report.summary[0].starts_with("No missing physics"));
+    }
+
+    #[test]
+    fn a_run_through_the_grid_is_cut_where_the_speed_changes_grid_point() {
+        // 100 s at 0.5, 100 s at 1.0, 100 s at 1.5 m/s, 10 Hz, with ripple.
+        let u: Vec<f64> = (0..3000)
+            .map(|k| 0.5 * (1 + k / 1000) as f64 + 0.2 * (k as f64 * 0.3).sin())
+            .collect();
+        let p = pieces_by_speed(&u, 0.1, &[0.5, 1.0, 1.5]);
+        assert_eq!(
+            p.iter().map(|x| x.2).collect::<Vec<_>>(),
+            [0, 1, 2],
+            "{p:?}"
+        );
+        // The 10 s smoothing moves each cut by at most half its window.
+        assert_eq!((p[0].0, p[2].1), (0, 3000));
+        assert!((p[0].1 as i64 - 1000).abs() <= 50 && (p[1].1 as i64 - 2000).abs() <= 50);
     }
 
     #[test]

@@ -1,0 +1,225 @@
+//! Missing-physics discovery end to end through REST: a campaign flown by a
+//! truth with a metacentric righting moment (which a λ model without static
+//! runs leaves out), identified, then a `discover` job names the left-out
+//! restoring in roll and pitch, stores the augmented model as version 2 of
+//! the model, and the report and both models are served. Every response is
+//! checked against openapi.yaml.
+
+mod common;
+
+use common::TestApp;
+use common::flights::{flown_campaign, wait_for};
+use seatrial::jobs::{JobRegistry, JobsConfig};
+use seatrial_core::simulation::rov::RovTruth;
+use serde_json::{Value, json};
+
+async fn app() -> TestApp {
+    TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await
+}
+
+async fn run_job(app: &TestApp, body: Value) -> Value {
+    let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let job = wait_for(app, r.json["id"].as_str().unwrap()).await;
+    assert_eq!(job["state"], "succeeded", "{job}");
+    job
+}
+
+fn sim_fit(validation: &Value, ch: &str) -> f64 {
+    validation[0]["report"]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["output"] == ch)
+        .and_then(|c| c["fit_simulation"].as_f64())
+        .unwrap_or(f64::NEG_INFINITY)
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn discovery_names_the_righting_moment_and_stores_the_augmented_model() {
+    let app = app().await;
+    let cid = flown_campaign(&app, &RovTruth::surveyor_like()).await;
+    let job = run_job(
+        &app,
+        json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf" }),
+    )
+    .await;
+    let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+
+    let job = run_job(
+        &app,
+        json!({ "kind": "discover", "campaign_id": cid, "model_id": mid }),
+    )
+    .await;
+    assert_eq!(job["progress"], 1.0);
+    let did = job["result"]["discrepancy_id"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let aug = job["result"]["augmented_model_id"]
+        .as_str()
+        .expect("an augmented model")
+        .to_string();
+    assert_eq!(job["result"]["augmented_version"], 2);
+
+    // The report: restoring named in roll and pitch at both grid speeds.
+    let d = app
+        .call("GET", "/api/discrepancies/{id}", &[&did], None)
+        .await;
+    assert_eq!(d.status, 200, "{}", d.text);
+    assert_eq!(d.json["model"]["id"], mid.as_str());
+    assert_eq!(d.json["augmented_model"]["id"], aug.as_str());
+    let effects = d.json["report"]["effects"].as_array().unwrap();
+    for dof in ["roll", "pitch"] {
+        let e = effects
+            .iter()
+            .find(|e| e["effect"]["effect"] == "restoring" && e["effect"]["dof"] == dof)
+            .unwrap_or_else(|| panic!("no {dof} restoring: {}", d.json["report"]["summary"]));
+        assert_eq!(
+            e["grid_speeds_mps"].as_array().unwrap().len(),
+            2,
+            "{e}\n{:#}",
+            d.json["report"]["summary"]
+        );
+        // z_B·B of the truth: 0.2 m × (5000 kg · 9.81 + 250 N) = 9860 N·m.
+        for m in e["magnitudes"].as_array().unwrap() {
+            let v = m[0].as_f64().unwrap();
+            assert!((v - 9860.0).abs() < 0.1 * 9860.0, "{dof}: {v}");
+        }
+    }
+    let points = d.json["report"]["points"].as_array().unwrap();
+    assert_eq!(points.len(), 2);
+    for p in points {
+        let rep = &p["report"];
+        assert!(!rep["location"]["sentences"].as_array().unwrap().is_empty());
+        assert!(!rep["hypotheses"].as_array().unwrap().is_empty());
+        assert!(!rep["plots"].as_array().unwrap().is_empty());
+    }
+    assert!(!d.json["run_names"].as_object().unwrap().is_empty());
+
+    // Listed on the model it examined.
+    let l = app
+        .call("GET", "/api/models/{id}/discrepancies", &[&mid], None)
+        .await;
+    assert_eq!(l.status, 200, "{}", l.text);
+    assert_eq!(l.json[0]["id"], did.as_str());
+
+    // The augmented model: version 2 of the same lineage, fits roll and
+    // pitch on the held-out runs where the baseline failed.
+    let base = app.call("GET", "/api/models/{id}", &[&mid], None).await;
+    let new = app.call("GET", "/api/models/{id}", &[&aug], None).await;
+    assert_eq!(new.status, 200, "{}", new.text);
+    assert_eq!(new.json["model"]["version"], 2);
+    assert_eq!(new.json["model"]["parent_id"], mid.as_str());
+    assert_eq!(new.json["model"]["method"], "discovery");
+    assert_eq!(
+        new.json["validation_run_ids"],
+        base.json["validation_run_ids"]
+    );
+    for ch in ["p", "q"] {
+        let (b, a) = (
+            sim_fit(&base.json["validation"], ch),
+            sim_fit(&new.json["validation"], ch),
+        );
+        assert!(a > 0.6 && a - b > 0.3, "{ch}: {b} → {a}");
+    }
+    // It validates on any run like every stored model, and exports.
+    let val = base.json["validation_run_ids"][0].as_str().unwrap();
+    let c = app
+        .call(
+            "GET",
+            "/api/models/compare?a={a}&b={b}&run_id={r}",
+            &[&mid, &aug, val],
+            None,
+        )
+        .await;
+    assert_eq!(c.status, 200, "{}", c.text);
+    let csv = app
+        .call("GET", "/api/models/{id}/export?format=csv", &[&aug], None)
+        .await;
+    assert_eq!(csv.status, 200);
+    assert!(csv.text.contains("discovered: restoring"), "{}", csv.text);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn bad_discover_requests_name_the_field() {
+    let app = app().await;
+    let cid = flown_campaign(&app, &RovTruth::surveyor_like()).await;
+    let job = run_job(
+        &app,
+        json!({ "kind": "identify", "campaign_id": cid, "method": "n4sid" }),
+    )
+    .await;
+    let black_box = job["result"]["model_id"].as_str().unwrap().to_string();
+    let cases = [
+        (json!({ "kind": "discover" }), 422, "model_id"),
+        (
+            json!({ "kind": "discover", "model_id": "nope" }),
+            404,
+            "model_id",
+        ),
+        (
+            json!({ "kind": "discover", "model_id": black_box }),
+            422,
+            "model_id",
+        ),
+    ];
+    for (body, status, field) in cases {
+        let r = app.call("POST", "/api/jobs", &[], Some(body.clone())).await;
+        assert_eq!(r.status.as_u16(), status, "{body}: {}", r.text);
+        assert_eq!(r.json["field"], field, "{body}: {}", r.text);
+    }
+    let job = run_job(
+        &app,
+        json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf" }),
+    )
+    .await;
+    let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+    let cases = [
+        (
+            json!({ "kind": "discover", "model_id": mid, "settings": { "discovery": { "k_step": "ten" } } }),
+            "settings.discovery.k_step",
+        ),
+        (
+            json!({ "kind": "discover", "model_id": mid, "settings": { "grid": [1] } }),
+            "settings",
+        ),
+        (
+            json!({ "kind": "discover", "model_id": mid, "method": "lasso" }),
+            "method",
+        ),
+    ];
+    for (body, field) in cases {
+        let r = app.call("POST", "/api/jobs", &[], Some(body.clone())).await;
+        assert_eq!(r.status.as_u16(), 422, "{body}: {}", r.text);
+        assert!(
+            r.json["field"].as_str().unwrap().starts_with(field),
+            "{body}: {}",
+            r.text
+        );
+    }
+    // A grid speed the model does not have fails the job naming the field.
+    let r = app
+        .call(
+            "POST",
+            "/api/jobs",
+            &[],
+            Some(json!({ "kind": "discover", "model_id": mid, "settings": { "grid_speeds_mps": [0.3] } })),
+        )
+        .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let job = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    assert_eq!(job["state"], "failed", "{job}");
+    assert_eq!(
+        job["error"]["field"], "settings.grid_speeds_mps[0]",
+        "{job}"
+    );
+    let r = app
+        .call("GET", "/api/discrepancies/{id}", &["nope"], None)
+        .await;
+    assert_eq!(r.status, 404);
+    let r = app
+        .call("GET", "/api/models/{id}/discrepancies", &["nope"], None)
+        .await;
+    assert_eq!(r.status, 404);
+}

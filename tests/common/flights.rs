@@ -1,0 +1,99 @@
+//! Flying a planned ROV campaign through the truth simulator and uploading
+//! its logs, and waiting for a job: what the identification and discovery
+//! tests share.
+
+#![allow(dead_code)]
+
+use std::time::Duration;
+
+use seatrial_core::planning::{CampaignSpec, generate_plan};
+use seatrial_core::simulation::rov::RovTruth;
+use seatrial_core::simulation::trials::{TrialSettings, fly_experiment};
+use serde_json::{Value, json};
+
+use super::sim::multipart;
+use super::{TestApp, rov_profile};
+
+/// The Surveyor-like truth without restoring: what the λ model at each grid
+/// speed can represent.
+pub fn linear_truth() -> RovTruth {
+    let mut truth = RovTruth::surveyor_like();
+    truth.restoring = Default::default();
+    truth
+}
+
+/// Creates the Surveyor and a campaign on 1 and 2 kn with recursive and
+/// validation experiments, flies every planned experiment (≤ 240 s each)
+/// through `truth`, and uploads the logs linked to their experiments.
+pub async fn flown_campaign(app: &TestApp, truth: &RovTruth) -> String {
+    let r = app
+        .call("POST", "/api/vessels", &[], Some(rov_profile()))
+        .await;
+    let vid = r.json["id"].as_str().unwrap().to_string();
+    let spec = json!({
+        "vessel_id": vid,
+        "name": "identification trial",
+        "grid": { "unit": "kn", "speeds": [1.0, 2.0] },
+        "families": ["recursive", "validation"],
+        "repetitions": 2,
+        "seed": 11
+    });
+    let r = app
+        .call("POST", "/api/campaigns", &[], Some(spec.clone()))
+        .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let cid = r.json["id"].as_str().unwrap().to_string();
+    let plan = app
+        .call("POST", "/api/campaigns/{id}/plan", &[&cid], None)
+        .await;
+    assert_eq!(plan.status, 201, "{}", plan.text);
+    // The same plan, generated in-process to fly it (plans are deterministic).
+    let profile = seatrial_core::planning::examples::surveyor_rov();
+    let mut core_spec = spec.clone();
+    core_spec.as_object_mut().unwrap().remove("vessel_id");
+    let core_spec: CampaignSpec = serde_json::from_value(core_spec).unwrap();
+    let core_plan = generate_plan(&profile, &core_spec).unwrap();
+    let settings = TrialSettings {
+        max_duration_s: Some(240.0),
+        seed: 3,
+        ..TrialSettings::default()
+    };
+    for planned in &core_plan.experiments {
+        let code = &planned.experiment.code;
+        let eid = plan.json["experiments"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["code"] == *code)
+            .and_then(|e| e["id"].as_str())
+            .unwrap_or_else(|| panic!("experiment {code} not in the stored plan"))
+            .to_string();
+        let flown = fly_experiment(&profile, truth, planned, &settings).unwrap();
+        let meta = json!({ "experiment_id": eid }).to_string();
+        let (ct, body) = multipart(&[
+            ("meta", None, &meta),
+            ("file", Some(&format!("{code}.csv")), &flown.csv),
+        ]);
+        let r = app
+            .raw(
+                "POST",
+                &format!("/api/campaigns/{cid}/runs"),
+                Some((&ct, body)),
+            )
+            .await;
+        assert_eq!(r.status, 201, "{code}: {}", r.text);
+    }
+    cid
+}
+
+pub async fn wait_for(app: &TestApp, job_id: &str) -> Value {
+    for _ in 0..600 {
+        let r = app.call("GET", "/api/jobs/{id}", &[job_id], None).await;
+        let state = r.json["state"].as_str().unwrap_or("").to_string();
+        if ["succeeded", "failed", "cancelled", "interrupted"].contains(&state.as_str()) {
+            return r.json;
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    panic!("job {job_id} did not finish in 60 s");
+}
