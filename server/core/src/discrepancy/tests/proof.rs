@@ -5,8 +5,7 @@
 
 use std::time::Instant;
 
-use super::scenario::{Scenario, scenario, true_model};
-use super::truth::Truth;
+use super::scenario::{Scenario, clean_truth, command_share, reach, scenario, true_model};
 use crate::discrepancy::candidates::Family;
 use crate::discrepancy::discover::{DiscoverySettings, discover};
 use crate::discrepancy::report::DiscoveryReport;
@@ -14,6 +13,7 @@ use crate::estimation::NoProgress;
 use crate::planning::Dof;
 use crate::planning::examples::surveyor_rov;
 use crate::rng::{SplitMix64, mix};
+use crate::simulation::rov::{Current, RovTruth};
 use crate::validation::nrmse_fit;
 
 /// A concealed effect.
@@ -43,8 +43,10 @@ impl Concealed {
 
     /// Puts the effect into `t` with a DOF and magnitude drawn from `rng`;
     /// returns the affected DOFs (empty: several, any is right).
-    fn apply(self, t: &mut Truth, rng: &mut SplitMix64, avoid: Option<Dof>) -> Vec<Dof> {
+    fn apply(self, t: &mut RovTruth, rng: &mut SplitMix64, avoid: Option<Dof>) -> Vec<Dof> {
         let p = surveyor_rov();
+        let reach = reach(&p, &clean_truth());
+        let d_lin = t.damping.at(0.0);
         let mut pick = |set: &[Dof]| loop {
             let d = set[(rng.uniform() * set.len() as f64) as usize % set.len()];
             if Some(d) != avoid {
@@ -57,7 +59,7 @@ impl Concealed {
                 let i = d.index();
                 // |ν|ν force equal to 40–80 % of the linear one at 0.4 of the velocity limit.
                 let v = 0.4 * p.limit(d).max_velocity;
-                t.quad[i] = rng.uniform_in(0.4, 0.8) * t.d[i] / v;
+                t.quadratic_damping[i] = rng.uniform_in(0.4, 0.8) * d_lin[(i, i)] / v;
                 vec![d]
             }
             Concealed::Coriolis => {
@@ -65,38 +67,42 @@ impl Concealed {
                 vec![]
             }
             Concealed::Tether => {
-                let d = pick(&[Dof::Pitch, Dof::Yaw]);
+                // A pitch moment (the thesis's τ_θ) or a body force in sway
+                // or heave, 10–30 % of the campaign's reach.
+                let d = pick(&[Dof::Pitch, Dof::Sway, Dof::Heave]);
                 let sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-                t.constant[d.index()] = sign * rng.uniform_in(0.05, 0.15) * p.limit(d).max_force;
+                let load = sign * rng.uniform_in(0.1, 0.3) * reach[d.index()];
+                match d {
+                    Dof::Pitch => t.tether.pitch_moment = load,
+                    _ => t.tether.body_force[d.index()] = load,
+                }
                 vec![d]
             }
             Concealed::Current => {
                 let speed = rng.uniform_in(0.1, 0.25);
                 let dir = rng.uniform_in(0.0, std::f64::consts::TAU);
-                t.current = Some([speed * dir.cos(), speed * dir.sin()]);
+                t.current = Current::Constant {
+                    ned: [speed * dir.cos(), speed * dir.sin(), 0.0],
+                };
                 vec![Dof::Surge, Dof::Sway]
             }
             Concealed::Lag => {
                 let d = pick(&Dof::ALL);
-                t.lag[d.index()] = Some(rng.uniform_in(0.3, 1.0));
+                t.actuators.time_constants[d.index()] = rng.uniform_in(0.3, 1.0);
                 vec![d]
             }
             Concealed::Delay => {
-                let d = pick(&Dof::ALL);
-                t.delay[d.index()] = 2 + (rng.uniform() * 5.0) as usize;
-                vec![d]
+                // The simulator delays every DOF's command alike (a
+                // transport delay of the command link).
+                t.actuators.delay_samples = 2 + (rng.uniform() * 5.0) as usize;
+                vec![]
             }
             Concealed::Saturation => {
                 let d = pick(&Dof::ALL);
-                // Clip at 60–80 % of the largest command of the campaign
-                // (`truth::commands`), so the effect is material.
-                let reach = match d {
-                    Dof::Surge => 0.9,
-                    Dof::Yaw => 0.47,
-                    _ => 0.45,
-                };
-                t.saturation[d.index()] =
-                    Some(rng.uniform_in(0.6, 0.8) * reach * p.limit(d).max_force);
+                // Clip at 60–80 % of the largest command of the campaign,
+                // so the effect is material.
+                t.actuators.saturation[d.index()] =
+                    rng.uniform_in(0.6, 0.8) * command_share(d) * reach[d.index()];
                 vec![d]
             }
         }
@@ -116,7 +122,7 @@ pub struct Outcome {
 /// by the same recorded η, so only the concealed physics counts.
 pub fn run_case(effects: &[Concealed], seed: u64) -> Outcome {
     let mut rng = SplitMix64::new(mix(seed ^ 0xD15C));
-    let mut t = Truth::from_profile(&surveyor_rov());
+    let mut t = clean_truth();
     let mut expected = Vec::new();
     let mut used: Option<Dof> = None;
     for &e in effects {
