@@ -66,6 +66,7 @@ pub mod experiment;
 pub mod fit;
 pub mod locate;
 pub mod model;
+pub mod proof;
 pub mod report;
 pub mod residual;
 pub mod select;

@@ -2,9 +2,8 @@
 //! without them, discovery run on the result.
 
 mod proof;
-mod scenario;
 
-use scenario::{clean_truth, restoring_of, scenario};
+use crate::discrepancy::proof::scenario::{clean_truth, restoring_of, scenario};
 
 use crate::discrepancy::candidates::Effect;
 use crate::discrepancy::fit::{Prepared, Spec};
