@@ -20,7 +20,7 @@ use crate::estimation::NoProgress;
 use crate::planning::Dof;
 use crate::planning::examples::surveyor_rov;
 use crate::rng::{SplitMix64, mix};
-use crate::simulation::rov::{Current, RovTruth};
+use crate::simulation::rov::{Current, RandomWalkCurrent, RovTruth};
 use crate::validation::nrmse_fit;
 use scenario::{Scenario, clean_truth, command_share, reach, scenario, true_model};
 
@@ -41,6 +41,9 @@ pub enum Concealed {
     Delay,
     /// Thrust saturation in one DOF.
     Saturation,
+    /// A current that wanders as a random walk (not in [`cases`]: the
+    /// library fits a constant current; see [`extra_cases`]).
+    RandomWalkCurrent,
 }
 
 /// What was concealed: its family, the DOFs where naming it is right
@@ -63,7 +66,7 @@ impl Concealed {
             Concealed::QuadraticDamping => Family::QuadraticDamping,
             Concealed::Coriolis => Family::Coriolis,
             Concealed::Tether => Family::ConstantLoad,
-            Concealed::Current => Family::Current,
+            Concealed::Current | Concealed::RandomWalkCurrent => Family::Current,
             Concealed::Lag => Family::ActuatorLag,
             Concealed::Delay => Family::InputDelay,
             Concealed::Saturation => Family::Saturation,
@@ -121,6 +124,20 @@ impl Concealed {
                     ned: [speed * dir.cos(), speed * dir.sin(), 0.0],
                 };
                 expected(vec![Dof::Surge, Dof::Sway], "|V_c| (m/s)", speed)
+            }
+            Concealed::RandomWalkCurrent => {
+                let speed = rng.uniform_in(0.1, 0.25);
+                let dir = rng.uniform_in(0.0, std::f64::consts::TAU);
+                // σ = 0.01 m/s per √s: the current drifts ≈ 0.1 m/s per
+                // 120 s run in each horizontal axis.
+                t.current = Current::RandomWalk(RandomWalkCurrent {
+                    initial_ned: [speed * dir.cos(), speed * dir.sin(), 0.0],
+                    sigma: [0.01, 0.01, 0.0],
+                    mu: 0.0,
+                    max_speed: 0.5,
+                    seed: mix(rng.uniform().to_bits()),
+                });
+                expected(vec![Dof::Surge, Dof::Sway], "|V_c(0)| (m/s)", speed)
             }
             Concealed::Lag => {
                 let d = pick(&Dof::ALL);
@@ -329,6 +346,13 @@ pub fn cases() -> Vec<(&'static str, Vec<Concealed>)> {
         ("tether + delay", vec![Tether, Delay]),
         ("current + saturation", vec![Current, Saturation]),
     ]
+}
+
+/// Cases beyond the proof, reported as they come out: a random-walk
+/// current, which the library can only fit as a constant (the gap is taken
+/// against the truth with the current frozen at its initial value).
+pub fn extra_cases() -> Vec<(&'static str, Vec<Concealed>)> {
+    vec![("random-walk current", vec![Concealed::RandomWalkCurrent])]
 }
 
 /// Every case of `cases` at every seed.

@@ -224,8 +224,13 @@ pub fn scenario(
         } else {
             format!("val{}", r - n_est)
         };
+        // A wandering current takes its own path in every run.
+        let mut flown = truth.clone();
+        if let Current::RandomWalk(rw) = &mut flown.current {
+            rw.seed = mix(rw.seed ^ r as u64);
+        }
         let rec = fly(
-            &truth,
+            &flown,
             &name,
             &tau,
             0.7 * r as f64,
@@ -302,8 +307,15 @@ pub fn true_model(t: &RovTruth) -> AugmentedModel {
     if t.coriolis {
         terms.push(term(Effect::CoriolisFromM, vec![1.0], None));
     }
-    if let Current::Constant { ned } = t.current {
-        terms.push(term(Effect::Current, vec![ned[0], ned[1]], None));
+    // A random walk has no constant form: frozen at its initial value.
+    match t.current {
+        Current::Constant { ned } => terms.push(term(Effect::Current, vec![ned[0], ned[1]], None)),
+        Current::RandomWalk(rw) => terms.push(term(
+            Effect::Current,
+            vec![rw.initial_ned[0], rw.initial_ned[1]],
+            None,
+        )),
+        Current::None => {}
     }
     AugmentedModel::new(
         Dof::ALL.to_vec(),
