@@ -178,24 +178,11 @@ pub fn identify_baseline(p: &VesselProfile, restoring: Restoring, runs: &[Record
             gamma: &r.tau - g_of(r),
         })
         .collect();
-    let d0 = DVector::from_iterator(
-        6,
-        Dof::ALL
-            .iter()
-            .map(|&d| p.limit(d).max_force / p.limit(d).max_velocity),
-    );
-    let m0 = DVector::from_iterator(
-        6,
-        Dof::ALL
-            .iter()
-            .zip(d0.iter())
-            .map(|(&d, di)| p.limit(d).time_constant_s * di),
-    );
     let settings = LambdaSettings::new(
         Dof::ALL.to_vec(),
         1.0,
         Structure::Coupled(CouplingMask::full(6)),
-        Prior::weak(DMatrix::from_diagonal(&m0), DMatrix::from_diagonal(&d0)),
+        Prior::from_profile(p, &Dof::ALL),
     );
     let est = identify(&exps, &settings).expect("λ identification");
     let model = LinearVesselModel::new(Dof::ALL.to_vec(), est.m, est.d_bar).expect("model");
