@@ -81,6 +81,9 @@ pub enum Effect {
         /// The DOF.
         dof: Dof,
     },
+    /// One pure delay of d whole samples on every DOF's command: a
+    /// transport delay of the command link or the logger's time stamps.
+    CommonInputDelay,
     /// Thrust saturation τ_a = clip(τ_c, ±τ_max).
     Saturation {
         /// The DOF.
@@ -182,7 +185,7 @@ impl Effect {
             Effect::Current => Family::Current,
             Effect::Coupling { .. } => Family::Coupling,
             Effect::ActuatorLag { .. } => Family::ActuatorLag,
-            Effect::InputDelay { .. } => Family::InputDelay,
+            Effect::InputDelay { .. } | Effect::CommonInputDelay => Family::InputDelay,
             Effect::Saturation { .. } => Family::Saturation,
             Effect::DeadZone { .. } => Family::DeadZone,
         }
@@ -200,7 +203,7 @@ impl Effect {
             | Effect::InputDelay { dof }
             | Effect::Saturation { dof }
             | Effect::DeadZone { dof } => Some(dof),
-            Effect::CoriolisFromM | Effect::Current => None,
+            Effect::CoriolisFromM | Effect::Current | Effect::CommonInputDelay => None,
         }
     }
 
@@ -208,11 +211,17 @@ impl Effect {
     pub fn shape(&self) -> Option<ShapeKind> {
         match self {
             Effect::ActuatorLag { .. } => Some(ShapeKind::LagTime),
-            Effect::InputDelay { .. } => Some(ShapeKind::DelaySamples),
+            Effect::InputDelay { .. } | Effect::CommonInputDelay => Some(ShapeKind::DelaySamples),
             Effect::Saturation { .. } => Some(ShapeKind::SaturationLevel),
             Effect::DeadZone { .. } => Some(ShapeKind::DeadZoneWidth),
             _ => None,
         }
+    }
+
+    /// It changes the force acting in `dof` (actuator effects).
+    pub fn acts_on(&self, dof: Dof) -> bool {
+        self.shape().is_some()
+            && (self.dof() == Some(dof) || matches!(self, Effect::CommonInputDelay))
     }
 
     /// Number of coefficients that enter linearly.
@@ -301,6 +310,7 @@ impl Effect {
             }
             Effect::ActuatorLag { dof } => format!("actuator lag in {}", dof.name()),
             Effect::InputDelay { dof } => format!("input delay in {}", dof.name()),
+            Effect::CommonInputDelay => "input delay in every DOF (command link)".into(),
             Effect::Saturation { dof } => format!("thrust saturation in {}", dof.name()),
             Effect::DeadZone { dof } => format!("thrust dead zone in {}", dof.name()),
         }
@@ -310,7 +320,7 @@ impl Effect {
     pub fn rows(&self, dofs: &[Dof], d_ref: &DMatrix<f64>) -> Vec<usize> {
         let idx = |d: Dof| dofs.iter().position(|&x| x == d);
         match *self {
-            Effect::CoriolisFromM => (0..dofs.len()).collect(),
+            Effect::CoriolisFromM | Effect::CommonInputDelay => (0..dofs.len()).collect(),
             Effect::Current => match (idx(Dof::Surge), idx(Dof::Sway)) {
                 (Some(iu), Some(iv)) => (0..dofs.len())
                     .filter(|&i| d_ref[(i, iu)] != 0.0 || d_ref[(i, iv)] != 0.0)
@@ -515,6 +525,9 @@ pub fn library(
         if s.dead_zone {
             out.push(Effect::DeadZone { dof });
         }
+    }
+    if s.input_delay && dofs.len() > 1 {
+        out.push(Effect::CommonInputDelay);
     }
     if s.coriolis && dofs.len() > 1 {
         out.push(Effect::CoriolisFromM);

@@ -5,6 +5,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::error::DiscoveryError;
+use crate::models::LinearVesselModel;
 use crate::planning::Dof;
 
 /// Restoring forces and moments g(η) of the baseline (thesis eq. 1.6):
@@ -52,6 +53,18 @@ pub struct Baseline {
 }
 
 impl Baseline {
+    /// The baseline of an identified linear model (e.g. from
+    /// `estimation::lambda::identify`) with the restoring g(η) its γ was
+    /// formed with.
+    pub fn from_model(model: &LinearVesselModel, restoring: Restoring) -> Self {
+        Baseline {
+            dofs: model.dofs().to_vec(),
+            m: model.m().clone(),
+            d_bar: model.d_bar().clone(),
+            restoring,
+        }
+    }
+
     /// Number of modeled DOFs.
     pub fn n(&self) -> usize {
         self.dofs.len()
@@ -113,6 +126,14 @@ impl Baseline {
             ));
         }
         Ok(())
+    }
+}
+
+/// A linear model without restoring (g(η) = 0: a surface vessel, or γ = τ);
+/// see [`Baseline::from_model`] for one with g(η).
+impl From<&LinearVesselModel> for Baseline {
+    fn from(model: &LinearVesselModel) -> Self {
+        Baseline::from_model(model, Restoring::default())
     }
 }
 

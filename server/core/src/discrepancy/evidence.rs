@@ -104,6 +104,14 @@ pub(crate) fn effect_text(t: &ModelTerm, h: f64) -> String {
                 sig(d * h)
             )
         }
+        Effect::CommonInputDelay => {
+            let d = t.shape.unwrap_or(0.0);
+            format!(
+                "Thrust in every DOF acts {:.0} samples ({} s) after the command: a delay of the command link or of the log's time stamps.",
+                d,
+                sig(d * h)
+            )
+        }
         Effect::Saturation { dof } => format!(
             "Thrust in {} saturates at ±{} {}.",
             dof.name(),

@@ -272,7 +272,7 @@ impl<'a> Prepared<'a> {
                 let dof = dofs[r];
                 // Target [λτ_a] − [λg]: the applied force depends on the
                 // actuator hypotheses of this DOF.
-                let lam_tau_a = if shapes.iter().any(|(e, _)| e.dof() == Some(dof)) {
+                let lam_tau_a = if shapes.iter().any(|(e, _)| e.acts_on(dof)) {
                     let (x, lag) = actuate(rec.tau.column(r).as_slice(), dof, &shapes);
                     match lag {
                         Some(t) => self.svf.foh(&lag_zoh(&x, t, rec.h)),
@@ -480,6 +480,34 @@ impl<'a> Prepared<'a> {
 }
 
 impl Prepared<'_> {
+    /// [`Self::kstep_row`] over several rows: each row's errors scaled by
+    /// its equation weight times M_rr (velocity error → normalized force),
+    /// so DOFs in different units add up.
+    pub fn kstep_rows(
+        &self,
+        specs: &[Spec],
+        f: &FitOut,
+        rows: &[usize],
+        runs: &[usize],
+        k: usize,
+    ) -> Option<(f64, Vec<Vec<f64>>)> {
+        if let [r] = rows {
+            return self.kstep_row(specs, f, *r, runs, k);
+        }
+        let mut sse = 0.0;
+        let mut resid = Vec::new();
+        for &r in rows {
+            let (s, e) = self.kstep_row(specs, f, r, runs, k)?;
+            let w = self.weights[r] * self.baseline.m[(r, r)].abs();
+            sse += w * w * s;
+            resid.extend(
+                e.into_iter()
+                    .map(|v| v.into_iter().map(|x| w * x).collect::<Vec<_>>()),
+            );
+        }
+        Some((sse, resid))
+    }
+
     /// Output error of one row: the k-step-ahead prediction of ν_r from
     /// the measured ν_r(t−k), the other velocities and η taken as measured
     /// (linear between samples), under the fitted row of `f`. Returns the
@@ -701,7 +729,7 @@ pub(crate) fn profile(
     continuous: bool,
     k: usize,
 ) -> Option<Profile> {
-    let row = *extra.first()?;
+    extra.first()?;
     let specs_at = |v: f64| {
         let mut specs = chosen.to_vec();
         specs.push(Spec {
@@ -713,7 +741,7 @@ pub(crate) fn profile(
     let eval = |v: f64| -> Option<FitOut> { prep.fit(&specs_at(v), extra, runs, false) };
     let sse = |v: f64| {
         eval(v)
-            .and_then(|f| prep.kstep_row(&specs_at(v), &f, row, runs, k))
+            .and_then(|f| prep.kstep_rows(&specs_at(v), &f, extra, runs, k))
             .map_or(f64::INFINITY, |x| x.0)
     };
     let values: Vec<f64> = grid.iter().map(|&g| sse(g)).collect();
@@ -752,7 +780,7 @@ pub(crate) fn profile(
         }
     }
     let fit = eval(best)?;
-    let (s0, resid) = prep.kstep_row(&specs_at(best), &fit, row, runs, k)?;
+    let (s0, resid) = prep.kstep_rows(&specs_at(best), &fit, extra, runs, k)?;
     let delta = if continuous {
         0.03 * best.abs().max(1e-9)
     } else {

@@ -61,7 +61,7 @@ pub(crate) struct AppliedInput {
 pub(crate) fn actuate(tau: &[f64], dof: Dof, shapes: &[(Effect, f64)]) -> (Vec<f64>, Option<f64>) {
     let mut x = tau.to_vec();
     let mut lag = None;
-    let mine = shapes.iter().filter(|(e, _)| e.dof() == Some(dof));
+    let mine = shapes.iter().filter(|(e, _)| e.acts_on(dof));
     let mut delay = None;
     let mut sat = None;
     let mut dz = None;

@@ -6,6 +6,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::spectra::{WelchConfig, welch};
+use crate::validation::correlation::autocorrelation;
+use crate::validation::residuals::zero_crossings;
 
 /// Whiteness of one residual channel (pooled over runs).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -29,43 +31,40 @@ pub struct Whiteness {
     pub white: bool,
 }
 
-/// Whiteness of residual runs `e` (NaN samples are dropped within a run).
+/// Whiteness of residual runs `e` (NaN samples are dropped within a run),
+/// pooled over runs: each run's autocorrelation and zero crossings come from
+/// [`crate::validation::correlation::autocorrelation`] and
+/// [`crate::validation::residuals::zero_crossings`] about the run's own
+/// mean; ρ(l) is their energy-weighted mean.
 pub fn whiteness(runs: &[Vec<f64>], lags: usize) -> Whiteness {
     let runs: Vec<Vec<f64>> = runs
         .iter()
         .map(|e| e.iter().copied().filter(|x| x.is_finite()).collect())
         .collect();
     let n: usize = runs.iter().map(Vec::len).sum();
-    let mean = runs.iter().flatten().sum::<f64>() / n.max(1) as f64;
-    let c: Vec<Vec<f64>> = runs
-        .iter()
-        .map(|e| e.iter().map(|x| x - mean).collect())
-        .collect();
-    let r0: f64 = c.iter().flatten().map(|x| x * x).sum();
-    let bound = 2.576 / (n.max(1) as f64).sqrt();
-    let mut outside = 0;
-    let mut max_abs: f64 = 0.0;
-    for l in 1..=lags {
-        let rl: f64 = c
-            .iter()
-            .filter(|e| e.len() > l)
-            .map(|e| e[l..].iter().zip(e).map(|(a, b)| a * b).sum::<f64>())
-            .sum();
-        let rho = if r0 > 0.0 { rl / r0 } else { 0.0 };
-        max_abs = max_abs.max(rho.abs());
-        if rho.abs() > bound {
-            outside += 1;
+    let mut num = vec![0.0; lags + 1];
+    let mut energy = 0.0;
+    let (mut zc, mut pairs) = (0, 0.0);
+    for e in &runs {
+        let mean = e.iter().sum::<f64>() / e.len().max(1) as f64;
+        let c: Vec<f64> = e.iter().map(|x| x - mean).collect();
+        if let Some(r) = autocorrelation(&c, lags) {
+            let r0: f64 = c.iter().map(|x| x * x).sum();
+            num.iter_mut().zip(&r).for_each(|(a, b)| *a += r0 * b);
+            energy += r0;
         }
+        let z = zero_crossings(&c);
+        zc += z.count;
+        pairs += 2.0 * z.expected;
     }
-    let zc: usize = runs
+    let rho: Vec<f64> = num
         .iter()
-        .map(|e| {
-            e.windows(2)
-                .filter(|w| (w[0] - mean) * (w[1] - mean) < 0.0)
-                .count()
-        })
-        .sum();
-    let m = n.saturating_sub(runs.len()).max(1) as f64;
+        .map(|x| if energy > 0.0 { x / energy } else { 0.0 })
+        .collect();
+    let bound = 2.576 / (n.max(1) as f64).sqrt();
+    let outside = rho.iter().skip(1).filter(|r| r.abs() > bound).count();
+    let max_abs = rho.iter().skip(1).fold(0.0_f64, |m, r| m.max(r.abs()));
+    let m = pairs.max(1.0);
     let expected = [
         m / 2.0 - 2.576 * m.sqrt() / 2.0,
         m / 2.0 + 2.576 * m.sqrt() / 2.0,

@@ -110,7 +110,7 @@ pub(crate) fn score(
         let k = c.k_step.min(4);
         let p = profile(prep, chosen, effect, &rows, runs, &grid, continuous, k)?;
         // Output-error statistics against the chosen terms alone.
-        let (s0, r0) = prep.kstep_row(chosen, &null, rows[0], runs, k)?;
+        let (s0, r0) = prep.kstep_rows(chosen, &null, &rows, runs, k)?;
         let kappa = super::fit::long_run_inflation(&r0, prep.hac_lags.max(2 * k));
         let n_eff = (p.n as f64 / kappa).max(2.0);
         let lr = n_eff * (s0 / p.sse.max(f64::MIN_POSITIVE)).ln();
@@ -250,7 +250,9 @@ pub(crate) fn step(
 fn conflicts(e: &Effect, taken: &[Effect]) -> bool {
     taken.iter().any(|t| match (t, e) {
         (Effect::CoriolisFromM, Effect::CoriolisProduct { .. })
-        | (Effect::CoriolisProduct { .. }, Effect::CoriolisFromM) => true,
+        | (Effect::CoriolisProduct { .. }, Effect::CoriolisFromM)
+        | (Effect::CommonInputDelay, Effect::InputDelay { .. })
+        | (Effect::InputDelay { .. }, Effect::CommonInputDelay) => true,
         _ => t.shape().is_some() && e.shape() == t.shape() && t.dof() == e.dof(),
     })
 }

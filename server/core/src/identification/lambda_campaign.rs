@@ -390,23 +390,12 @@ pub fn identify_lambda_campaign(
     };
 
     // Weak rigid-body prior from the profile: D ≈ F_max/v_max, M ≈ T·D.
-    let d0 = DMatrix::from_fn(n, n, |i, j| {
-        if i == j {
-            let l = profile.limit(dofs[i]);
-            l.max_force / l.max_velocity
-        } else {
-            0.0
-        }
-    });
-    let m0 = DMatrix::from_fn(n, n, |i, j| {
-        if i == j {
-            profile.limit(dofs[i]).time_constant_s * d0[(i, i)]
-        } else {
-            0.0
-        }
-    });
-    let lambda_settings =
-        LambdaSettings::new(dofs.clone(), t_lambda, structure, Prior::weak(m0, d0));
+    let lambda_settings = LambdaSettings::new(
+        dofs.clone(),
+        t_lambda,
+        structure,
+        Prior::from_profile(profile, &dofs),
+    );
     let points: Vec<(f64, Vec<Experiment>)> = grid
         .iter()
         .zip(per_point)

@@ -1,261 +1,59 @@
-//! The acceptance proof: one effect (or two) concealed from the baseline,
-//! drawn DOF and magnitude from seeded ranges; discovery must name the
-//! right effect first, name nothing on a clean vessel, and close ≥ 80 % of
-//! the validation free-run NRMSE gap between baseline and truth.
+//! The acceptance proof ([`crate::discrepancy::proof`]), one test per case
+//! so the cases run in parallel; more seeds behind `#[ignore]`.
 
-use std::time::Instant;
+use crate::discrepancy::proof::{cases, format_table, proof_row, proof_table};
 
-use super::scenario::{Scenario, scenario, true_model};
-use super::truth::Truth;
-use crate::discrepancy::candidates::Family;
-use crate::discrepancy::discover::{DiscoverySettings, discover};
-use crate::discrepancy::report::DiscoveryReport;
-use crate::estimation::NoProgress;
-use crate::planning::Dof;
-use crate::planning::examples::surveyor_rov;
-use crate::rng::{SplitMix64, mix};
-use crate::validation::nrmse_fit;
+/// Seed of the default suite.
+const SEED: u64 = 11;
 
-/// A concealed effect.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Concealed {
-    QuadraticDamping,
-    Coriolis,
-    Tether,
-    Current,
-    Lag,
-    Delay,
-    Saturation,
+fn check(name: &str) {
+    let (name, effects) = cases()
+        .into_iter()
+        .find(|(n, _)| *n == name)
+        .expect("a listed case");
+    let row = proof_row(name, &effects, SEED);
+    eprint!("{}", format_table(std::slice::from_ref(&row)));
+    assert!(row.verdict.is_ok(), "{name}: {:?}", row.verdict);
 }
 
-impl Concealed {
-    fn family(self) -> Family {
-        match self {
-            Concealed::QuadraticDamping => Family::QuadraticDamping,
-            Concealed::Coriolis => Family::Coriolis,
-            Concealed::Tether => Family::ConstantLoad,
-            Concealed::Current => Family::Current,
-            Concealed::Lag => Family::ActuatorLag,
-            Concealed::Delay => Family::InputDelay,
-            Concealed::Saturation => Family::Saturation,
-        }
-    }
-
-    /// Puts the effect into `t` with a DOF and magnitude drawn from `rng`;
-    /// returns the affected DOFs (empty: several, any is right).
-    fn apply(self, t: &mut Truth, rng: &mut SplitMix64, avoid: Option<Dof>) -> Vec<Dof> {
-        let p = surveyor_rov();
-        let mut pick = |set: &[Dof]| loop {
-            let d = set[(rng.uniform() * set.len() as f64) as usize % set.len()];
-            if Some(d) != avoid {
-                return d;
+macro_rules! proof_cases {
+    ($($test:ident => $name:literal,)*) => {
+        $(
+            #[test]
+            fn $test() {
+                check($name);
             }
-        };
-        match self {
-            Concealed::QuadraticDamping => {
-                let d = pick(&[Dof::Surge, Dof::Sway, Dof::Heave, Dof::Yaw]);
-                let i = d.index();
-                // |ν|ν force equal to 40–80 % of the linear one at 0.4 of the velocity limit.
-                let v = 0.4 * p.limit(d).max_velocity;
-                t.quad[i] = rng.uniform_in(0.4, 0.8) * t.d[i] / v;
-                vec![d]
-            }
-            Concealed::Coriolis => {
-                t.coriolis = true;
-                vec![]
-            }
-            Concealed::Tether => {
-                let d = pick(&[Dof::Pitch, Dof::Yaw]);
-                let sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-                t.constant[d.index()] = sign * rng.uniform_in(0.05, 0.15) * p.limit(d).max_force;
-                vec![d]
-            }
-            Concealed::Current => {
-                let speed = rng.uniform_in(0.1, 0.25);
-                let dir = rng.uniform_in(0.0, std::f64::consts::TAU);
-                t.current = Some([speed * dir.cos(), speed * dir.sin()]);
-                vec![Dof::Surge, Dof::Sway]
-            }
-            Concealed::Lag => {
-                let d = pick(&Dof::ALL);
-                t.lag[d.index()] = Some(rng.uniform_in(0.3, 1.0));
-                vec![d]
-            }
-            Concealed::Delay => {
-                let d = pick(&Dof::ALL);
-                t.delay[d.index()] = 2 + (rng.uniform() * 5.0) as usize;
-                vec![d]
-            }
-            Concealed::Saturation => {
-                let d = pick(&Dof::ALL);
-                // Clip at 60–80 % of the largest command of the campaign
-                // (`truth::commands`), so the effect is material.
-                let reach = match d {
-                    Dof::Surge => 0.9,
-                    Dof::Yaw => 0.47,
-                    _ => 0.45,
-                };
-                t.saturation[d.index()] =
-                    Some(rng.uniform_in(0.6, 0.8) * reach * p.limit(d).max_force);
-                vec![d]
-            }
-        }
-    }
-}
-
-/// Outcome of one case.
-pub struct Outcome {
-    pub report: DiscoveryReport,
-    pub expected: Vec<(Family, Vec<Dof>)>,
-    pub gap_closed: Option<f64>,
-    pub seconds: f64,
-}
-
-/// Runs discovery on a truth with `effects` concealed (seeded draws). The
-/// gap is measured against the truth written in the model's form, driven
-/// by the same recorded η, so only the concealed physics counts.
-pub fn run_case(effects: &[Concealed], seed: u64) -> Outcome {
-    let mut rng = SplitMix64::new(mix(seed ^ 0xD15C));
-    let mut t = Truth::from_profile(&surveyor_rov());
-    let mut expected = Vec::new();
-    let mut used: Option<Dof> = None;
-    for &e in effects {
-        let dofs = e.apply(&mut t, &mut rng, used);
-        used = dofs.first().copied();
-        expected.push((e.family(), dofs));
-    }
-    let s: Scenario = scenario(t, seed, 3, 1, 120.0);
-    let settings = DiscoverySettings {
-        vessel: Some(s.profile.clone()),
-        ..DiscoverySettings::default()
+        )*
     };
-    let t0 = Instant::now();
-    let report =
-        discover(&s.baseline, &s.est, &s.val, &settings, &mut NoProgress).expect("discovery runs");
-    let seconds = t0.elapsed().as_secs_f64();
-    // Gap on the channels the truth's free run fits clearly better.
-    let val = &s.val[0];
-    let truth_sim = true_model(&s.truth).simulate(val);
-    let (mut closed, mut gap) = (0.0, 0.0);
-    for (i, c) in report.validation.iter().enumerate() {
-        let t_fit = nrmse_fit(val.nu.column(i).as_slice(), truth_sim.column(i).as_slice());
-        if let (Some(b), Some(a), Some(tf)) = (c.before.free_run, c.after.free_run, t_fit)
-            && tf - b > 0.02
-        {
-            gap += tf - b;
-            closed += a - b;
-        }
-    }
-    Outcome {
-        report,
-        expected,
-        gap_closed: (gap > 0.0).then(|| closed / gap),
-        seconds,
-    }
 }
 
-/// The check of one outcome; Err names what failed.
-pub fn judge(o: &Outcome) -> Result<(), String> {
-    let f = &o.report.findings;
-    if o.expected.is_empty() {
-        if !f.is_empty() {
-            return Err(format!(
-                "clean case named {:?}",
-                f.iter().map(|x| &x.label).collect::<Vec<_>>()
-            ));
-        }
-        return Ok(());
-    }
-    // Each concealed effect must be named, and the first finding must be one of them.
-    let matches = |fi: &crate::discrepancy::report::Finding, (fam, dofs): &(Family, Vec<Dof>)| {
-        fi.effect.family() == *fam && (dofs.is_empty() || fi.dofs.iter().any(|d| dofs.contains(d)))
-    };
-    let first = f.first().ok_or("nothing named")?;
-    if !o.expected.iter().any(|e| matches(first, e)) {
-        return Err(format!(
-            "first named {} (expected {:?})",
-            first.label, o.expected
-        ));
-    }
-    for e in &o.expected {
-        if !f.iter().any(|fi| matches(fi, e)) {
-            return Err(format!(
-                "{e:?} not named; named {:?}",
-                f.iter().map(|x| &x.label).collect::<Vec<_>>()
-            ));
-        }
-    }
-    match o.gap_closed {
-        Some(g) if g < 0.8 => Err(format!("closed only {:.0} % of the gap", 100.0 * g)),
-        _ => Ok(()),
-    }
-}
-
-fn table(cases: &[(&str, Vec<Concealed>)], seeds: &[u64]) {
-    let mut failures = Vec::new();
-    eprintln!(
-        "{:<22} {:>5}  {:<48} {:>8} {:>7}",
-        "case", "seed", "named first (DOFs)", "gap", "time s"
-    );
-    for (name, effects) in cases {
-        for &seed in seeds {
-            let o = run_case(effects, seed);
-            let first = o.report.findings.first().map_or("—".to_string(), |f| {
-                format!(
-                    "{} ({})",
-                    f.label,
-                    f.dofs
-                        .iter()
-                        .map(|d| d.name())
-                        .collect::<Vec<_>>()
-                        .join(",")
-                )
-            });
-            eprintln!(
-                "{:<22} {:>5}  {:<48} {:>8} {:>7.2}",
-                name,
-                seed,
-                first,
-                o.gap_closed
-                    .map_or("–".into(), |g| format!("{:.0} %", 100.0 * g)),
-                o.seconds
-            );
-            if let Err(e) = judge(&o) {
-                eprintln!("    FAIL: {e}");
-                for s in &o.report.summary {
-                    eprintln!("      {s}");
-                }
-                failures.push(format!("{name} seed {seed}: {e}"));
-            }
-        }
-    }
-    assert!(failures.is_empty(), "{failures:#?}");
-}
-
-fn cases() -> Vec<(&'static str, Vec<Concealed>)> {
-    use Concealed::*;
-    vec![
-        ("clean", vec![]),
-        ("quadratic damping", vec![QuadraticDamping]),
-        ("Coriolis", vec![Coriolis]),
-        ("tether moment", vec![Tether]),
-        ("current", vec![Current]),
-        ("actuator lag", vec![Lag]),
-        ("input delay", vec![Delay]),
-        ("saturation", vec![Saturation]),
-        ("quad + lag", vec![QuadraticDamping, Lag]),
-        ("tether + delay", vec![Tether, Delay]),
-        ("current + saturation", vec![Current, Saturation]),
-    ]
-}
-
-#[test]
-fn proof_table_one_seed() {
-    table(&cases(), &[11]);
+proof_cases! {
+    proof_clean => "clean",
+    proof_quadratic_damping => "quadratic damping",
+    proof_coriolis => "Coriolis",
+    proof_tether => "tether",
+    proof_current => "current",
+    proof_actuator_lag => "actuator lag",
+    proof_input_delay => "input delay",
+    proof_saturation => "saturation",
+    proof_quad_and_lag => "quad + lag",
+    proof_tether_and_delay => "tether + delay",
+    proof_current_and_saturation => "current + saturation",
 }
 
 #[test]
 #[ignore]
 fn proof_table_more_seeds() {
-    table(&cases(), &[12, 13, 14, 15]);
+    let rows = proof_table(&cases(), &[12, 13, 14, 15]);
+    eprint!("{}", format_table(&rows));
+    let failures: Vec<String> = rows
+        .iter()
+        .filter_map(|r| {
+            r.verdict
+                .as_ref()
+                .err()
+                .map(|e| format!("{} seed {}: {e}", r.case, r.seed))
+        })
+        .collect();
+    assert!(failures.is_empty(), "{failures:#?}");
 }

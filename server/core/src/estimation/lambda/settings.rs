@@ -36,6 +36,22 @@ pub struct Prior {
 }
 
 impl Prior {
+    /// The weak rigid-body prior a vessel profile gives (diagonal):
+    /// D̄₀,ii = F_max/v_max, M₀,ii = T·D̄₀,ii per DOF of `dofs`.
+    pub fn from_profile(profile: &crate::planning::VesselProfile, dofs: &[Dof]) -> Self {
+        let d0: Vec<f64> = dofs
+            .iter()
+            .map(|&d| profile.limit(d).max_force / profile.limit(d).max_velocity)
+            .collect();
+        let m0: Vec<f64> = dofs
+            .iter()
+            .zip(&d0)
+            .map(|(&d, di)| profile.limit(d).time_constant_s * di)
+            .collect();
+        let diag = |v: Vec<f64>| DMatrix::from_diagonal(&nalgebra::DVector::from_vec(v));
+        Prior::weak(diag(m0), diag(d0))
+    }
+
     /// A weakly informative prior around (M₀, D̄₀): both stds 1.
     pub fn weak(m0: DMatrix<f64>, d_bar0: DMatrix<f64>) -> Self {
         Prior {
