@@ -1,0 +1,227 @@
+//! Proof of the campaign entry point on the simulated supply vessel: the
+//! planned DP manoeuvres flown through the truth, logged as SI CSV, parsed
+//! like an upload, identified and validated.
+
+use super::*;
+use crate::estimation::NoProgress;
+use crate::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
+use crate::planning::examples::{supply_vessel, supply_vessel_trial_campaign};
+use crate::planning::generate_plan;
+use crate::simulation::dp_ship::{DpFlightSettings, DpShip, fly_dp_campaign, paper};
+
+/// The campaign flown with truth noise seed `seed`, as uploaded runs.
+pub(crate) fn flown_runs(plan_seed: u64, seed: u64) -> Vec<RunInput> {
+    let profile = supply_vessel();
+    let plan = generate_plan(&profile, &supply_vessel_trial_campaign(plan_seed)).unwrap();
+    let flown = fly_dp_campaign(
+        &profile,
+        &DpShip::supply_vessel(),
+        &plan,
+        &DpFlightSettings::supply_vessel(seed),
+        |_| true,
+    )
+    .unwrap();
+    flown
+        .iter()
+        .map(|f| {
+            let parsed = parse_log(
+                f.csv.as_bytes(),
+                &ParseOptions::for_vessel(&profile, LogRole::Single, None),
+            )
+            .unwrap();
+            let (record, _) = to_uniform(&parsed.table, None).unwrap();
+            RunInput {
+                run_id: f.code.clone(),
+                name: f.code.clone(),
+                family: Some(f.family),
+                grid_speed_mps: Some(0.0),
+                record,
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn supply_vessel_profile_carries_the_papers_m_and_t() {
+    let p = supply_vessel();
+    let prior = p.dp_prior.as_ref().unwrap();
+    assert_eq!(prior.length_m, paper::LENGTH_M);
+    for i in 0..3 {
+        assert_eq!(prior.inertia_bis[i].as_slice(), &paper::M_INERTIA[i]);
+    }
+    let InputChannels::Thrusters { configuration, .. } = &p.inputs else {
+        panic!("thrusters")
+    };
+    for i in 0..3 {
+        assert_eq!(configuration[i].as_slice(), &paper::T_CONFIG[i]);
+    }
+}
+
+#[test]
+fn campaign_identifies_the_supply_vessel_within_five_percent() {
+    let profile = supply_vessel();
+    let runs = flown_runs(1995, 2024);
+    let inputs = input_columns(&profile);
+    let start = std::time::Instant::now();
+    let out = identify_ekf_campaign(
+        &profile,
+        &inputs,
+        &runs,
+        &EkfCampaignSettings::default(),
+        &mut NoProgress,
+    )
+    .unwrap();
+    eprintln!("identified in {:.2} s", start.elapsed().as_secs_f64());
+    let doc = out.document.dp_ship.as_ref().unwrap();
+    let mut worst: f64 = 0.0;
+    for p in 0..N_THETA {
+        let err = doc.theta[p] / paper::THETA[p] - 1.0;
+        eprintln!(
+            "θ″{} {:>6} {:>10.6} ± {:.1e} truth {:>10.6} err {:>6.2} %",
+            p + 1,
+            THETA_NAMES[p],
+            doc.theta[p],
+            doc.theta_std[p],
+            paper::THETA[p],
+            100.0 * err
+        );
+        worst = worst.max(err.abs());
+    }
+    assert!(worst < 0.05, "worst θ″ error {:.2} %", 100.0 * worst);
+    assert_eq!(out.document.kind, ModelKind::DpShip);
+    assert!(
+        out.document.structure_findings.is_empty(),
+        "{:?}",
+        out.document.structure_findings
+    );
+    assert_eq!(out.document.parameters.len(), 9);
+    assert_eq!(out.estimation_run_ids.len(), 6);
+    assert_eq!(out.validation_run_ids, ["VAL-r1", "VAL-r2"]);
+    // Held-out validation in SI: k-step predictions of x, y, ψ fit.
+    let v = &out.validation[0].report;
+    for c in &v.channels {
+        eprintln!(
+            "{}: 1-step {:?} k-step {:?} sim {:?}",
+            c.output, c.fit_one_step, c.fit_k_step, c.fit_simulation
+        );
+        assert!(c.fit_k_step.unwrap() > 0.8, "{} k-step fit", c.output);
+    }
+    let json = serde_json::to_value(v).unwrap();
+    assert!(json.to_string().contains("\"psi\""));
+    // The stored document predicts again through the stored-model path.
+    let val = runs
+        .iter()
+        .find(|r| r.family == Some(ExperimentFamily::Validation))
+        .unwrap();
+    let pred = super::super::predictor::validate_on_run(&out.document, val, &[], 10).unwrap();
+    assert_eq!(
+        serde_json::to_value(&pred.channels).unwrap(),
+        serde_json::to_value(&v.channels).unwrap()
+    );
+    // SI A and B follow from the Bis ones.
+    let t = doc.time_unit_s;
+    assert!((doc.a_si[0][0] - doc.a[0][0] / t).abs() < 1e-12);
+}
+
+#[test]
+fn bad_settings_and_runs_name_the_field() {
+    let profile = supply_vessel();
+    let runs = flown_runs(1995, 5);
+    let inputs = input_columns(&profile);
+    let go = |s: &EkfCampaignSettings, runs: &[RunInput]| {
+        identify_ekf_campaign(&profile, &inputs, runs, s, &mut NoProgress).unwrap_err()
+    };
+    let s = EkfCampaignSettings {
+        theta_init: Some(vec![0.0; 4]),
+        ..Default::default()
+    };
+    assert_eq!(go(&s, &runs).field(), "settings.theta_init");
+    let s = EkfCampaignSettings {
+        position_noise_std_m: -1.0,
+        ..Default::default()
+    };
+    assert_eq!(go(&s, &runs).field(), "settings.position_noise_std_m");
+    let s = EkfCampaignSettings {
+        sweeps: 0,
+        ..Default::default()
+    };
+    assert_eq!(go(&s, &runs).field(), "settings.sweeps");
+    // No SI3 run.
+    let no_si3: Vec<RunInput> = runs
+        .iter()
+        .filter(|r| r.family != Some(ExperimentFamily::DpAzimuth))
+        .cloned()
+        .collect();
+    let e = go(&EkfCampaignSettings::default(), &no_si3);
+    assert_eq!(e.field(), "run_ids");
+    assert!(e.to_string().contains("SI3"), "{e}");
+    // A ROV profile is refused naming the method; a DP profile without M″ names it.
+    let rov = crate::planning::examples::surveyor_rov();
+    let e = identify_ekf_campaign(&rov, &inputs, &runs, &Default::default(), &mut NoProgress)
+        .unwrap_err();
+    assert_eq!(e.field(), "method");
+    let mut bare = supply_vessel();
+    bare.dp_prior = None;
+    let e = identify_ekf_campaign(&bare, &inputs, &runs, &Default::default(), &mut NoProgress)
+        .unwrap_err();
+    assert_eq!(e.field(), "vessel.dp_prior");
+}
+
+#[test]
+fn unphysical_estimates_are_reported() {
+    let m = Matrix3::from_fn(|i, j| paper::M_INERTIA[i][j]);
+    let good = Matrix3::from_fn(|i, j| paper::A_H[i][j]);
+    assert!(structure_findings(&m, &good, &paper::K_THRUST).is_empty());
+    let mut bad = good;
+    bad[(1, 1)] = 0.05;
+    let mut k = paper::K_THRUST;
+    k[5] = -1e-3;
+    let f = structure_findings(&m, &bad, &k);
+    assert!(f.iter().any(|s| s.contains("not dissipative")), "{f:?}");
+    assert!(f.iter().any(|s| s.contains("not stable")), "{f:?}");
+    assert!(f.iter().any(|s| s.contains("K″6")), "{f:?}");
+}
+
+/// The campaign path over truth seeds 1–12 (planned PRBS manoeuvres, N = 2):
+/// `cargo test --release -p seatrial-core campaign_seed_sweep -- --ignored --nocapture`.
+#[test]
+#[ignore = "seed sweep, ≈ 5 s in release"]
+fn campaign_seed_sweep() {
+    let profile = supply_vessel();
+    let inputs = input_columns(&profile);
+    let mut hits = [0usize; N_THETA];
+    let mut covered = 0;
+    for seed in 1..=12u64 {
+        let runs = flown_runs(1995, seed);
+        let out = identify_ekf_campaign(
+            &profile,
+            &inputs,
+            &runs,
+            &EkfCampaignSettings::default(),
+            &mut NoProgress,
+        )
+        .unwrap();
+        let doc = out.document.dp_ship.unwrap();
+        let err: Vec<f64> = (0..N_THETA)
+            .map(|p| doc.theta[p] / paper::THETA[p] - 1.0)
+            .collect();
+        for p in 0..N_THETA {
+            hits[p] += usize::from(err[p].abs() < 0.05);
+        }
+        covered += usize::from(err[2].abs() < 3.0 * doc.theta_std[2] / paper::THETA[2]);
+        let worst = err.iter().fold(0.0f64, |a, e| a.max(e.abs()));
+        eprintln!(
+            "seed {seed:>2}: θ″3 {:+.1} % (σ {:.1} %), worst θ″ {:.1} %",
+            100.0 * err[2],
+            100.0 * doc.theta_std[2] / paper::THETA[2],
+            100.0 * worst
+        );
+    }
+    eprintln!("within 5 % per θ″ over 12 seeds: {hits:?}; θ″3 within 3σ: {covered}/12");
+    // θ″3 = A″_h23 is weakly identifiable from the planned N = 2 sway–yaw
+    // runs (σ ≈ 7 %): it is not held to 5 %, but its σ must cover the error.
+    for (p, &h) in hits.iter().enumerate() {
+        assert!(p == 2 || h >= 11, "θ″{}: {hits:?}", p + 1);
+    }
+    assert_eq!(covered, 12, "θ″3's σ covers its error");
+}
