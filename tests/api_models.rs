@@ -5,8 +5,6 @@
 
 mod common;
 
-use std::time::Duration;
-
 use common::sim::multipart;
 use common::{TestApp, rov_profile};
 use seatrial::jobs::{JobRegistry, JobsConfig};
@@ -86,15 +84,7 @@ async fn flown_campaign(app: &TestApp) -> String {
 }
 
 async fn wait_for(app: &TestApp, job_id: &str) -> Value {
-    for _ in 0..600 {
-        let r = app.call("GET", "/api/jobs/{id}", &[job_id], None).await;
-        let state = r.json["state"].as_str().unwrap_or("").to_string();
-        if ["succeeded", "failed", "cancelled", "interrupted"].contains(&state.as_str()) {
-            return r.json;
-        }
-        tokio::time::sleep(Duration::from_millis(100)).await;
-    }
-    panic!("job {job_id} did not finish in 60 s");
+    common::wait_for_job(app, job_id, 60).await
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
