@@ -2,6 +2,8 @@
 //! planned DP manoeuvres flown through the truth, logged as SI CSV, parsed
 //! like an upload, identified and validated.
 
+#![allow(clippy::needless_range_loop)] // θ″ and matrix indices read best as indices
+
 use super::*;
 use crate::estimation::NoProgress;
 use crate::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};

@@ -244,7 +244,8 @@ fn errors_for_seed(
 #[test]
 #[ignore = "seed sweep, ≈ 10 s in release"]
 fn seed_sweep_of_the_staged_ekf() {
-    let variants: Vec<(&str, Box<dyn Fn(&mut DpIdentConfig)>, usize)> = vec![
+    type Tune = Box<dyn Fn(&mut DpIdentConfig)>;
+    let variants: Vec<(&str, Tune, usize)> = vec![
         ("baseline", Box::new(|_| {}), 600),
         ("sweeps 4", Box::new(|c| c.sweeps = 4), 600),
         ("q_h 1e-9", Box::new(|c| c.q_h = [1e-9; 3]), 600),
