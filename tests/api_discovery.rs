@@ -8,7 +8,8 @@
 mod common;
 
 use common::TestApp;
-use common::flights::{flown_campaign, wait_for};
+use common::flights::flown_campaign;
+use common::wait_for_job;
 use seatrial::jobs::{JobRegistry, JobsConfig};
 use seatrial_core::simulation::rov::RovTruth;
 use serde_json::{Value, json};
@@ -20,7 +21,7 @@ async fn app() -> TestApp {
 async fn run_job(app: &TestApp, body: Value) -> Value {
     let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
     assert_eq!(r.status, 202, "{}", r.text);
-    let job = wait_for(app, r.json["id"].as_str().unwrap()).await;
+    let job = wait_for_job(app, r.json["id"].as_str().unwrap(), 60).await;
     assert_eq!(job["state"], "succeeded", "{job}");
     job
 }
@@ -208,7 +209,7 @@ async fn bad_discover_requests_name_the_field() {
         )
         .await;
     assert_eq!(r.status, 202, "{}", r.text);
-    let job = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    let job = wait_for_job(&app, r.json["id"].as_str().unwrap(), 60).await;
     assert_eq!(job["state"], "failed", "{job}");
     assert_eq!(
         job["error"]["field"], "settings.grid_speeds_mps[0]",

@@ -6,7 +6,8 @@
 mod common;
 
 use common::TestApp;
-use common::flights::{flown_campaign, linear_truth, wait_for};
+use common::flights::{flown_campaign, linear_truth};
+use common::wait_for_job;
 use seatrial::jobs::{JobRegistry, JobsConfig};
 use serde_json::{Value, json};
 
@@ -24,7 +25,7 @@ async fn identify_job_stores_a_validated_versioned_lpv_model() {
         .call("POST", "/api/jobs", &[], Some(submit.clone()))
         .await;
     assert_eq!(r.status, 202, "{}", r.text);
-    let job = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    let job = wait_for_job(&app, r.json["id"].as_str().unwrap(), 60).await;
     assert_eq!(job["state"], "succeeded", "{job}");
     assert_eq!(job["progress"], 1.0);
     let mid = job["result"]["model_id"].as_str().unwrap().to_string();
@@ -99,7 +100,7 @@ async fn identify_job_stores_a_validated_versioned_lpv_model() {
 
     // Re-identification continues the lineage as version 2.
     let r = app.call("POST", "/api/jobs", &[], Some(submit)).await;
-    let job2 = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    let job2 = wait_for_job(&app, r.json["id"].as_str().unwrap(), 60).await;
     assert_eq!(job2["result"]["version"], 2, "{job2}");
     let list = app
         .call("GET", "/api/models?campaign_id={id}", &[&cid], None)
@@ -183,13 +184,13 @@ async fn n4sid_job_and_bad_requests_name_the_field() {
         bad(json!({ "kind": "identify", "campaign_id": cid, "settings": { "t_lambda_s": 0.01 } }))
             .await;
     assert_eq!(r.status, 202);
-    let job = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    let job = wait_for_job(&app, r.json["id"].as_str().unwrap(), 60).await;
     assert_eq!(job["state"], "failed");
     assert_eq!(job["error"]["field"], "settings.t_lambda_s", "{job}");
 
     let r = bad(json!({ "kind": "identify", "campaign_id": cid, "method": "n4sid", "settings": { "order": 6 } })).await;
     assert_eq!(r.status, 202, "{}", r.text);
-    let job = wait_for(&app, r.json["id"].as_str().unwrap()).await;
+    let job = wait_for_job(&app, r.json["id"].as_str().unwrap(), 60).await;
     assert_eq!(job["state"], "succeeded", "{job}");
     let mid = job["result"]["model_id"].as_str().unwrap().to_string();
     let m = app.call("GET", "/api/models/{id}", &[&mid], None).await;

@@ -13,6 +13,14 @@ export const METHOD_LABEL = {
   parallel_ekf: 'Parallel EKF (DP ship)',
   discovery: 'Missing-physics discovery',
 };
+/** What each method fits, shown under the method selector. */
+export const METHOD_HELP = {
+  lambda_kf: 'LPV model on forward speed: restoring forces from the static holds, then M ν̇ + D̄ ν = γ per grid point by the state-variable filter λ(s) = 1/(1+sT) and a Kalman filter over the parameters (thesis sec. 2.5).',
+  n4sid: 'Black-box LTI model about the mean operating point by subspace identification (N4SID): a comparison model, no physical parameters.',
+  parallel_ekf: 'DP ship (Fossen, Sagatun & Sørensen 1995): state-augmented EKF in parallel over the runs of each manoeuvre, staged SI1 surge → SI2 sway–yaw → SI3 azimuth; M″ and T″ from the vessel profile, A″_h and K″ estimated from position and heading (Bis units).',
+};
+/** The parallel-EKF stage of a DP experiment family. */
+const DP_STAGE = { dp_surge: 'SI1', dp_sway_yaw: 'SI2', dp_azimuth: 'SI3' };
 /** Methods that fit a vessel kind, the first one the default. */
 export const METHODS_FOR = { rov6: ['lambda_kf', 'n4sid'], dp3: ['parallel_ekf', 'n4sid'] };
 const STRUCTURES = [
@@ -58,6 +66,9 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
 
   // ---- the form ---------------------------------------------------------------
   const form = h('form', { class: 'card form identify', novalidate: true, 'data-testid': 'identify-form', 'aria-label': 'Identify a model', onSubmit: submit });
+  const methodHelp = h('p', { class: 'hint method-help', 'data-testid': 'identify-method-help', 'aria-live': 'polite' });
+  const sweepsIn = h('input', { type: 'number', min: '1', max: '20', step: '1', value: '2', class: 'short', 'data-field': 'settings.sweeps', 'data-testid': 'identify-sweeps' });
+  const sweepsFld = labelled('Sweeps', sweepsIn, 'passes through SI1 → SI2 → SI3');
   const methodSel = h('select', { 'data-field': 'method', 'data-testid': 'identify-method', onChange: (e) => { m.method = e.target.value; renderStructure(); renderRunsTable(); } },
     methods.map((k) => h('option', { value: k, selected: k === m.method }, METHOD_LABEL[k])));
   const structSel = h('select', { 'data-field': 'settings.structure', 'data-testid': 'identify-structure', onChange: (e) => { m.structure = e.target.value; } },
@@ -70,7 +81,8 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
 
   fill(form,
     h('h3', null, 'Identify ', h('span', { class: 'hint' }, 'estimate a model from the accepted runs and validate it on held-out runs')),
-    h('div', { class: 'row' }, labelled('Method', methodSel), structFld),
+    h('div', { class: 'row' }, labelled('Method', methodSel), structFld, sweepsFld),
+    methodHelp,
     runsBox,
     rolesNote,
     h('div', { class: 'form-actions' }, startBtn),
@@ -78,8 +90,12 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
 
   function renderStructure() {
     structFld.hidden = m.method !== 'lambda_kf';
+    sweepsFld.hidden = m.method !== 'parallel_ekf';
+    methodHelp.textContent = METHOD_HELP[m.method] || '';
   }
 
+  /** "estimation", with the EKF stage of a DP manoeuvre. */
+  const estimationRole = (e) => (m.method === 'parallel_ekf' && e && DP_STAGE[e.family] ? `estimation (${DP_STAGE[e.family]})` : 'estimation');
   const expOf = (r) => (plan && r.experiment_id ? plan.experiments.find((e) => e.id === r.experiment_id) : null);
   const accepted = () => runs.filter((r) => r.status === 'accepted');
 
@@ -124,7 +140,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
         h('td', { class: 'mono nowrap' }, e ? e.code : h('span', { class: 'muted' }, '–')),
         h('td', null, e ? h('span', { class: `fam-tag ${e.family}` }, FAMILY_LABEL[e.family] || e.family) : h('span', { class: 'muted' }, 'not planned')),
         h('td', { class: 'num' }, e && e.grid_speed_mps != null ? `${fmtKn(e.grid_speed_mps)} kn` : '–'),
-        h('td', { class: 'nowrap', 'data-testid': 'identify-role' }, rl ? (rl === 'validation' ? (explicit ? 'validation (held out)' : 'validation (plan)') : rl === 'static' ? 'static (restoring)' : 'estimation') : h('span', { class: 'muted' }, 'not used')),
+        h('td', { class: 'nowrap', 'data-testid': 'identify-role' }, rl ? (rl === 'validation' ? (explicit ? 'validation (held out)' : 'validation (plan)') : rl === 'static' ? 'static (restoring)' : estimationRole(e)) : h('span', { class: 'muted' }, 'not used')),
         h('td', null, h('label', { class: 'check' }, holdBox, ' hold out')));
     });
     fill(runsBox, h('div', { class: 'table-x' }, h('table', { class: 'grid-table compact', 'data-testid': 'identify-runs' },
@@ -158,6 +174,10 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
     const { used, explicit } = roles();
     const settings = {};
     if (m.method === 'lambda_kf') settings.structure = m.structure;
+    if (m.method === 'parallel_ekf') {
+      const sw = Number(sweepsIn.value);
+      settings.sweeps = sweepsIn.value.trim() === '' || !Number.isFinite(sw) ? sweepsIn.value : sw;
+    }
     if (explicit) settings.validation_run_ids = used.filter((r) => m.holdOut.has(r.id)).map((r) => r.id);
     const body = { kind: 'identify', campaign_id: id, run_ids: used.map((r) => r.id), method: m.method, settings };
     startBtn.disabled = true;

@@ -46,6 +46,34 @@ function matrixTable(rows, { rowNames = [], colNames = [], testid } = {}) {
       r.map((v) => h('td', { class: 'num mono', title: String(v) }, exact(v)))))));
 }
 
+const DOF3 = ['surge', 'sway', 'yaw'];
+const NU3 = ['u', 'v', 'r'];
+
+/** A DP ship's matrices (Fossen et al. 1995): θ″ with ± std, A″_h, K″, D″, A″, B″ (Bis) and A, B in SI. */
+function dpShipSection(dp, inputs) {
+  const pm = (label, hint, rows, opts) => h('div', { class: 'dp-matrix' }, h('b', null, label), h('span', { class: 'hint' }, ` ${hint}`), matrixTable(rows, opts));
+  const withStd = dp.a_h.map((r, i) => r.map((v, j) => (dp.a_h_std[i][j] ? `${exact(v)} ± ${exact(dp.a_h_std[i][j])}` : exact(v))));
+  const kRows = [dp.k.map((v, j) => `${exact(v)} ± ${exact(dp.k_std[j])}`)];
+  const textTable = (rows, rowNames, colNames, testid) => h('table', { class: 'grid-table compact matrix', 'data-testid': testid },
+    h('thead', null, h('tr', null, h('th', null, ''), colNames.map((c) => h('th', { class: 'num mono' }, c)))),
+    h('tbody', null, rows.map((r, i) => h('tr', null, h('th', { class: 'mono' }, rowNames[i]), r.map((v) => h('td', { class: 'num mono' }, v))))));
+  return h('section', { class: 'card dp-ship', 'data-testid': 'dp-ship' },
+    h('p', { class: 'hint' }, `Momentum form ḣ = A_h·h + T·K·u + b_h, h = M·ν (eq. 35); Bis units: L = ${exact(dp.length_m)} m, time √(L/g) = ${fmt(dp.time_unit_s, 4)} s, forces m·g, moments m·g·L.`),
+    h('div', { class: 'matrix-pair' },
+      h('div', { class: 'dp-matrix' }, h('b', null, 'A″_h'), h('span', { class: 'hint' }, ' identified (eq. 48), ± std'), textTable(withStd, DOF3, DOF3, 'dp-a-h')),
+      h('div', { class: 'dp-matrix' }, h('b', null, 'K″'), h('span', { class: 'hint' }, ' thrust coefficients (eq. 49), ± std'), textTable(kRows, ['K'], inputs, 'dp-k'))),
+    h('div', { class: 'matrix-pair' },
+      pm('M″', 'known (eq. 30)', dp.m, { rowNames: DOF3, colNames: DOF3, testid: 'dp-m' }),
+      pm('D″ = −A″_h M″', 'linear damping', dp.d, { rowNames: DOF3, colNames: DOF3, testid: 'dp-d' }),
+      pm('T″', 'thruster configuration (eq. 29)', dp.t_config, { rowNames: DOF3, colNames: inputs, testid: 'dp-t' })),
+    h('div', { class: 'matrix-pair' },
+      pm('A″ = M″⁻¹A″_h M″', 'ν̇ = Aν + Bu (eq. 51, Bis)', dp.a, { rowNames: NU3, colNames: NU3, testid: 'dp-a' }),
+      pm('B″ = M″⁻¹T″K″', '(eq. 52, Bis)', dp.b, { rowNames: NU3, colNames: inputs, testid: 'dp-b' })),
+    h('div', { class: 'matrix-pair' },
+      pm('A [1/s]', 'SI: ν in m/s, m/s, rad/s', dp.a_si, { rowNames: NU3, colNames: NU3, testid: 'dp-a-si' }),
+      pm('B [SI per unit command]', 'm/s², m/s², rad/s²', dp.b_si, { rowNames: NU3, colNames: inputs, testid: 'dp-b-si' })));
+}
+
 /** The model page. Returns a controller whose mount() draws the plots. */
 export async function modelPage(view, id) {
   const mv = await api.model(id);
@@ -206,12 +234,14 @@ export async function modelPage(view, id) {
       const r = await api.model(id, hv);
       const d = r.discrete;
       if (!d) throw new Error('the server answered without the discretized model');
-      fill(zohOut, h('p', { class: 'hint' }, `ν(k+1) = Φ ν(k) + Γ γ(k), h = ${exact(d.h)} s, zero-order hold on the input.`),
+      const dpm = model.kind === 'dp_ship';
+      const states = dpm ? NU3 : doc.outputs;
+      fill(zohOut, h('p', { class: 'hint' }, `ν(k+1) = Φ ν(k) + Γ ${dpm ? 'u' : 'γ'}(k), h = ${exact(d.h)} s, zero-order hold on the input${dpm ? ' (ν in m/s, m/s, rad/s; u the thruster commands)' : ''}.`),
         d.points.map((p) => h('div', { class: 'zoh-point', 'data-testid': 'zoh-point' },
           h('h4', null, p.speed_mps != null ? `Grid point ${speedText(p.speed_mps)}` : 'Operating point'),
           h('div', { class: 'matrix-pair' },
-            h('div', null, h('b', null, 'Φ'), matrixTable(p.phi, { rowNames: doc.outputs, colNames: doc.outputs, testid: 'zoh-phi' })),
-            h('div', null, h('b', null, 'Γ'), matrixTable(p.gamma, { rowNames: doc.outputs, colNames: doc.inputs, testid: 'zoh-gamma' }))))));
+            h('div', null, h('b', null, 'Φ'), matrixTable(p.phi, { rowNames: states, colNames: states, testid: 'zoh-phi' })),
+            h('div', null, h('b', null, 'Γ'), matrixTable(p.gamma, { rowNames: states, colNames: doc.inputs, testid: 'zoh-gamma' }))))));
     } catch (err) {
       fill(zohOut);
       if (err.field === 'h') showFieldError(zohForm, 'h', err.message, err.limit);
@@ -232,6 +262,7 @@ export async function modelPage(view, id) {
     notes,
     h('h2', { class: 'section-title' }, 'Parameters ', h('span', { class: 'hint' }, `${params.length} estimates with their standard deviations`)),
     paramSection,
+    doc.dp_ship ? [h('h2', { class: 'section-title' }, 'DP ship matrices'), dpShipSection(doc.dp_ship, doc.inputs || [])] : null,
     h('h2', { class: 'section-title' }, 'Validation ', h('span', { class: 'hint' }, 'on runs the model was not fitted to')),
     valSections.length ? valSections : h('p', { class: 'empty', 'data-testid': 'no-validation' }, 'No validation report.'),
     h('h2', { class: 'section-title' }, 'Discrete-time model'),

@@ -1,14 +1,17 @@
 //! The demo a newcomer clicks through: the Surveyor ROV on the thesis's grid
 //! and Fossen's supply vessel with its three decoupled DP manoeuvres, each
-//! with a campaign and a generated plan. The ROV campaign has been "flown":
-//! every planned experiment simulated through the ROV truth
-//! (`simulation::trials`) and uploaded as a run, so identification can be
-//! started at once. Seeded only into an empty database.
+//! with a campaign and a generated plan. Both campaigns have been "flown":
+//! every planned experiment simulated through its truth (the ROV through
+//! `simulation::trials`, the supply vessel through `simulation::dp_ship`)
+//! and uploaded as a run, so identification can be started at once. Seeded
+//! only into an empty database.
 
 use seatrial_core::planning::examples::{
-    supply_vessel, supply_vessel_campaign, surveyor_campaign, surveyor_rov,
+    supply_vessel, supply_vessel_trial_campaign, surveyor_campaign, surveyor_rov,
 };
-use seatrial_core::planning::{CampaignSpec, ExperimentFamily, generate_plan};
+use seatrial_core::planning::vessel::VesselKind;
+use seatrial_core::planning::{CampaignSpec, Plan, VesselProfile, generate_plan};
+use seatrial_core::simulation::dp_ship::{DpFlightSettings, DpShip, fly_dp_campaign};
 
 use seatrial_core::simulation::rov::RovTruth;
 use seatrial_core::simulation::trials::{TrialSettings, fly_campaign};
@@ -26,10 +29,7 @@ pub fn rov_campaign() -> CampaignSpec {
 /// The DP demo campaign: the three decoupled manoeuvres, N = 2 each, and a
 /// 600 s validation run.
 pub fn dp_campaign() -> CampaignSpec {
-    let mut c = supply_vessel_campaign(1995);
-    c.families.push(ExperimentFamily::Validation);
-    c.durations.validation_s = 600.0;
-    c
+    supply_vessel_trial_campaign(1995)
 }
 
 /// Seeds the demo if there are no vessels yet. Returns whether it did.
@@ -46,8 +46,9 @@ pub async fn seed_if_empty(db: &Db, blobs: &BlobStore) -> anyhow::Result<bool> {
         let v = vessels::insert(db, profile.clone()).await?;
         let c = campaigns::insert(db, &v.id, spec).await?;
         let stored = plans::insert(db, &c.id, &plan).await?;
-        if v.profile.kind == seatrial_core::planning::vessel::VesselKind::Rov6 {
-            fly_rov_trials(db, blobs, &c.id, &profile, plan, &stored).await?;
+        match v.profile.kind {
+            VesselKind::Rov6 => fly_rov_trials(db, blobs, &c.id, &profile, plan, &stored).await?,
+            VesselKind::Dp3 => fly_dp_trials(db, blobs, &c.id, &profile, plan, &stored).await?,
         }
     }
     Ok(true)
@@ -59,8 +60,8 @@ async fn fly_rov_trials(
     db: &Db,
     blobs: &BlobStore,
     campaign_id: &str,
-    profile: &seatrial_core::planning::VesselProfile,
-    plan: seatrial_core::planning::Plan,
+    profile: &VesselProfile,
+    plan: Plan,
     stored: &plans::StoredPlan,
 ) -> anyhow::Result<()> {
     let p = profile.clone();
@@ -74,28 +75,68 @@ async fn fly_rov_trials(
         fly_campaign(&p, &RovTruth::surveyor_like(), &plan, &settings, |_| true)
     })
     .await??;
-    for run in flown {
+    let logs = flown.into_iter().map(|r| (r.code, r.csv)).collect();
+    upload_all(db, blobs, campaign_id, profile, stored, logs).await
+}
+
+/// Flies the DP plan through Fossen's supply vessel (the paper's M″, T″,
+/// A″_h, K″; 1 m position and 0.2° heading noise, a slowly varying bias)
+/// and uploads each run, so `parallel_ekf` can be run at once.
+async fn fly_dp_trials(
+    db: &Db,
+    blobs: &BlobStore,
+    campaign_id: &str,
+    profile: &VesselProfile,
+    plan: Plan,
+    stored: &plans::StoredPlan,
+) -> anyhow::Result<()> {
+    let p = profile.clone();
+    let flown = tokio::task::spawn_blocking(move || {
+        fly_dp_campaign(
+            &p,
+            &DpShip::supply_vessel(),
+            &plan,
+            &DpFlightSettings::supply_vessel(1995),
+            |_| true,
+        )
+    })
+    .await??;
+    let logs = flown.into_iter().map(|r| (r.code, r.csv)).collect();
+    upload_all(db, blobs, campaign_id, profile, stored, logs).await
+}
+
+/// Uploads `(experiment code, csv)` logs as runs of their planned
+/// experiments: stored verbatim, then parsed and scored.
+pub async fn upload_all(
+    db: &Db,
+    blobs: &BlobStore,
+    campaign_id: &str,
+    profile: &VesselProfile,
+    stored: &plans::StoredPlan,
+    logs: Vec<(String, String)>,
+) -> anyhow::Result<()> {
+    for (code, csv) in logs {
         let Some(eid) = stored
             .experiments
             .iter()
-            .find(|e| e.experiment.code == run.code)
+            .find(|e| e.experiment.code == code)
             .map(|e| e.id.clone())
         else {
             continue;
         };
         let mut w = blobs.begin().await?;
-        w.write(run.csv.as_bytes()).await?;
+        w.write(csv.as_bytes()).await?;
         let blob = w.finish().await?;
         let path = blobs.path(&blob.sha256);
         let r = runs::insert(
             db,
             campaign_id,
             Some(&eid),
-            &run.code,
+            &code,
             "single",
             &[NewFile {
                 role: "file".into(),
-                filename: format!("{}.csv", run.code),
+                filename: format!("{code}.csv"),
                 blob,
             }],
         )

@@ -318,7 +318,10 @@ pub fn process_run(
             output: d.velocity_symbol().to_string(),
         })
         .collect();
-    let inputs = input_columns(vessel);
+    // A thruster-actuated vessel's DOFs are scored on the derived τ_T = T·u,
+    // so those columns are inputs of the report too.
+    let mut inputs = input_columns(vessel);
+    inputs.extend(thruster_force_columns(vessel));
     let outputs = output_columns(vessel);
     let planned_ref = planned.map(|(e, s)| PlannedReference {
         sample_rate_hz: s.sample_rate_hz,

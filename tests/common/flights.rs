@@ -1,15 +1,12 @@
 //! Flying a planned ROV campaign through the truth simulator and uploading
-//! its logs, and waiting for a job: what the identification and discovery
-//! tests share.
+//! its logs: what the identification and discovery tests share.
 
 #![allow(dead_code)]
-
-use std::time::Duration;
 
 use seatrial_core::planning::{CampaignSpec, generate_plan};
 use seatrial_core::simulation::rov::RovTruth;
 use seatrial_core::simulation::trials::{TrialSettings, fly_experiment};
-use serde_json::{Value, json};
+use serde_json::json;
 
 use super::sim::multipart;
 use super::{TestApp, rov_profile};
@@ -84,16 +81,4 @@ pub async fn flown_campaign(app: &TestApp, truth: &RovTruth) -> String {
         assert_eq!(r.status, 201, "{code}: {}", r.text);
     }
     cid
-}
-
-pub async fn wait_for(app: &TestApp, job_id: &str) -> Value {
-    for _ in 0..600 {
-        let r = app.call("GET", "/api/jobs/{id}", &[job_id], None).await;
-        let state = r.json["state"].as_str().unwrap_or("").to_string();
-        if ["succeeded", "failed", "cancelled", "interrupted"].contains(&state.as_str()) {
-            return r.json;
-        }
-        tokio::time::sleep(Duration::from_millis(100)).await;
-    }
-    panic!("job {job_id} did not finish in 60 s");
 }

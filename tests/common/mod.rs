@@ -224,3 +224,16 @@ pub fn rov_profile() -> Value {
 pub fn dp_profile() -> Value {
     serde_json::to_value(seatrial_core::planning::examples::supply_vessel()).unwrap()
 }
+
+/// Polls `GET /api/jobs/{id}` until the job ends (at most `seconds`); its JSON.
+pub async fn wait_for_job(app: &TestApp, job_id: &str, seconds: u64) -> Value {
+    for _ in 0..seconds * 10 {
+        let r = app.call("GET", "/api/jobs/{id}", &[job_id], None).await;
+        let state = r.json["state"].as_str().unwrap_or("").to_string();
+        if ["succeeded", "failed", "cancelled", "interrupted"].contains(&state.as_str()) {
+            return r.json;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(100)).await;
+    }
+    panic!("job {job_id} did not finish in {seconds} s");
+}

@@ -25,7 +25,8 @@ const ARGS = [
 
 export const tid = (id) => `[data-testid="${id}"]`;
 
-export function harness() {
+/** `extraArgs`: more server flags, e.g. ['--demo']. */
+export function harness({ extraArgs = [] } = {}) {
   const h = { base: null, browser: null, serverLog: '' };
   let server;
   let tmp;
@@ -38,7 +39,7 @@ export function harness() {
   function startServer() {
     tmp = mkdtempSync(path.join(tmpdir(), 'seatrial-web-'));
     assert.ok(existsSync(BIN), `seatrial binary not found at ${BIN} (cargo build --release, or set SEATRIAL_BIN)`);
-    server = spawn(BIN, ['--db', path.join(tmp, 'db.sqlite'), '--listen', '127.0.0.1:0', '--web-dir', WEB], {
+    server = spawn(BIN, ['--db', path.join(tmp, 'db.sqlite'), '--listen', '127.0.0.1:0', '--web-dir', WEB, ...extraArgs], {
       stdio: ['ignore', 'pipe', 'pipe'],
     });
     return new Promise((resolve, reject) => {

@@ -8,10 +8,12 @@ use std::path::PathBuf;
 
 use seatrial_core::estimation::Progress;
 use seatrial_core::identification::{
-    Identified, IdentifyError, LambdaCampaignSettings, N4sidCampaignSettings, RunInput,
-    identify_lambda_campaign, identify_n4sid_campaign,
+    EkfCampaignSettings, Identified, IdentifyError, LambdaCampaignSettings, N4sidCampaignSettings,
+    RunInput, identify_ekf_campaign, identify_lambda_campaign, identify_n4sid_campaign,
 };
+use seatrial_core::logs::input_columns;
 use seatrial_core::planning::VesselProfile;
+use seatrial_core::planning::vessel::VesselKind;
 use serde::de::DeserializeOwned;
 use sqlx::SqliteConnection;
 
@@ -22,8 +24,17 @@ use crate::storage::jobs::{Job, JobRequest};
 use crate::storage::models::{self, Lineage, NewModel};
 use crate::storage::{campaigns, plans, runs, vessels};
 
-/// Methods of `identify`, with what they fit.
-pub const METHODS: [&str; 2] = ["lambda_kf", "n4sid"];
+/// Methods of `identify`: `lambda_kf` (ROV LPV), `n4sid` (black box, any
+/// vessel), `parallel_ekf` (DP vessels).
+pub const METHODS: [&str; 3] = ["lambda_kf", "n4sid", "parallel_ekf"];
+
+/// The method used when the request names none: the vessel's physical one.
+pub fn default_method(vessel: &VesselProfile) -> &'static str {
+    match vessel.kind {
+        VesselKind::Rov6 => "lambda_kf",
+        VesselKind::Dp3 => "parallel_ekf",
+    }
+}
 
 /// The `identify` handler.
 pub struct Identify;
@@ -45,11 +56,30 @@ pub(super) fn parse_settings<T: DeserializeOwned>(
 
 fn check_method(vessel: &VesselProfile, method: &str) -> Result<(), String> {
     match (method, vessel.kind) {
-        ("lambda_kf" | "n4sid", _) => Ok(()),
+        ("lambda_kf", VesselKind::Rov6) | ("n4sid", _) | ("parallel_ekf", VesselKind::Dp3) => {
+            Ok(())
+        }
+        ("lambda_kf", VesselKind::Dp3) => Err(
+            "lambda_kf fits the ROV LPV model on forward speed; a DP vessel (dp3) is identified by parallel_ekf (Fossen et al. 1995), or n4sid for a black-box comparison"
+                .into(),
+        ),
+        ("parallel_ekf", _) => Err(format!(
+            "parallel_ekf identifies DP vessels (kind dp3) from the SI1–SI3 manoeuvres; '{}' is a {:?} vessel: use lambda_kf or n4sid",
+            vessel.name, vessel.kind
+        )),
         (m, _) => Err(format!(
             "unknown method '{m}'; use one of {}",
             METHODS.join(", ")
         )),
+    }
+}
+
+/// Parses `settings` for a known method, naming the field on error.
+fn check_settings(method: &str, settings: &serde_json::Value) -> Result<(), (String, String)> {
+    match method {
+        "lambda_kf" => parse_settings::<LambdaCampaignSettings>(settings).map(|_| ()),
+        "parallel_ekf" => parse_settings::<EkfCampaignSettings>(settings).map(|_| ()),
+        _ => parse_settings::<N4sidCampaignSettings>(settings).map(|_| ()),
     }
 }
 
@@ -82,13 +112,13 @@ impl JobHandler for Identify {
             let vessel = vessels::get(&cx.db, &campaign.vessel_id)
                 .await?
                 .ok_or_else(|| ApiError::missing("campaign_id", "the campaign's vessel is gone"))?;
-            let method = req.method.as_deref().unwrap_or("lambda_kf");
+            let method = req
+                .method
+                .as_deref()
+                .unwrap_or(default_method(&vessel.profile));
             check_method(&vessel.profile, method).map_err(|m| ApiError::invalid("method", m))?;
-            let parsed = match method {
-                "lambda_kf" => parse_settings::<LambdaCampaignSettings>(&req.settings).map(|_| ()),
-                _ => parse_settings::<N4sidCampaignSettings>(&req.settings).map(|_| ()),
-            };
-            parsed.map_err(|(field, msg)| ApiError::invalid(field, msg))?;
+            check_settings(method, &req.settings)
+                .map_err(|(field, msg)| ApiError::invalid(field, msg))?;
             if req.run_ids.is_empty() {
                 let accepted = runs::list(&cx.db, cid)
                     .await?
@@ -159,7 +189,10 @@ impl JobHandler for Identify {
                     grid_speed_mps: planned.as_ref().and_then(|e| e.grid_speed_mps),
                 });
             }
-            let method = req.method.clone().unwrap_or_else(|| "lambda_kf".into());
+            let method = req
+                .method
+                .clone()
+                .unwrap_or_else(|| default_method(&vessel.profile).into());
             let settings = req.settings.clone();
             let profile = vessel.profile.clone();
             let grid = campaign.grid_speeds_mps.clone();
@@ -191,6 +224,12 @@ impl JobHandler for Identify {
                         let s: LambdaCampaignSettings =
                             parse_settings(&settings).map_err(|(f, m)| JobFailure::field(f, m))?;
                         identify_lambda_campaign(&profile, &grid, &forces, &inputs, &s, &mut sub)
+                    }
+                    "parallel_ekf" => {
+                        let s: EkfCampaignSettings =
+                            parse_settings(&settings).map_err(|(f, m)| JobFailure::field(f, m))?;
+                        let thrusters = input_columns(&profile);
+                        identify_ekf_campaign(&profile, &thrusters, &inputs, &s, &mut sub)
                     }
                     _ => {
                         let s: N4sidCampaignSettings =

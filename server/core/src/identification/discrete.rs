@@ -64,8 +64,9 @@ pub fn discretize(doc: &ModelDocument, h: f64) -> Result<DiscreteModel, String> 
                 .collect::<Result<Vec<_>, _>>()?
         }
         ModelKind::DpShip => {
+            // The SI A, B: h is in seconds, ν in m/s and rad/s.
             let s = doc.dp_ship.as_ref().ok_or("the DP model is missing")?;
-            vec![zoh(&s.a, &s.b, h, None)?]
+            vec![zoh(&s.a_si, &s.b_si, h, None)?]
         }
         ModelKind::StateSpace => {
             let s = doc

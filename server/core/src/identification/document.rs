@@ -160,30 +160,70 @@ pub struct LpvDoc {
     pub points: Vec<LpvPoint>,
 }
 
-/// A DP ship's low-frequency model in momentum form (Fossen et al. 1995).
+/// A DP ship's low-frequency model in momentum form (Fossen et al. 1995,
+/// eq. 35–52): ḣ = −C_h(h)h + A_h·h + T·K·u + b_h, h = M·ν, η̇ = J(ψ)ν.
+///
+/// M, T, A_h, K, D, A and B are in the paper's non-dimensional Bis system of
+/// the ship's length L: lengths in L, time in √(L/g), mass in the
+/// displacement mass m, forces in m·g, moments in m·g·L; the thruster
+/// commands u are normalized (|u| ≤ 1). `a_si`, `b_si` are the same
+/// state-space model for ν in m/s, m/s, rad/s and time in s (they need no
+/// mass). The SI D is m·√(g/L)·D″ (surge, sway), with L and L² on the yaw
+/// row/column.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 pub struct DpShipDoc {
-    /// Units of the matrices, e.g. `Bis` (non-dimensional) or `SI`.
+    /// Units of M, T, A_h, K, D, A, B: `Bis`.
     pub units: String,
-    /// Inertia M (known a priori).
+    /// Ship length L (m), the Bis length unit.
+    pub length_m: f64,
+    /// Bis time unit √(L/g) (s).
+    pub time_unit_s: f64,
+    /// Inertia M″ (known a priori, eq. 30).
     pub m: Matrix,
-    /// Thruster configuration T (3 × r).
+    /// Thruster configuration T″ (3 × 6, eq. 29).
     pub t_config: Matrix,
-    /// A_h = −D M⁻¹.
+    /// A″_h = −D″ M″⁻¹ (eq. 39, 48).
     pub a_h: Matrix,
-    /// Std of A_h's entries.
+    /// Std of A″_h's entries (0 where structurally zero).
     pub a_h_std: Matrix,
-    /// Thrust coefficients K (diagonal).
+    /// Thrust coefficients K″ (diagonal, eq. 49).
     pub k: Vec<f64>,
-    /// Std of K.
+    /// Std of K″.
     pub k_std: Vec<f64>,
-    /// D = −A_h M.
+    /// θ″1 … θ″9 (eq. 46–47).
+    pub theta: Vec<f64>,
+    /// Their standard deviations.
+    pub theta_std: Vec<f64>,
+    /// D″ = −A″_h M″.
     pub d: Matrix,
-    /// A = M⁻¹A_h M.
+    /// A″ = M″⁻¹A″_h M″ (eq. 51, C_h = 0).
     pub a: Matrix,
-    /// B = M⁻¹ T K.
+    /// B″ = M″⁻¹ T″ K″ (eq. 52).
     pub b: Matrix,
+    /// A in SI: ν̇ = A·ν + B·u, ν in m/s, m/s, rad/s (1/s).
+    pub a_si: Matrix,
+    /// B in SI (m/s², m/s², rad/s² per unit command).
+    pub b_si: Matrix,
+    /// The state estimator's noise model (Bis, per sample), used to
+    /// estimate momentum and bias when the model predicts k steps ahead.
+    pub noise: DpNoiseDoc,
+}
+
+/// Noise model of the momentum/bias estimator (Bis units, per sample).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct DpNoiseDoc {
+    /// Measurement variances of x, y, ψ.
+    pub r: Vec<f64>,
+    /// Initial momentum variance.
+    pub p0_h: Vec<f64>,
+    /// Initial bias variance.
+    pub p0_b: Vec<f64>,
+    /// Process noise on h.
+    pub q_h: Vec<f64>,
+    /// Bias random walk.
+    pub q_b: Vec<f64>,
 }
 
 /// A discrete-time innovation-form model x⁺ = Φx + Γu + Ke, y = Cx + Du + e.

@@ -113,9 +113,12 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
             let s = doc.dp_ship.as_ref().ok_or("the DP model is missing")?;
             Ok(FossenParameterSet {
                 format: "seatrial-fossen/1".into(),
-                equation: "M·ν̇ + C(ν)ν + D·ν = T·K·u, η̇ = J(ψ)ν".into(),
+                equation: "M″·ν̇″ + C″(ν″)ν″ + D″·ν″ = T″·K″·u, η̇″ = J(ψ)ν″ (Fossen et al. 1995, eq. 26; momentum form ḣ = A_h·h + T·K·u + b_h with h = M·ν, A_h = −D·M⁻¹)".into(),
                 dofs,
-                units: s.units.clone(),
+                units: format!(
+                    "{} (non-dimensional): length L = {} m, time √(L/g) = {:.4} s, mass m (displacement), force m·g, moment m·g·L; u normalized thruster commands",
+                    s.units, s.length_m, s.time_unit_s
+                ),
                 points: vec![FossenPoint {
                     u: 0.0,
                     m: s.m.clone(),
@@ -125,7 +128,9 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                 t: Some(s.t_config.clone()),
                 k: Some(s.k.clone()),
                 notes: vec![
-                    "Low-frequency DP model; D = −A_h·M (Fossen et al. 1995, eq. 39).".into(),
+                    "Low-frequency DP model at rest (U = 0); D″ = −A″_h·M″ (eq. 39); M″ and T″ are the a-priori values (eq. 29–30), A″_h and K″ identified (eq. 48–49).".into(),
+                    format!("A″_h = {:?}", s.a_h),
+                    "To SI: M = m·diag(1, 1, L)·M″·diag(1, 1, L); D = m·√(g/L)·diag(1, 1, L)·D″·diag(1, 1, L); τ = m·g·diag(1, 1, L)·T″·K″·u.".into(),
                 ],
             })
         }

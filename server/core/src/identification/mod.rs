@@ -9,6 +9,7 @@
 //! - [`roles`]: static, estimation and held-out validation runs.
 //! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method.
 //! - [`n4sid_campaign`]: black-box LTI comparison model by N4SID.
+//! - [`ekf_campaign`]: DP ship by the staged parallel EKF (Bis units: [`bis`]).
 //! - [`document`]: the stored/served model: matrices, parameters with std.
 //! - [`discrete`]: ZOH matrices at a chosen h.
 //! - [`export`]: parameter CSV and the Fossen-form parameter set.
@@ -16,10 +17,12 @@
 //! - [`outcome`], [`error`]: what an identification returns.
 
 pub mod augmented;
+pub mod bis;
 pub mod dataset;
 pub mod discover_campaign;
 pub mod discrete;
 pub mod document;
+pub mod ekf_campaign;
 pub mod error;
 pub mod export;
 pub mod lambda_campaign;
@@ -31,6 +34,7 @@ pub mod roles;
 pub use dataset::{DatasetError, RunInput, Segment, segments};
 pub use discover_campaign::{CampaignDiscovery, DiscoverCampaignSettings, discover_campaign};
 pub use document::{Method, ModelDocument, ModelKind, ParameterRow};
+pub use ekf_campaign::{EkfCampaignSettings, identify_ekf_campaign};
 pub use error::IdentifyError;
 pub use lambda_campaign::{LambdaCampaignSettings, identify_lambda_campaign};
 pub use n4sid_campaign::{N4sidCampaignSettings, identify_n4sid_campaign};

@@ -2,16 +2,19 @@
 //! record — so any model can be validated on any run later (side-by-side
 //! comparison of two models on the same run).
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Matrix3, Vector6};
 
 use super::augmented::{AugmentedLpv, is_augmented};
+use super::bis::{BisScale, SiDpShip, unwrap_heading};
 use super::dataset::{RunInput, segments};
 use super::document::{ModelDocument, ModelKind, from_rows};
 use super::error::IdentifyError;
+use crate::estimation::ekf::IdentifiedDpShip;
 use crate::estimation::n4sid::{N4sidModel, NoiseCovariances, Weighting};
 use crate::logs::schema::pose_column;
 use crate::models::{LinearVesselModel, LpvModel};
 use crate::planning::dof::Dof;
+use crate::simulation::dp_ship::{DpShip, Matrix3x6};
 use crate::validation::{
     Predictor, ValidationRecord, ValidationReport, ValidationSettings, validate,
 };
@@ -74,22 +77,79 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                 output_names: doc.outputs.clone(),
             }))
         }
-        ModelKind::DpShip => Err(IdentifyError::invalid(
-            "document.kind",
-            "validating a stored DP-ship model on new runs is not available yet",
-        )),
+        ModelKind::DpShip => Ok(Box::new(dp_ship(doc)?)),
     }
 }
 
+/// The SI predictor of a stored DP-ship document.
+pub fn dp_ship(doc: &ModelDocument) -> Result<SiDpShip, IdentifyError> {
+    let s = doc
+        .dp_ship
+        .as_ref()
+        .ok_or_else(|| IdentifyError::invalid("document.dp_ship", "missing"))?;
+    let three = |v: &[f64], what: &str| -> Result<[f64; 3], IdentifyError> {
+        v.try_into().map_err(|_| {
+            IdentifyError::invalid("document.dp_ship.noise", format!("{what} needs 3 entries"))
+        })
+    };
+    let (m, t, a_h) = (
+        matrix(&s.m, "M")?,
+        matrix(&s.t_config, "T")?,
+        matrix(&s.a_h, "A_h")?,
+    );
+    if m.shape() != (3, 3) || a_h.shape() != (3, 3) || t.shape() != (3, 6) || s.k.len() != 6 {
+        return Err(IdentifyError::invalid(
+            "document.dp_ship",
+            "M and A_h must be 3 × 3, T 3 × 6 and K of length 6",
+        ));
+    }
+    Ok(SiDpShip {
+        model: IdentifiedDpShip {
+            ship: DpShip {
+                m: Matrix3::from_fn(|i, j| m[(i, j)]),
+                t: Matrix3x6::from_fn(|i, j| t[(i, j)]),
+                a_h: Matrix3::from_fn(|i, j| a_h[(i, j)]),
+                k: Vector6::from_column_slice(&s.k),
+            },
+            r: three(&s.noise.r, "r")?,
+            p0_h: three(&s.noise.p0_h, "p0_h")?,
+            p0_b: three(&s.noise.p0_b, "p0_b")?,
+            q_h: three(&s.noise.q_h, "q_h")?,
+            q_b: three(&s.noise.q_b, "q_b")?,
+        },
+        scale: BisScale {
+            length_m: s.length_m,
+            time_unit_s: s.time_unit_s,
+        },
+    })
+}
+
 /// The longest valid block of `run` as the model's validation data:
-/// γ = τ − g(η) and ν for an LPV model, deviations from the operating point
-/// for a subspace model, [τ | η] for a model with discovered terms.
-/// `inputs` are the force columns in DOF order.
+/// γ = τ − g(η) and ν for an LPV model, [τ | η] and ν for one with
+/// discovered terms, deviations from the operating point for a subspace
+/// model, thruster commands and (x, y, ψ unwrapped) for a DP ship. `inputs`
+/// are the force columns in DOF order (a DP ship uses its own `doc.inputs`,
+/// the thruster commands).
 pub fn validation_data(
     doc: &ModelDocument,
     run: &RunInput,
     inputs: &[String],
 ) -> Result<(f64, DMatrix<f64>, DMatrix<f64>), IdentifyError> {
+    if doc.kind == ModelKind::DpShip {
+        let segs = segments(run, &doc.inputs, &doc.outputs, 50)
+            .map_err(|e| IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string()))?;
+        let seg = segs
+            .into_iter()
+            .max_by_key(|s| s.y.nrows())
+            .expect("segments is non-empty");
+        let mut y = seg.y;
+        if y.ncols() == 3 {
+            let mut psi: Vec<f64> = y.column(2).iter().copied().collect();
+            unwrap_heading(&mut psi);
+            y.set_column(2, &nalgebra::DVector::from_vec(psi));
+        }
+        return Ok((seg.h, seg.u, y));
+    }
     let n = doc.dofs.len();
     let outputs: Vec<String> = doc
         .dofs

@@ -7,7 +7,9 @@ use super::campaign::{
     CampaignSpec, Durations, Excitation, ExperimentFamily, SpeedGrid, SpeedUnit,
 };
 use super::dof::{Dof, KNOT};
-use super::vessel::{DofLimits, InputChannels, Thruster, ThrusterKind, VesselKind, VesselProfile};
+use super::vessel::{
+    DofLimits, DpPrior, InputChannels, Thruster, ThrusterKind, VesselKind, VesselProfile,
+};
 
 /// The Surveyor ROV of the thesis (≈ 5 t, 9 hydraulic thrusters, τ logged per
 /// DOF, 20 Hz controller logged at 10 Hz). Velocity limits follow the
@@ -45,12 +47,14 @@ pub fn surveyor_rov() -> VesselProfile {
         limits,
         controller_rate_hz: 20.0,
         logger_rate_hz: 10.0,
+        dp_prior: None,
     }
 }
 
 /// Fossen, Sagatun & Sørensen's supply vessel (L = 76.2 m): two main
 /// propellers, three tunnel thrusters, one azimuth at α = 90°, with the
-/// thruster configuration matrix T″ of eq. 29 (non-dimensional, bis system).
+/// thruster configuration matrix T″ of eq. 29 and the inertia M″ of eq. 30
+/// (non-dimensional, Bis system).
 /// Time constants follow the identified A″ of eq. 51 scaled by √(L/g):
 /// surge 2.787/0.0318 ≈ 88 s, sway 2.787/0.0628 ≈ 44 s, yaw 2.787/0.2428 ≈ 11 s.
 pub fn supply_vessel() -> VesselProfile {
@@ -95,6 +99,15 @@ pub fn supply_vessel() -> VesselProfile {
         limits,
         controller_rate_hz: 1.0,
         logger_rate_hz: 1.0,
+        // M″ of eq. 30 (semi-empirical added mass, Faltinsen 1990).
+        dp_prior: Some(DpPrior {
+            length_m: 76.2,
+            inertia_bis: vec![
+                vec![1.1274, 0.0, 0.0],
+                vec![0.0, 1.8902, -0.0744],
+                vec![0.0, -0.0744, 0.1278],
+            ],
+        }),
     }
 }
 
@@ -139,4 +152,13 @@ pub fn supply_vessel_campaign(seed: u64) -> CampaignSpec {
         durations: Durations::default(),
         seed,
     }
+}
+
+/// The supply vessel's full trial campaign: SI1–SI3 (N = 2) and a 600 s
+/// validation run held out for the model check (the demo's DP campaign).
+pub fn supply_vessel_trial_campaign(seed: u64) -> CampaignSpec {
+    let mut c = supply_vessel_campaign(seed);
+    c.families.push(ExperimentFamily::Validation);
+    c.durations.validation_s = 600.0;
+    c
 }

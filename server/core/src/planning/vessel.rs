@@ -89,6 +89,66 @@ pub enum InputChannels {
     },
 }
 
+/// What a DP vessel's identification takes as known (Fossen et al. 1995,
+/// sec. 4.1): the inertia M″ including added mass, non-dimensional in the
+/// Bis system of the ship's length L (lengths in L, time in √(L/g), mass in
+/// the displacement mass m, forces in m·g, moments in m·g·L). The thruster
+/// configuration `inputs.configuration` of such a vessel is the T″ of eq. 29
+/// in the same system: force rows are direction cosines, the yaw row is the
+/// lever arm divided by L. Logs stay SI (m, s, rad); the parallel EKF converts
+/// them (x″ = x/L, t″ = t/√(L/g)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct DpPrior {
+    /// Ship length L (m): the Bis length unit.
+    pub length_m: f64,
+    /// M″ = M/m (Bis), 3 × 3 in the DOF order surge, sway, yaw; symmetric
+    /// positive definite (eq. 27, 30).
+    pub inertia_bis: Vec<Vec<f64>>,
+}
+
+impl DpPrior {
+    /// Acceleration of gravity of the Bis units (m/s²).
+    pub const GRAVITY: f64 = 9.81;
+
+    /// The Bis time unit √(L/g) (s).
+    pub fn time_unit_s(&self) -> f64 {
+        (self.length_m / Self::GRAVITY).sqrt()
+    }
+
+    /// The Bis velocity unit √(L·g) (m/s).
+    pub fn velocity_unit_mps(&self) -> f64 {
+        (self.length_m * Self::GRAVITY).sqrt()
+    }
+
+    fn validate(&self) -> Result<(), PlanError> {
+        positive("dp_prior.length_m", self.length_m)?;
+        let m = &self.inertia_bis;
+        if m.len() != 3 || m.iter().any(|r| r.len() != 3) {
+            return Err(PlanError::invalid(
+                "dp_prior.inertia_bis",
+                "M″ must be 3 × 3 (surge, sway, yaw)",
+            ));
+        }
+        if m.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(PlanError::invalid(
+                "dp_prior.inertia_bis",
+                "every entry must be a finite number",
+            ));
+        }
+        let mat = nalgebra::Matrix3::from_fn(|i, j| m[i][j]);
+        let scale = mat.abs().max();
+        if (mat - mat.transpose()).abs().max() > 1e-9 * scale || mat.cholesky().is_none() {
+            return Err(PlanError::invalid(
+                "dp_prior.inertia_bis",
+                "M″ must be symmetric positive definite (M = Mᵀ > 0, eq. 9)",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// A vessel as the planner needs it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
@@ -109,6 +169,10 @@ pub struct VesselProfile {
     pub controller_rate_hz: f64,
     /// Rate of the data logger (Hz); the thesis logged a 20 Hz controller at 10 Hz.
     pub logger_rate_hz: f64,
+    /// DP vessels: the known inertia M″ and the Bis scale, for the parallel
+    /// EKF identification (`parallel_ekf`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dp_prior: Option<DpPrior>,
 }
 
 impl VesselProfile {
@@ -205,6 +269,15 @@ impl VesselProfile {
                 format!("{} is not among the modeled DOFs", d.name()),
             ));
         }
+        if let Some(prior) = &self.dp_prior {
+            if self.kind != VesselKind::Dp3 || self.dofs != Dof::HORIZONTAL {
+                return Err(PlanError::invalid(
+                    "dp_prior",
+                    "only a DP vessel modelling surge, sway and yaw (in that order) has a DP prior",
+                ));
+            }
+            prior.validate()?;
+        }
         if let InputChannels::Thrusters {
             thrusters,
             configuration,
@@ -296,6 +369,13 @@ mod tests {
         let mut v = supply_vessel();
         v.dofs.push(Dof::Heave);
         assert_eq!(v.validate().unwrap_err().field, "dofs[3]");
+
+        let mut v = supply_vessel();
+        v.dp_prior.as_mut().unwrap().inertia_bis[1][2] = 0.5;
+        assert_eq!(v.validate().unwrap_err().field, "dp_prior.inertia_bis");
+        let mut v = surveyor_rov();
+        v.dp_prior = supply_vessel().dp_prior;
+        assert_eq!(v.validate().unwrap_err().field, "dp_prior");
 
         let mut v = surveyor_rov();
         v.limits.get_mut(&Dof::Yaw).unwrap().max_force_rate = f64::NAN;

@@ -15,7 +15,8 @@
 //!   `max_force`).
 //!
 //! DOFs the profile does not model get τ = 0 (left passive) and are not
-//! logged. Thruster-actuated (DP) profiles are not flown here.
+//! logged. Thruster-actuated (DP) profiles are flown by
+//! [`super::dp_ship::fly`].
 //!
 //! The controller feeds back ν over ground as the navigation filter would
 //! estimate it (taken noise-free); the logger then records τ commanded, ν and
@@ -74,7 +75,7 @@ pub enum TrialError {
 }
 
 impl TrialError {
-    fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
+    pub(crate) fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
         TrialError::Invalid {
             field: field.into(),
             reason: reason.into(),
@@ -628,7 +629,7 @@ fn body_current(eta: &Vector6<f64>, v_ned: &Vector3<f64>) -> Vector6<f64> {
     Vector6::new(v.x, v.y, v.z, 0.0, 0.0, 0.0)
 }
 
-fn wrap_pi(a: f64) -> f64 {
+pub(crate) fn wrap_pi(a: f64) -> f64 {
     let w = a.rem_euclid(std::f64::consts::TAU);
     if w > std::f64::consts::PI {
         w - std::f64::consts::TAU

@@ -8,7 +8,9 @@
 //! - [`model`]: M, T, A_h, K, C(ν), J(ψ), θ″ ↔ (A_h, K), eq. 51–52.
 //! - [`manoeuvres`]: the six decoupled manoeuvres (Fig. 5–7).
 //! - [`trial`]: simulation of a run with bias and measurement noise.
+//! - [`fly`]: a planned DP campaign flown and logged as SI CSV.
 
+pub mod fly;
 pub mod manoeuvres;
 pub mod model;
 pub mod paper;
@@ -17,6 +19,7 @@ pub mod trial;
 #[cfg(test)]
 mod tests;
 
+pub use fly::{DpFlightSettings, FlownDpRun, fly_dp_campaign, fly_dp_experiment};
 pub use manoeuvres::{Manoeuvre, manoeuvre_inputs};
 pub use model::{DpShip, Matrix3x6, N_THETA, THETA_NAMES};
 pub use trial::{DpRun, TrialConfig, simulate_campaign, simulate_trial};

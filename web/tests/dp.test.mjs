@@ -1,0 +1,81 @@
+// End-to-end DP identification in a real (headless) Chromium, on the demo:
+// the supply vessel's planned SI1–SI3 manoeuvres and validation run, flown
+// by the DP ship truth when the service seeds its demo (`--demo`), are
+// identified by the parallel EKF from the campaign page; the model page
+// shows θ″ with ± std, the DP matrices, and x, y, ψ validation plots.
+//
+//   cd web && npm ci && node --test tests/dp.test.mjs
+//
+// Env: see harness.mjs; DP_SCREENSHOT=/tmp/dp.png saves the model page.
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { harness, tid, inked } from './harness.mjs';
+
+const H = harness({ extraArgs: ['--demo'] });
+let cid;
+
+before(async () => {
+  await H.start();
+  const cs = await H.api('GET', '/api/campaigns');
+  assert.equal(cs.status, 200);
+  const dp = cs.json.find((c) => /Supply vessel/.test(JSON.stringify(c)));
+  assert.ok(dp, `the demo has the DP campaign: ${JSON.stringify(cs.json).slice(0, 300)}`);
+  cid = dp.id;
+  const runs = await H.api('GET', `/api/campaigns/${cid}/runs`);
+  assert.equal(runs.json.filter((r) => r.status === 'accepted').length, 8, 'six manoeuvres and two validation runs were flown');
+});
+
+after(() => H.stop());
+
+test('identify the demo supply vessel by the parallel EKF and read its model page', async () => {
+  await H.withPage([], async (page) => {
+    await page.goto(`${H.base}/#/campaigns/${cid}`);
+    const form = page.getByRole('form', { name: 'Identify a model' });
+    await form.waitFor();
+    const methods = await page.locator(`${tid('identify-method')} option`).evaluateAll((os) => os.map((o) => o.value));
+    assert.deepEqual(methods, ['parallel_ekf', 'n4sid']);
+    assert.match(await page.textContent(tid('identify-method-help')), /SI1 surge → SI2 sway–yaw → SI3 azimuth/);
+    const roles = await page.locator(tid('identify-role')).allTextContents();
+    assert.deepEqual(roles.filter((r) => /SI/.test(r)).sort(), ['estimation (SI1)', 'estimation (SI1)', 'estimation (SI2)', 'estimation (SI2)', 'estimation (SI3)', 'estimation (SI3)']);
+    assert.match(await page.textContent(tid('identify-roles')), /8 of 8 accepted runs: 6 to estimate from, 2 held out/);
+    await page.getByRole('button', { name: 'Start identification' }).click();
+    const row = page.locator(tid('job-row')).first();
+    await page.locator(`${tid('job-row')}[data-state="succeeded"]`).waitFor({ timeout: 120000 });
+
+    await row.getByRole('link', { name: /Open model/ }).click();
+    await page.waitForURL(/#\/models\/[0-9a-f-]{36}$/);
+    await page.locator(tid('param-table')).waitFor();
+    assert.match(await page.textContent(tid('model-method')), /Parallel EKF \(DP ship\)/);
+    assert.equal(await page.locator(tid('param-row')).count(), 9);
+    const symbols = await page.locator(`${tid('param-row')} td:nth-child(2)`).allTextContents();
+    assert.match(symbols.join(' '), /θ″1 \(A_h11\).*θ″9 \(K6\)/);
+    const stds = await page.locator(tid('param-std')).allTextContents();
+    assert.ok(stds.every((s) => /^± \S+/.test(s)), `± std on every θ″: ${stds}`);
+    // The DP matrices.
+    for (const t of ['dp-a-h', 'dp-k', 'dp-m', 'dp-d', 'dp-t', 'dp-a', 'dp-b', 'dp-a-si', 'dp-b-si']) {
+      assert.equal(await page.locator(tid(t)).count(), 1, t);
+    }
+    assert.match(await page.textContent(tid('dp-a-h')), /±/);
+    assert.equal(await page.locator(`${tid('dp-b')} td`).count(), 18);
+    // Validation of x, y, ψ with plots drawn.
+    const chans = await page.locator(tid('fit-row')).evaluateAll((rs) => rs.map((r) => r.dataset.channel));
+    assert.deepEqual(chans, ['x', 'y', 'psi', 'x', 'y', 'psi']);
+    for (const ch of ['x', 'psi']) {
+      const c = page.locator(`${tid('pvm-plot')}[data-channel="${ch}"] canvas >> nth=0`);
+      await c.waitFor();
+      await c.scrollIntoViewIfNeeded();
+      assert.ok(await inked(c) > 1000, `${ch} plot looks blank`);
+    }
+    // Fossen export is available; ZOH gives ν(k+1) = Φν + Γu.
+    const href = await page.getAttribute(tid('export-fossen'), 'href');
+    const res = await page.request.get(H.base + href);
+    assert.equal(res.status(), 200);
+    assert.equal((await res.json()).K.length, 6);
+    await page.getByLabel('Sample time h [s]').fill('1');
+    await page.getByRole('button', { name: 'Discretize (ZOH)' }).click();
+    await page.locator(tid('zoh-point')).first().waitFor();
+    assert.equal(await page.locator(`${tid('zoh-gamma')} td`).count(), 18);
+    if (process.env.DP_SCREENSHOT) await page.screenshot({ path: process.env.DP_SCREENSHOT, fullPage: true });
+  });
+});
