@@ -80,6 +80,9 @@ export const api = {
   lineage: (lineageId) => request('GET', `/api/models?lineage_id=${enc(lineageId)}`),
   // `hSample`: add the ZOH-discretized Φ, Γ at this sample time.
   model: (mid, hSample) => request('GET', `/api/models/${enc(mid)}${hSample != null ? `?h=${enc(hSample)}` : ''}`),
+  // Missing-physics discovery reports.
+  discrepancies: (mid) => request('GET', `/api/models/${enc(mid)}/discrepancies`),
+  discrepancy: (did) => request('GET', `/api/discrepancies/${enc(did)}`),
 };
 
 /**
@@ -137,6 +140,7 @@ export const urls = {
   quality: (rid) => `/api/runs/${enc(rid)}/quality`,
   run: (rid) => `#/runs/${enc(rid)}`,
   model: (mid) => `#/models/${enc(mid)}`,
+  discrepancy: (did) => `#/discrepancies/${enc(did)}`,
   jobEvents: (jid) => `/api/jobs/${enc(jid)}/events`,
   modelExport: (mid, format) => `/api/models/${enc(mid)}/export?format=${enc(format)}`,
 };

@@ -1,7 +1,7 @@
 // seatrial planner: hash router and page shell.
 //   #/vessels  #/vessels/new[?from=id]  #/vessels/{id}
 //   #/campaigns  #/campaigns/new[?vessel=id]  #/campaigns/{id}[/experiments/{eid}]
-//   #/runs/{id}  #/models/{id}
+//   #/runs/{id}  #/models/{id}  #/discrepancies/{id}
 
 import { api, ApiError } from './api.js';
 import { h, fill, banner, clearBanner, showFlash } from './forms.js';
@@ -10,6 +10,7 @@ import { campaignList, campaignForm } from './campaigns.js';
 import { campaignPage } from './plan.js';
 import { runPage } from './runpage.js';
 import { modelPage } from './modelpage.js';
+import { discoveryPage } from './discoverypage.js';
 import { destroyPlots } from './plots.js';
 
 const view = document.getElementById('view');
@@ -27,7 +28,7 @@ async function route() {
   const { parts, query } = parse();
   const my = ++seq;
   const section = parts[0] || 'campaigns';
-  const navSection = section === 'runs' || section === 'models' ? 'campaigns' : section; // runs and models live in their campaign
+  const navSection = ['runs', 'models', 'discrepancies'].includes(section) ? 'campaigns' : section; // runs and models live in their campaign
   document.querySelectorAll('[data-nav]').forEach((a) => a.classList.toggle('active', a.dataset.nav === navSection));
 
   // Experiment routes of the campaign already shown: no reload.
@@ -55,6 +56,8 @@ async function route() {
       ctl = await runPage(target, parts[1]);
     } else if (section === 'models' && parts[1]) {
       ctl = await modelPage(target, parts[1]);
+    } else if (section === 'discrepancies' && parts[1]) {
+      ctl = await discoveryPage(target, parts[1]);
     } else {
       target.append(h('h1', null, 'Not found'), h('p', null, h('a', { href: '#/campaigns' }, 'Campaigns')));
     }

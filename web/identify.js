@@ -12,6 +12,7 @@ export const METHOD_LABEL = {
   n4sid: 'N4SID (black box)',
   parallel_ekf: 'Parallel EKF (DP ship)',
   discovery: 'Missing-physics discovery',
+  discover: 'Missing-physics discovery',
 };
 /** What each method fits, shown under the method selector. */
 export const METHOD_HELP = {
@@ -216,7 +217,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
     const settings = req.settings || {};
     const tr = h('tr', { 'data-testid': 'job-row', 'data-job-id': j.id, 'data-state': j.state },
       h('td', { class: 'nowrap' }, fmtDate(j.created_at)),
-      h('td', null, METHOD_LABEL[req.method] || req.method || j.kind,
+      h('td', null, METHOD_LABEL[req.method] || req.method || METHOD_LABEL[j.kind] || j.kind,
         settings.structure ? h('span', { class: 'muted' }, ` · ${settings.structure}`) : null,
         h('div', { class: 'hint' }, `${(req.run_ids || []).length} runs${settings.validation_run_ids ? `, ${settings.validation_run_ids.length} held out` : ''}${j.attempts > 1 ? ` · attempt ${j.attempts}` : ''}`)),
       h('td', null, state),
@@ -244,7 +245,10 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
     if (RETRYABLE.has(j.state)) {
       acts.push(h('button', { type: 'button', class: 'btn small', 'data-testid': 'job-retry', onClick: () => retry(j.id) }, 'Retry'));
     }
-    if (j.state === 'succeeded' && j.result && j.result.model_id) {
+    if (j.state === 'succeeded' && j.result && j.result.discrepancy_id) {
+      acts.push(h('a', { class: 'btn small primary', href: urls.discrepancy(j.result.discrepancy_id), 'data-testid': 'job-report-link' }, 'Open report →'));
+      if (j.result.augmented_model_id) acts.push(h('a', { class: 'btn small', href: urls.model(j.result.augmented_model_id), 'data-testid': 'job-model-link' }, 'Augmented model →'));
+    } else if (j.state === 'succeeded' && j.result && j.result.model_id) {
       acts.push(h('a', { class: 'btn small primary', href: urls.model(j.result.model_id), 'data-testid': 'job-model-link' }, 'Open model →'));
     }
     fill(r.actions, acts);

@@ -10,6 +10,7 @@ import { h, fill, labelled, num, clearErrors, showFieldError } from './forms.js'
 import { METHOD_LABEL, KIND_LABEL_MODEL, errLine } from './identify.js';
 import { predictionPlot, autocorrelationPlot, zoomGroup } from './modelplots.js';
 import { exact } from './runplots.js';
+import { discoveryPanel } from './discoverpanel.js';
 
 /** Unit of an output channel (the log contract). */
 function outUnit(name) {
@@ -86,6 +87,7 @@ export async function modelPage(view, id) {
   const runLink = (rid) => h('a', { href: urls.run(rid), 'data-testid': 'provenance-run' }, runName.get(rid) || rid);
   const validation = Array.isArray(mv.validation) ? mv.validation : (mv.validation && mv.validation.runs) || [];
   const parent = model.parent_id ? lineage.find((x) => x.id === model.parent_id) : null;
+  const discovery = await discoveryPanel(model);
   const versions = lineage.slice().sort((a, b) => a.version - b.version);
 
   // ---- provenance -------------------------------------------------------------
@@ -265,6 +267,8 @@ export async function modelPage(view, id) {
     doc.dp_ship ? [h('h2', { class: 'section-title' }, 'DP ship matrices'), dpShipSection(doc.dp_ship, doc.inputs || [])] : null,
     h('h2', { class: 'section-title' }, 'Validation ', h('span', { class: 'hint' }, 'on runs the model was not fitted to')),
     valSections.length ? valSections : h('p', { class: 'empty', 'data-testid': 'no-validation' }, 'No validation report.'),
+    h('h2', { class: 'section-title' }, 'Missing physics ', h('span', { class: 'hint' }, 'where simulation and recordings part, and why')),
+    discovery.el,
     h('h2', { class: 'section-title' }, 'Discrete-time model'),
     zohForm,
     zohOut);
@@ -273,6 +277,6 @@ export async function modelPage(view, id) {
   return {
     key: `model:${id}`,
     mount() { for (const f of plotJobs) f(); },
-    destroy() {},
+    destroy() { discovery.destroy(); },
   };
 }

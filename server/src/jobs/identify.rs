@@ -4,12 +4,10 @@
 //! Fossen et al. 1995). The numerics are the core's
 //! [`seatrial_core::identification`]; this file loads, calls and stores.
 
-use std::path::PathBuf;
-
 use seatrial_core::estimation::Progress;
 use seatrial_core::identification::{
     EkfCampaignSettings, Identified, IdentifyError, LambdaCampaignSettings, N4sidCampaignSettings,
-    RunInput, identify_ekf_campaign, identify_lambda_campaign, identify_n4sid_campaign,
+    identify_ekf_campaign, identify_lambda_campaign, identify_n4sid_campaign,
 };
 use seatrial_core::logs::input_columns;
 use seatrial_core::planning::VesselProfile;
@@ -18,11 +16,12 @@ use serde::de::DeserializeOwned;
 use sqlx::SqliteConnection;
 
 use super::handler::{BoxFuture, Compute, JobContext, JobFailure, JobHandler, Persist, compute};
+use super::run_inputs;
 use crate::error::ApiError;
-use crate::processing::{self, RunMeta, RunSummary, generalized_force_columns};
+use crate::processing::generalized_force_columns;
 use crate::storage::jobs::{Job, JobRequest};
 use crate::storage::models::{self, Lineage, NewModel};
-use crate::storage::{campaigns, plans, runs, vessels};
+use crate::storage::{campaigns, runs, vessels};
 
 /// Methods of `identify`: `lambda_kf` (ROV LPV), `n4sid` (black box, any
 /// vessel), `parallel_ekf` (DP vessels).
@@ -81,16 +80,6 @@ fn check_settings(method: &str, settings: &serde_json::Value) -> Result<(), (Str
         "parallel_ekf" => parse_settings::<EkfCampaignSettings>(settings).map(|_| ()),
         _ => parse_settings::<N4sidCampaignSettings>(settings).map(|_| ()),
     }
-}
-
-/// A run as stored, ready to be re-read on the worker.
-struct StoredRun {
-    id: String,
-    name: String,
-    files: Vec<(String, PathBuf)>,
-    meta: RunMeta,
-    family: Option<seatrial_core::planning::ExperimentFamily>,
-    grid_speed_mps: Option<f64>,
 }
 
 impl JobHandler for Identify {
@@ -167,28 +156,7 @@ impl JobHandler for Identify {
                 }
                 v
             };
-            let mut stored = Vec::new();
-            for r in chosen {
-                let planned = match &r.experiment_id {
-                    Some(eid) => plans::experiment(&cx.db, &cid, eid)
-                        .await?
-                        .map(|(e, _)| e.experiment),
-                    None => None,
-                };
-                let meta = RunMeta::of_stored(r.summary.as_ref());
-                stored.push(StoredRun {
-                    id: r.id.clone(),
-                    name: r.name.clone(),
-                    files: r
-                        .files
-                        .iter()
-                        .map(|f| (f.role.clone(), cx.blobs.path(&f.sha256)))
-                        .collect(),
-                    meta,
-                    family: planned.as_ref().map(|e| e.family),
-                    grid_speed_mps: planned.as_ref().and_then(|e| e.grid_speed_mps),
-                });
-            }
+            let stored = run_inputs::describe(cx, &cid, chosen).await?;
             let method = req
                 .method
                 .clone()
@@ -204,19 +172,7 @@ impl JobHandler for Identify {
                 .unwrap_or(Lineage::New);
             Ok(compute(move |progress: &mut dyn Progress| {
                 progress.update(0.0, "reading runs")?;
-                let mut inputs = Vec::new();
-                for s in &stored {
-                    let mut summary = RunSummary::default();
-                    let record = processing::load_record(&profile, &s.files, &s.meta, &mut summary)
-                        .map_err(|e| JobFailure::field(format!("runs[{}]", s.id), e.message))?;
-                    inputs.push(RunInput {
-                        run_id: s.id.clone(),
-                        name: s.name.clone(),
-                        family: s.family,
-                        grid_speed_mps: s.grid_speed_mps,
-                        record,
-                    });
-                }
+                let inputs = run_inputs::read(&profile, &stored)?;
                 let mut sub = seatrial_core::estimation::SubProgress::new(progress, 0.05, 0.95);
                 let forces = generalized_force_columns(&profile);
                 let out: Result<Identified, IdentifyError> = match method.as_str() {

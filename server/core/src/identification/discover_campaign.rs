@@ -479,10 +479,26 @@ fn summarize(
             speeds_text(speeds)
         ));
     }
+    // Look-alikes, once per pair: where, and the first deciding run proposed.
+    let mut pairs: BTreeMap<(Effect, Effect), (Vec<f64>, String)> = BTreeMap::new();
     for p in points {
         for a in &p.report.ambiguities {
-            out.push(format!("{:.2} m/s: {}", p.grid_speed_mps, a.text));
+            let e = pairs
+                .entry((a.chosen, a.alternative))
+                .or_insert_with(|| (vec![], a.text.clone()));
+            e.0.push(p.grid_speed_mps);
         }
+    }
+    for (speeds, text) in pairs.values() {
+        out.push(format!(
+            "At {} m/s: {text}{}",
+            speeds_text(speeds),
+            if speeds.len() > 1 {
+                " (numbers and run from the first of these speeds; each speed's report has its own)"
+            } else {
+                ""
+            }
+        ));
     }
     if !skipped.is_empty() {
         out.push(format!("Not examined: {}.", skipped.join("; ")));
