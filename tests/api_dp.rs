@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::sim::multipart;
+use common::flights::upload_planned;
 use common::{TestApp, dp_profile, rov_profile};
 use seatrial::jobs::{JobRegistry, JobsConfig};
 use seatrial_core::planning::examples::{supply_vessel, supply_vessel_trial_campaign};
@@ -48,27 +48,7 @@ async fn flown_dp_campaign(app: &TestApp) -> String {
     .unwrap();
     assert_eq!(flown.len(), 8);
     for run in flown {
-        let eid = plan.json["experiments"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|e| e["code"] == run.code.as_str())
-            .and_then(|e| e["id"].as_str())
-            .unwrap()
-            .to_string();
-        let meta = json!({ "experiment_id": eid }).to_string();
-        let (ct, body) = multipart(&[
-            ("meta", None, &meta),
-            ("file", Some(&format!("{}.csv", run.code)), &run.csv),
-        ]);
-        let r = app
-            .raw(
-                "POST",
-                &format!("/api/campaigns/{cid}/runs"),
-                Some((&ct, body)),
-            )
-            .await;
-        assert_eq!(r.status, 201, "{}: {}", run.code, r.text);
+        upload_planned(app, &cid, &plan.json, &run.code, &run.csv).await;
     }
     cid
 }

@@ -6,7 +6,7 @@
 use seatrial_core::planning::{CampaignSpec, generate_plan};
 use seatrial_core::simulation::rov::RovTruth;
 use seatrial_core::simulation::trials::{TrialSettings, fly_experiment};
-use serde_json::json;
+use serde_json::{Value, json};
 
 use super::sim::multipart;
 use super::{TestApp, rov_profile};
@@ -57,28 +57,33 @@ pub async fn flown_campaign(app: &TestApp, truth: &RovTruth) -> String {
     };
     for planned in &core_plan.experiments {
         let code = &planned.experiment.code;
-        let eid = plan.json["experiments"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|e| e["code"] == *code)
-            .and_then(|e| e["id"].as_str())
-            .unwrap_or_else(|| panic!("experiment {code} not in the stored plan"))
-            .to_string();
         let flown = fly_experiment(&profile, truth, planned, &settings).unwrap();
-        let meta = json!({ "experiment_id": eid }).to_string();
-        let (ct, body) = multipart(&[
-            ("meta", None, &meta),
-            ("file", Some(&format!("{code}.csv")), &flown.csv),
-        ]);
-        let r = app
-            .raw(
-                "POST",
-                &format!("/api/campaigns/{cid}/runs"),
-                Some((&ct, body)),
-            )
-            .await;
-        assert_eq!(r.status, 201, "{code}: {}", r.text);
+        upload_planned(app, &cid, &plan.json, code, &flown.csv).await;
     }
     cid
+}
+
+/// Uploads the log `csv` of the planned experiment `code` (its id looked up
+/// in the stored `plan`) to campaign `cid`, linked to that experiment.
+pub async fn upload_planned(app: &TestApp, cid: &str, plan: &Value, code: &str, csv: &str) {
+    let eid = plan["experiments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["code"] == code)
+        .and_then(|e| e["id"].as_str())
+        .unwrap_or_else(|| panic!("experiment {code} not in the stored plan"));
+    let meta = json!({ "experiment_id": eid }).to_string();
+    let (ct, body) = multipart(&[
+        ("meta", None, &meta),
+        ("file", Some(&format!("{code}.csv")), csv),
+    ]);
+    let r = app
+        .raw(
+            "POST",
+            &format!("/api/campaigns/{cid}/runs"),
+            Some((&ct, body)),
+        )
+        .await;
+    assert_eq!(r.status, 201, "{code}: {}", r.text);
 }
