@@ -7,7 +7,7 @@ use nalgebra::DMatrix;
 
 use super::document::{LpvPoint, ModelDocument, from_rows};
 use super::error::IdentifyError;
-use crate::discrepancy::{AugmentedModel, Baseline, Restoring};
+use crate::discrepancy::{AugmentedModel, Baseline, Record, Restoring};
 use crate::planning::dof::Dof;
 use crate::validation::{Predictor, ValidationRecord};
 
@@ -66,10 +66,11 @@ pub fn augmented_at(
     })
 }
 
-/// The augmented LPV model as a predictor with u = [τ | η]. A run is
-/// predicted by the sub-model of the grid speed nearest its mean measured
-/// forward speed (runs fly one grid speed; scheduling sample by sample
-/// would switch the actuator states of lag and delay terms mid-run).
+/// The augmented LPV model as a predictor with u = [τ | η]. Scheduling is
+/// by nearest grid point on the measured forward speed smoothed over 10 s
+/// (see [`pieces_by_speed`]): each stretch of a run is predicted by its
+/// sub-model; a free run carries its simulated state across the switch,
+/// and k-step predictions start k samples before the stretch.
 pub struct AugmentedLpv {
     speeds: Vec<f64>,
     models: Vec<AugmentedModel>,
@@ -98,13 +99,56 @@ impl AugmentedLpv {
         })
     }
 
-    fn pick(&self, rec: &ValidationRecord<'_>) -> &AugmentedModel {
-        let speed = match self.surge {
-            Some(j) if rec.y.nrows() > 0 => rec.y.column(j).mean(),
-            _ => self.speeds[0],
-        };
-        &self.models[super::roles::nearest_grid_index(&self.speeds, speed)]
+    fn n(&self) -> usize {
+        self.models[0].dofs.len()
     }
+
+    fn pieces(&self, rec: &ValidationRecord<'_>) -> Vec<(usize, usize, usize)> {
+        let len = rec.y.nrows();
+        match self.surge {
+            Some(j) if self.speeds.len() > 1 && len > 0 => {
+                let u: Vec<f64> = rec.y.column(j).iter().copied().collect();
+                pieces_by_speed(&u, rec.h, &self.speeds)
+            }
+            _ => vec![(0, len, 0)],
+        }
+    }
+
+    fn record(&self, rec: &ValidationRecord<'_>, start: usize, end: usize) -> Option<Record> {
+        let n = self.n();
+        if rec.u.ncols() != n + 6 || rec.y.ncols() != n || rec.u.nrows() != rec.y.nrows() {
+            return None;
+        }
+        Some(Record {
+            name: String::new(),
+            h: rec.h,
+            tau: rec.u.view((start, 0), (end - start, n)).into_owned(),
+            nu: rec.y.rows(start, end - start).into_owned(),
+            eta: rec.u.view((start, n), (end - start, 6)).into_owned(),
+        })
+    }
+}
+
+/// Maximal stretches [start, end) over which the forward speed `u`,
+/// smoothed over 10 s, stays nearest one grid point (the grid index is the
+/// third element).
+pub fn pieces_by_speed(u: &[f64], h: f64, grid: &[f64]) -> Vec<(usize, usize, usize)> {
+    let n = u.len();
+    let half = ((5.0 / h).round() as usize).max(1);
+    let mut prefix = vec![0.0; n + 1];
+    for k in 0..n {
+        prefix[k + 1] = prefix[k] + u[k];
+    }
+    let mut pieces: Vec<(usize, usize, usize)> = Vec::new();
+    for k in 0..n {
+        let (a, b) = (k.saturating_sub(half), (k + half + 1).min(n));
+        let i = super::roles::nearest_grid_index(grid, (prefix[b] - prefix[a]) / (b - a) as f64);
+        match pieces.last_mut() {
+            Some(last) if last.2 == i => last.1 = k + 1,
+            _ => pieces.push((k, k + 1, i)),
+        }
+    }
+    pieces
 }
 
 impl Predictor for AugmentedLpv {
@@ -113,10 +157,142 @@ impl Predictor for AugmentedLpv {
     }
 
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {
-        Predictor::predict_k_step(self.pick(rec), rec, k)
+        let (len, n) = (rec.y.nrows(), self.n());
+        let mut out = DMatrix::from_element(len, n, f64::NAN);
+        for (start, end, i) in self.pieces(rec) {
+            let from = start.saturating_sub(k);
+            let Some(r) = self.record(rec, from, end) else {
+                return out;
+            };
+            let p = self.models[i].predict_k_step(&r, k);
+            for t in start..end {
+                for c in 0..n {
+                    out[(t, c)] = p[(t - from, c)];
+                }
+            }
+        }
+        out
     }
 
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
-        Predictor::simulate(self.pick(rec), rec)
+        let (len, n) = (rec.y.nrows(), self.n());
+        let mut out = DMatrix::from_element(len, n, f64::NAN);
+        for (start, end, i) in self.pieces(rec) {
+            // Start one sample early from the simulated state there.
+            let from = start.saturating_sub(1);
+            let Some(mut r) = self.record(rec, from, end) else {
+                return out;
+            };
+            if start > 0 {
+                for c in 0..n {
+                    r.nu[(0, c)] = out[(from, c)];
+                }
+            }
+            let s = self.models[i].simulate(&r);
+            for t in start..end {
+                for c in 0..n {
+                    out[(t, c)] = s[(t - from, c)];
+                }
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identification::document::{LpvDoc, Method, ModelKind};
+
+    fn doc(d_fast: f64) -> ModelDocument {
+        let point = |speed: f64, d: f64| LpvPoint {
+            speed_mps: speed,
+            m: vec![vec![100.0, 0.0], vec![0.0, 50.0]],
+            m_std: vec![vec![0.0; 2]; 2],
+            d_bar: vec![vec![d, 0.0], vec![0.0, 25.0]],
+            d_bar_std: vec![vec![0.0; 2]; 2],
+            a: vec![vec![0.0; 2]; 2],
+            a_std: vec![vec![0.0; 2]; 2],
+            b: vec![vec![0.0; 2]; 2],
+            b_std: vec![vec![0.0; 2]; 2],
+            n_samples: 0,
+            run_ids: vec![],
+            augmentation: None,
+        };
+        ModelDocument {
+            kind: ModelKind::Lpv,
+            method: Method::LambdaKf,
+            dofs: vec![Dof::Surge, Dof::Yaw],
+            inputs: vec![],
+            outputs: vec!["u".into(), "r".into()],
+            restoring: None,
+            lpv: Some(LpvDoc {
+                t_lambda_s: 0.5,
+                structure: "diagonal".into(),
+                coupling: vec![],
+                points: vec![point(0.5, 50.0), point(1.5, d_fast)],
+            }),
+            dp_ship: None,
+            state_space: None,
+            parameters: vec![],
+            structure_findings: vec![],
+            notes: vec![],
+        }
+    }
+
+    /// A run that steps from 0.5 to 1.5 m/s half way: u = [τ | η], y = ν.
+    fn run() -> (DMatrix<f64>, DMatrix<f64>) {
+        let n = 2000;
+        let y = DMatrix::from_fn(n, 2, |k, j| {
+            if j == 0 {
+                if k < n / 2 { 0.5 } else { 1.5 }
+            } else {
+                0.1 * (k as f64 * 0.05).sin()
+            }
+        });
+        let u = DMatrix::from_fn(n, 8, |k, j| match j {
+            0 => 50.0 * y[(k, 0)] + 20.0 * (k as f64 * 0.1).sin(),
+            1 => 5.0 * (k as f64 * 0.07).cos(),
+            _ => 0.0,
+        });
+        (u, y)
+    }
+
+    /// With identical sub-models the scheduled free run equals one model's
+    /// free run over the whole record: the state is carried across the switch.
+    #[test]
+    fn free_run_carries_its_state_across_a_grid_switch() {
+        let lpv = AugmentedLpv::from_doc(&doc(50.0)).unwrap();
+        let (u, y) = run();
+        let rec = ValidationRecord {
+            h: 0.1,
+            u: &u,
+            y: &y,
+        };
+        assert_eq!(lpv.pieces(&rec).len(), 2);
+        let scheduled = Predictor::simulate(&lpv, &rec);
+        let single = Predictor::simulate(&lpv.models[0], &rec);
+        assert!((scheduled - single).abs().max() < 1e-12);
+        let k = Predictor::predict_k_step(&lpv, &rec, 10);
+        let k1 = Predictor::predict_k_step(&lpv.models[0], &rec, 10);
+        assert!((k.rows(10, 1990) - k1.rows(10, 1990)).abs().max() < 1e-12);
+    }
+
+    /// Different damping at 1.5 m/s: the second half follows that sub-model
+    /// (steady surge u = τ/d: 0.5 m/s → (50·1.5)/80 in the mean).
+    #[test]
+    fn each_stretch_is_predicted_by_its_grid_point() {
+        let lpv = AugmentedLpv::from_doc(&doc(80.0)).unwrap();
+        let (u, y) = run();
+        let rec = ValidationRecord {
+            h: 0.1,
+            u: &u,
+            y: &y,
+        };
+        let sim = Predictor::simulate(&lpv, &rec);
+        let tail = sim.view((1600, 0), (400, 1)).mean();
+        assert!((tail - 75.0 / 80.0).abs() < 0.02, "{tail}");
+        let head = sim.view((600, 0), (400, 1)).mean();
+        assert!((head - 0.5).abs() < 0.02, "{head}");
     }
 }

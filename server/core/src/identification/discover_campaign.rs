@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use super::augmented::baseline_at;
+use super::augmented::{baseline_at, pieces_by_speed};
 use super::dataset::{RunInput, segments};
 use super::document::{Method, ModelDocument, ModelKind, ParameterRow, PointAugmentation, to_rows};
 use super::error::IdentifyError;
@@ -173,27 +173,6 @@ fn records(
         }
     }
     Ok(out)
-}
-
-/// Maximal stretches [start, end) over which the forward speed `u`,
-/// smoothed over 10 s, stays nearest one grid point.
-fn pieces_by_speed(u: &[f64], h: f64, grid: &[f64]) -> Vec<(usize, usize, usize)> {
-    let n = u.len();
-    let half = ((5.0 / h).round() as usize).max(1);
-    let mut prefix = vec![0.0; n + 1];
-    for k in 0..n {
-        prefix[k + 1] = prefix[k] + u[k];
-    }
-    let mut pieces: Vec<(usize, usize, usize)> = Vec::new();
-    for k in 0..n {
-        let (a, b) = (k.saturating_sub(half), (k + half + 1).min(n));
-        let i = nearest_grid_index(grid, (prefix[b] - prefix[a]) / (b - a) as f64);
-        match pieces.last_mut() {
-            Some(last) if last.2 == i => last.1 = k + 1,
-            _ => pieces.push((k, k + 1, i)),
-        }
-    }
-    pieces
 }
 
 /// The shortest record discovery accepts: the filter transient and the
