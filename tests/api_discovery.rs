@@ -224,3 +224,84 @@ async fn bad_discover_requests_name_the_field() {
         .await;
     assert_eq!(r.status, 404);
 }
+
+/// More concealed effects through the whole service path (planned campaign
+/// flown under PI control by a truth the λ model represents except for the
+/// concealed effect, λ identification, discovery job): the effect and its
+/// DOF are named first, at every grid speed, and the augmented model's free
+/// run in that DOF improves on the held-out runs.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn concealed_effects_are_named_through_the_service() {
+    use common::flights::diagonal_truth;
+    let mut quadratic = diagonal_truth();
+    quadratic.quadratic_damping[1] = 30000.0;
+    let mut lag = diagonal_truth();
+    lag.actuators.time_constants[2] = 0.8;
+    let mut delay = diagonal_truth();
+    delay.actuators.delay_samples = 4;
+    for (name, truth, effect, dof, ch) in [
+        (
+            "quadratic damping",
+            quadratic,
+            "quadratic_damping",
+            Some("sway"),
+            "v",
+        ),
+        ("actuator lag", lag, "actuator_lag", Some("heave"), "w"),
+        ("input delay", delay, "common_input_delay", None, "u"),
+    ] {
+        let app = app().await;
+        let cid = flown_campaign(&app, &truth).await;
+        let job = run_job(
+            &app,
+            json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf" }),
+        )
+        .await;
+        let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+        let job = run_job(&app, json!({ "kind": "discover", "model_id": mid })).await;
+        let did = job["result"]["discrepancy_id"].as_str().unwrap();
+        let d = app
+            .call("GET", "/api/discrepancies/{id}", &[did], None)
+            .await;
+        let first = &d.json["report"]["effects"][0];
+        assert_eq!(
+            first["effect"]["effect"], effect,
+            "{name}: {:#}",
+            d.json["report"]["summary"]
+        );
+        if let Some(dof) = dof {
+            assert_eq!(first["effect"]["dof"], dof, "{name}");
+        }
+        assert_eq!(
+            first["grid_speeds_mps"].as_array().unwrap().len(),
+            2,
+            "{name}"
+        );
+        let aug = job["result"]["augmented_model_id"].as_str().unwrap();
+        let base = app.call("GET", "/api/models/{id}", &[&mid], None).await;
+        let new = app.call("GET", "/api/models/{id}", &[aug], None).await;
+        let (b, a) = (
+            sim_fit(&base.json["validation"], ch),
+            sim_fit(&new.json["validation"], ch),
+        );
+        assert!(a > b, "{name}: {ch} free run {b} → {a}");
+        eprintln!("{name}: {} | {ch} free run {b:.3} → {a:.3}", first["label"]);
+    }
+    // The clean base: nothing named, no new version.
+    let app = app().await;
+    let cid = flown_campaign(&app, &diagonal_truth()).await;
+    let job = run_job(
+        &app,
+        json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf" }),
+    )
+    .await;
+    let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+    let job = run_job(&app, json!({ "kind": "discover", "model_id": mid })).await;
+    assert!(job["result"]["augmented_model_id"].is_null(), "{job}");
+    let did = job["result"]["discrepancy_id"].as_str().unwrap();
+    let d = app
+        .call("GET", "/api/discrepancies/{id}", &[did], None)
+        .await;
+    assert!(d.json["report"]["effects"].as_array().unwrap().is_empty());
+    assert!(d.json["augmented_model"].is_null());
+}

@@ -19,6 +19,21 @@ pub fn linear_truth() -> RovTruth {
     truth
 }
 
+/// A truth the λ model represents exactly at every grid speed: the
+/// Surveyor-like truth with diagonal M, constant diagonal damping (its value
+/// at 0.75 m/s) and neutral restoring — the clean base of concealed-effect
+/// cases.
+pub fn diagonal_truth() -> RovTruth {
+    use seatrial_core::simulation::rov::LinearDamping;
+    let rich = RovTruth::surveyor_like();
+    let (mut m, mut d) = (rich.m, rich.damping.at(0.75));
+    for x in [&mut m, &mut d] {
+        x.fill_lower_triangle(0.0, 1);
+        x.fill_upper_triangle(0.0, 1);
+    }
+    RovTruth::new(m, LinearDamping::constant(d))
+}
+
 /// Creates the Surveyor and a campaign on 1 and 2 kn with recursive and
 /// validation experiments, flies every planned experiment (≤ 240 s each)
 /// through `truth`, and uploads the logs linked to their experiments.
