@@ -26,6 +26,16 @@ async fn run_job(app: &TestApp, body: Value) -> Value {
     job
 }
 
+/// Identifies campaign `cid` by `method`; the stored model's id.
+async fn identified(app: &TestApp, cid: &str, method: &str) -> String {
+    let job = run_job(
+        app,
+        json!({ "kind": "identify", "campaign_id": cid, "method": method }),
+    )
+    .await;
+    job["result"]["model_id"].as_str().unwrap().to_string()
+}
+
 fn sim_fit(validation: &Value, ch: &str) -> f64 {
     validation[0]["report"]["channels"]
         .as_array()
@@ -40,12 +50,7 @@ fn sim_fit(validation: &Value, ch: &str) -> f64 {
 async fn discovery_names_the_righting_moment_and_stores_the_augmented_model() {
     let app = app().await;
     let cid = flown_campaign(&app, &RovTruth::surveyor_like()).await;
-    let job = run_job(
-        &app,
-        json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf" }),
-    )
-    .await;
-    let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+    let mid = identified(&app, &cid, "lambda_kf").await;
 
     let job = run_job(
         &app,
@@ -146,12 +151,7 @@ async fn discovery_names_the_righting_moment_and_stores_the_augmented_model() {
 async fn bad_discover_requests_name_the_field() {
     let app = app().await;
     let cid = flown_campaign(&app, &RovTruth::surveyor_like()).await;
-    let job = run_job(
-        &app,
-        json!({ "kind": "identify", "campaign_id": cid, "method": "n4sid" }),
-    )
-    .await;
-    let black_box = job["result"]["model_id"].as_str().unwrap().to_string();
+    let black_box = identified(&app, &cid, "n4sid").await;
     let cases = [
         (json!({ "kind": "discover" }), 422, "model_id"),
         (
@@ -170,12 +170,7 @@ async fn bad_discover_requests_name_the_field() {
         assert_eq!(r.status.as_u16(), status, "{body}: {}", r.text);
         assert_eq!(r.json["field"], field, "{body}: {}", r.text);
     }
-    let job = run_job(
-        &app,
-        json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf" }),
-    )
-    .await;
-    let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+    let mid = identified(&app, &cid, "lambda_kf").await;
     let cases = [
         (
             json!({ "kind": "discover", "model_id": mid, "settings": { "discovery": { "k_step": "ten" } } }),
@@ -252,12 +247,7 @@ async fn concealed_effects_are_named_through_the_service() {
     ] {
         let app = app().await;
         let cid = flown_campaign(&app, &truth).await;
-        let job = run_job(
-            &app,
-            json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf" }),
-        )
-        .await;
-        let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+        let mid = identified(&app, &cid, "lambda_kf").await;
         let job = run_job(&app, json!({ "kind": "discover", "model_id": mid })).await;
         let did = job["result"]["discrepancy_id"].as_str().unwrap();
         let d = app
@@ -290,12 +280,7 @@ async fn concealed_effects_are_named_through_the_service() {
     // The clean base: nothing named, no new version.
     let app = app().await;
     let cid = flown_campaign(&app, &diagonal_truth()).await;
-    let job = run_job(
-        &app,
-        json!({ "kind": "identify", "campaign_id": cid, "method": "lambda_kf" }),
-    )
-    .await;
-    let mid = job["result"]["model_id"].as_str().unwrap().to_string();
+    let mid = identified(&app, &cid, "lambda_kf").await;
     let job = run_job(&app, json!({ "kind": "discover", "model_id": mid })).await;
     assert!(job["result"]["augmented_model_id"].is_null(), "{job}");
     let did = job["result"]["discrepancy_id"].as_str().unwrap();
