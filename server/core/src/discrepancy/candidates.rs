@@ -36,6 +36,21 @@ pub enum Effect {
         /// The DOF.
         dof: Dof,
     },
+    /// Cubic damping c·ν_i³ in DOF i: drag that grows faster than |ν_i|ν_i
+    /// at the top of the speed range (and less near zero).
+    CubicDamping {
+        /// The DOF.
+        dof: Dof,
+    },
+    /// Cross-flow damping d·|ν_j|·ν_i in DOF i's equation (j ≠ i): the
+    /// damping of ν_i grows with the size of another velocity, whatever its
+    /// sign (e.g. sway damping growing with |r| in a turn).
+    CrossDamping {
+        /// The equation i (and the velocity damped).
+        dof: Dof,
+        /// The velocity j whose size scales the damping.
+        from: Dof,
+    },
     /// Coriolis–centripetal C(ν)ν with the structure C(ν) takes from the
     /// baseline M (Fossen), one scale factor θ (≈ 1 when M is right) over
     /// all DOFs.
@@ -103,6 +118,10 @@ pub enum Effect {
 pub enum Family {
     /// |ν|ν damping.
     QuadraticDamping,
+    /// ν³ damping.
+    CubicDamping,
+    /// |ν_j|ν_i cross-flow damping.
+    CrossDamping,
     /// C(ν)ν products.
     Coriolis,
     /// g(η) shapes.
@@ -128,6 +147,8 @@ impl Family {
     pub fn name(self) -> &'static str {
         match self {
             Family::QuadraticDamping => "quadratic damping",
+            Family::CubicDamping => "cubic damping",
+            Family::CrossDamping => "cross-flow damping",
             Family::Coriolis => "Coriolis–centripetal coupling",
             Family::Restoring => "restoring force",
             Family::ConstantLoad => "constant load (tether)",
@@ -179,6 +200,8 @@ impl Effect {
     pub fn family(&self) -> Family {
         match self {
             Effect::QuadraticDamping { .. } => Family::QuadraticDamping,
+            Effect::CubicDamping { .. } => Family::CubicDamping,
+            Effect::CrossDamping { .. } => Family::CrossDamping,
             Effect::CoriolisFromM | Effect::CoriolisProduct { .. } => Family::Coriolis,
             Effect::Restoring { .. } => Family::Restoring,
             Effect::ConstantLoad { .. } => Family::ConstantLoad,
@@ -195,6 +218,8 @@ impl Effect {
     pub fn dof(&self) -> Option<Dof> {
         match *self {
             Effect::QuadraticDamping { dof }
+            | Effect::CubicDamping { dof }
+            | Effect::CrossDamping { dof, .. }
             | Effect::CoriolisProduct { dof, .. }
             | Effect::Restoring { dof, .. }
             | Effect::ConstantLoad { dof }
@@ -246,6 +271,24 @@ impl Effect {
                     vu.trim_end_matches("/s")
                 )]
             }
+            Effect::CubicDamping { dof } => {
+                let s = dof.velocity_symbol();
+                let vu = dof.velocity_unit();
+                vec![format!(
+                    "d_{s}{s}{s} ({}·s³/{}³)",
+                    unit(dof),
+                    vu.trim_end_matches("/s")
+                )]
+            }
+            Effect::CrossDamping { dof, from } => {
+                let (i, j) = (dof.velocity_symbol(), from.velocity_symbol());
+                vec![format!(
+                    "d_{i}|{j}| ({}/(({})·({})))",
+                    unit(dof),
+                    dof.velocity_unit(),
+                    from.velocity_unit()
+                )]
+            }
             Effect::CoriolisFromM => vec!["scale of C(ν) from M (–)".into()],
             Effect::CoriolisProduct { dof, a, b } => vec![format!(
                 "coefficient of {}·{} in {} ({})",
@@ -282,6 +325,16 @@ impl Effect {
                 let s = dof.velocity_symbol();
                 format!("quadratic damping |{s}|{s} in {}", dof.name())
             }
+            Effect::CubicDamping { dof } => {
+                let s = dof.velocity_symbol();
+                format!("cubic damping {s}³ in {}", dof.name())
+            }
+            Effect::CrossDamping { dof, from } => format!(
+                "cross-flow damping |{}|{} in {}",
+                from.velocity_symbol(),
+                dof.velocity_symbol(),
+                dof.name()
+            ),
             Effect::CoriolisFromM => "Coriolis–centripetal C(ν)ν from M".into(),
             Effect::CoriolisProduct { dof, a, b } => format!(
                 "Coriolis product {}·{} in {}",
@@ -349,6 +402,8 @@ impl Effect {
                 let x = v(dof);
                 x.abs() * x
             }
+            Effect::CubicDamping { dof } if dof == row_dof => v(dof).powi(3),
+            Effect::CrossDamping { dof, from } if dof == row_dof => v(from).abs() * v(dof),
             Effect::CoriolisFromM => coriolis_force(ctx.dofs, ctx.m_ref, nu)[row],
             Effect::CoriolisProduct { dof, a, b } if dof == row_dof => v(a) * v(b),
             Effect::Restoring { dof, shape } if dof == row_dof => {
@@ -445,6 +500,10 @@ pub fn coriolis_force(dofs: &[Dof], m: &DMatrix<f64>, nu: &[f64]) -> Vec<f64> {
 pub struct LibrarySettings {
     /// |ν_i|ν_i per DOF.
     pub quadratic_damping: bool,
+    /// ν_i³ per DOF.
+    pub cubic_damping: bool,
+    /// |ν_j|ν_i for every ordered pair of modeled DOFs (i ≠ j).
+    pub cross_damping: bool,
     /// C(ν)ν from M and its single products.
     pub coriolis: bool,
     /// sin θ, cos θ sin φ shapes.
@@ -469,6 +528,8 @@ impl Default for LibrarySettings {
     fn default() -> Self {
         LibrarySettings {
             quadratic_damping: true,
+            cubic_damping: true,
+            cross_damping: true,
             coriolis: true,
             restoring: true,
             constant_load: true,
@@ -495,6 +556,14 @@ pub fn library(
     for &dof in dofs {
         if s.quadratic_damping {
             out.push(Effect::QuadraticDamping { dof });
+        }
+        if s.cubic_damping {
+            out.push(Effect::CubicDamping { dof });
+        }
+        if s.cross_damping {
+            for &from in dofs.iter().filter(|&&j| j != dof) {
+                out.push(Effect::CrossDamping { dof, from });
+            }
         }
         if s.constant_load {
             out.push(Effect::ConstantLoad { dof });
@@ -595,6 +664,33 @@ mod tests {
             a: Dof::Surge,
             b: Dof::Sway
         }));
+        // Cubic per DOF, cross-flow for every ordered pair of modeled DOFs.
+        assert!(lib.contains(&Effect::CubicDamping { dof: Dof::Yaw }));
+        assert!(lib.contains(&Effect::CrossDamping {
+            dof: Dof::Sway,
+            from: Dof::Yaw
+        }));
+        let cross = lib
+            .iter()
+            .filter(|e| e.family() == Family::CrossDamping)
+            .count();
+        assert_eq!(cross, 6);
+        // |r|·v in sway is sign-symmetric in r, v·r is not.
+        let ctx = TermContext {
+            dofs: &dofs,
+            m_ref: &m,
+            d_ref: &d,
+        };
+        let e = Effect::CrossDamping {
+            dof: Dof::Sway,
+            from: Dof::Yaw,
+        };
+        let eta = [0.0; 6];
+        assert_eq!(e.regressor(0, 1, &ctx, &[0.1, 0.5, -0.2], &eta), 0.1);
+        assert_eq!(e.regressor(0, 1, &ctx, &[0.1, 0.5, 0.2], &eta), 0.1);
+        assert_eq!(e.regressor(0, 0, &ctx, &[0.1, 0.5, 0.2], &eta), 0.0);
+        let c = Effect::CubicDamping { dof: Dof::Surge };
+        assert!((c.regressor(0, 0, &ctx, &[-0.5, 0.0, 0.0], &eta) + 0.125).abs() < 1e-15);
         // No attitude DOFs: no restoring shapes.
         assert!(!lib.iter().any(|e| e.family() == Family::Restoring));
     }

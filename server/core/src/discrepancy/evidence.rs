@@ -1,7 +1,10 @@
 //! Plain-words effects and the evidence that separates look-alikes:
 //! lag vs delay (the lag of the peak input–residual cross-correlation),
 //! current vs tether (does the load turn with heading?), quadratic damping
-//! vs saturation (does the misfit follow ν or τ?).
+//! vs saturation (does the misfit follow ν or τ?), cubic vs quadratic
+//! damping (is the speed range wide enough for ν³ and |ν|ν to differ?),
+//! cross-flow damping |ν_j|ν_i vs a Coriolis product ν_j·ν_i (sign of ν_j)
+//! and vs |ν_i|ν_i.
 
 use super::candidates::Effect;
 use super::data::Record;
@@ -43,6 +46,28 @@ pub(crate) fn effect_text(t: &ModelTerm, h: f64) -> String {
             dof.force_unit(),
             if dof.is_angular() { "rad" } else { "m" },
             s = dof.velocity_symbol()
+        ),
+        Effect::CubicDamping { dof } => format!(
+            "Damping in {} grows steeply at the top of the speed range: an extra {}·{s}³ of {} {}·s³/{}³.",
+            dof.name(),
+            dof.force_column(),
+            pm(c(0), std_of(t, 0)),
+            dof.force_unit(),
+            if dof.is_angular() { "rad" } else { "m" },
+            s = dof.velocity_symbol()
+        ),
+        Effect::CrossDamping { dof, from } => format!(
+            "Damping in {} grows with the size of {} ({}, either sign): an extra {}·|{j}|{i} of {} {}/(({})·({})).",
+            dof.name(),
+            from.velocity_symbol(),
+            from.name(),
+            dof.force_column(),
+            pm(c(0), std_of(t, 0)),
+            dof.force_unit(),
+            dof.velocity_unit(),
+            from.velocity_unit(),
+            i = dof.velocity_symbol(),
+            j = from.velocity_symbol()
         ),
         Effect::CoriolisFromM => format!(
             "Coriolis–centripetal forces C(ν)ν built from the baseline M act, at scale {} (1 = as M predicts).",
@@ -265,7 +290,87 @@ pub(crate) fn separating_evidence(
                 }
             ));
         }
+        (Effect::CubicDamping { dof }, Some(r)) => {
+            let (lo, hi) = speed_spread(runs, r);
+            out.push(format!(
+                "|{s}| spans {} to {} {} (10th to 90th percentile) in these runs: {}.",
+                sig(lo),
+                sig(hi),
+                dof.velocity_unit(),
+                if hi > 2.0 * lo.max(f64::MIN_POSITIVE) {
+                    "a spread over which c·{s}³ bends away from d·|{s}|{s} (ν³/|ν|ν grows as |ν|), so the two shapes can be told apart"
+                } else {
+                    "too narrow a band for c·{s}³ and d·|{s}|{s} to look different; a run over a wider speed range decides"
+                }
+                .replace("{s}", dof.velocity_symbol()),
+                s = dof.velocity_symbol()
+            ));
+        }
+        (Effect::CrossDamping { dof, from }, Some(r)) => {
+            let j = dofs.iter().position(|&x| x == from);
+            let (u, w) = (dof.velocity_symbol(), from.velocity_symbol());
+            if let Some(j) = j {
+                let (sym, odd) = sign_symmetry(runs, r, j);
+                out.push(format!(
+                    "The term depends on |{w}|, not on the sign of {w}: a Coriolis-type product {w}·{u} would change sign with {w}, quadratic damping |{u}|{u} would not depend on {w} at all. In these runs |{w}|·{u} and {w}·{u} correlate at {:.2} and |{w}|·{u} and |{u}|{u} at {:.2}, {}.",
+                    odd,
+                    sym,
+                    if odd.abs() < 0.8 && sym.abs() < 0.9 {
+                        "so the three shapes are told apart"
+                    } else {
+                        "too closely to tell the shapes apart; a run with both signs of the other velocity decides"
+                    }
+                ));
+            }
+        }
         _ => {}
     }
     out
+}
+
+/// 10th and 90th percentile of |ν_row| over the runs.
+fn speed_spread(runs: &[&Record], row: usize) -> (f64, f64) {
+    let mut v: Vec<f64> = runs
+        .iter()
+        .flat_map(|r| r.nu.column(row).iter().map(|x| x.abs()).collect::<Vec<_>>())
+        .filter(|x| x.is_finite())
+        .collect();
+    if v.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    v.sort_by(f64::total_cmp);
+    let q = |p: f64| v[((v.len() - 1) as f64 * p) as usize];
+    (q(0.1), q(0.9))
+}
+
+/// Correlations of the cross-flow regressor |ν_j|ν_i with the quadratic
+/// |ν_i|ν_i and with the Coriolis-type product ν_j·ν_i.
+fn sign_symmetry(runs: &[&Record], i: usize, j: usize) -> (f64, f64) {
+    let (mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
+    for r in runs {
+        for k in 0..r.len() {
+            let (vi, vj) = (r.nu[(k, i)], r.nu[(k, j)]);
+            a.push(vj.abs() * vi);
+            b.push(vi.abs() * vi);
+            c.push(vj * vi);
+        }
+    }
+    (correlation(&a, &b), correlation(&a, &c))
+}
+
+fn correlation(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    if n < 3.0 {
+        return f64::NAN;
+    }
+    let mx = x.iter().sum::<f64>() / n;
+    let my = y.iter().sum::<f64>() / n;
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
+    let syy: f64 = y.iter().map(|b| (b - my).powi(2)).sum();
+    if sxx > 0.0 && syy > 0.0 {
+        sxy / (sxx * syy).sqrt()
+    } else {
+        f64::NAN
+    }
 }

@@ -29,6 +29,11 @@ use scenario::{Scenario, clean_truth, command_share, reach, scenario, true_model
 pub enum Concealed {
     /// d_q |ν_i|ν_i in surge, sway, heave or yaw.
     QuadraticDamping,
+    /// d_c ν_i³ in surge, sway, heave or yaw.
+    CubicDamping,
+    /// d_ij |ν_j|ν_i for a horizontal pair (sway with |r|, yaw with |v|,
+    /// surge with |v|, sway with |u|).
+    CrossDamping,
     /// C(ν_r)ν_r from M.
     Coriolis,
     /// A constant pitch moment or sway/heave force.
@@ -58,12 +63,17 @@ pub struct Expected {
     pub quantity: &'static str,
     /// Its true value.
     pub truth: f64,
+    /// For a cross-flow term, the velocity whose size scales the damping
+    /// (naming another one is wrong).
+    pub from: Option<Dof>,
 }
 
 impl Concealed {
     fn family(self) -> Family {
         match self {
             Concealed::QuadraticDamping => Family::QuadraticDamping,
+            Concealed::CubicDamping => Family::CubicDamping,
+            Concealed::CrossDamping => Family::CrossDamping,
             Concealed::Coriolis => Family::Coriolis,
             Concealed::Tether => Family::ConstantLoad,
             Concealed::Current | Concealed::RandomWalkCurrent => Family::Current,
@@ -81,6 +91,7 @@ impl Concealed {
             dofs,
             quantity,
             truth,
+            from: None,
         };
         let p = surveyor_rov();
         let reach = reach(&p, &clean_truth());
@@ -99,6 +110,38 @@ impl Concealed {
                 let v = 0.4 * p.limit(d).max_velocity;
                 t.quadratic_damping[i] = rng.uniform_in(0.4, 0.8) * d_lin[(i, i)] / v;
                 expected(vec![d], "d_q", t.quadratic_damping[i])
+            }
+            Concealed::CubicDamping => {
+                let d = pick(&[Dof::Surge, Dof::Sway, Dof::Heave, Dof::Yaw]);
+                let i = d.index();
+                // ν³ force equal to 40–80 % of the linear one at 0.4 of the velocity limit.
+                let v = 0.4 * p.limit(d).max_velocity;
+                t.cubic_damping[i] = rng.uniform_in(0.4, 0.8) * d_lin[(i, i)] / (v * v);
+                expected(vec![d], "d_c", t.cubic_damping[i])
+            }
+            Concealed::CrossDamping => {
+                const PAIRS: [(Dof, Dof); 4] = [
+                    (Dof::Sway, Dof::Yaw),
+                    (Dof::Yaw, Dof::Sway),
+                    (Dof::Surge, Dof::Sway),
+                    (Dof::Sway, Dof::Surge),
+                ];
+                let (d, j) = loop {
+                    let pair = PAIRS[(rng.uniform() * 4.0) as usize % 4];
+                    if Some(pair.0) != avoid {
+                        break pair;
+                    }
+                };
+                let i = d.index();
+                // |ν_j|ν_i force equal to 40–80 % of the linear one at
+                // |ν_j| = 0.4 of j's velocity limit.
+                let vj = 0.4 * p.limit(j).max_velocity;
+                let c = rng.uniform_in(0.4, 0.8) * d_lin[(i, i)] / vj;
+                t.cross_damping[i][j.index()] = c;
+                Expected {
+                    from: Some(j),
+                    ..expected(vec![d], "d_ij", c)
+                }
             }
             Concealed::Coriolis => {
                 t.coriolis = true;
@@ -257,6 +300,10 @@ pub fn judge(o: &Outcome) -> Result<(), String> {
 fn matches(f: &Finding, e: &Expected) -> bool {
     f.effect.family() == e.family
         && (e.dofs.is_empty() || f.dofs.iter().any(|d| e.dofs.contains(d)))
+        && match (f.effect, e.from) {
+            (Effect::CrossDamping { from, .. }, Some(j)) => from == j,
+            _ => true,
+        }
 }
 
 /// The magnitude discovery gives for `e` in finding `f`: value ± std.
@@ -330,12 +377,15 @@ pub fn proof_row(name: &str, effects: &[Concealed], seed: u64) -> ProofRow {
     }
 }
 
-/// The proof cases the issue asks for: each effect alone, pairs, clean.
+/// The proof cases the issue asks for: each effect alone (quadratic, cubic
+/// and cross-flow damping among them), pairs, clean.
 pub fn cases() -> Vec<(&'static str, Vec<Concealed>)> {
     use Concealed::*;
     vec![
         ("clean", vec![]),
         ("quadratic damping", vec![QuadraticDamping]),
+        ("cubic damping", vec![CubicDamping]),
+        ("cross damping", vec![CrossDamping]),
         ("Coriolis", vec![Coriolis]),
         ("tether", vec![Tether]),
         ("current", vec![Current]),

@@ -266,6 +266,19 @@ pub fn true_model(t: &RovTruth) -> AugmentedModel {
                 None,
             ));
         }
+        if t.cubic_damping[i] != 0.0 {
+            terms.push(term(
+                Effect::CubicDamping { dof },
+                vec![t.cubic_damping[i]],
+                None,
+            ));
+        }
+        for from in Dof::ALL {
+            let c = t.cross_damping[i][from.index()];
+            if c != 0.0 {
+                terms.push(term(Effect::CrossDamping { dof, from }, vec![c], None));
+            }
+        }
         if tether[i] != 0.0 {
             terms.push(term(Effect::ConstantLoad { dof }, vec![tether[i]], None));
         }

@@ -13,6 +13,11 @@ fn check(name: &str) {
         .expect("a listed case");
     let row = proof_row(name, &effects, SEED);
     eprint!("{}", format_table(std::slice::from_ref(&row)));
+    if row.verdict.is_ok() {
+        for s in &row.summary {
+            eprintln!("      {s}");
+        }
+    }
     assert!(row.verdict.is_ok(), "{name}: {:?}", row.verdict);
 }
 
@@ -30,6 +35,8 @@ macro_rules! proof_cases {
 proof_cases! {
     proof_clean => "clean",
     proof_quadratic_damping => "quadratic damping",
+    proof_cubic_damping => "cubic damping",
+    proof_cross_damping => "cross damping",
     proof_coriolis => "Coriolis",
     proof_tether => "tether",
     proof_current => "current",

@@ -110,9 +110,67 @@ pub(crate) fn damping_force(
     f
 }
 
+/// Checks cubic d_c,i ≥ 0 and cross-flow d_ij ≥ 0 (dissipative) with a
+/// zero diagonal.
+pub(crate) fn validate_nonlinear(cubic: &[f64; 6], cross: &[[f64; 6]; 6]) -> Result<(), SimError> {
+    for d in Dof::ALL {
+        non_negative(
+            format!("cubic_damping[{}]", d.name()),
+            cubic[d.index()],
+            false,
+        )?;
+        for e in Dof::ALL {
+            let v = cross[d.index()][e.index()];
+            let name = format!("cross_damping[{}][{}]", d.name(), e.name());
+            if d == e && v != 0.0 {
+                return Err(SimError::DampingTable {
+                    reason: format!(
+                        "{name} = {v}; the diagonal is quadratic_damping and must be 0 here"
+                    ),
+                });
+            }
+            non_negative(name, v, false)?;
+        }
+    }
+    Ok(())
+}
+
+/// D_c(ν_r)ν_r: d_c,i ν_r,i³ + Σ_j d_ij |ν_r,j| ν_r,i per DOF i.
+pub(crate) fn nonlinear_damping_force(
+    cubic: &[f64; 6],
+    cross: &[[f64; 6]; 6],
+    nu_r: &Vector6<f64>,
+) -> Vector6<f64> {
+    Vector6::from_fn(|i, _| {
+        let x = nu_r[i];
+        let c: f64 = (0..6).map(|j| cross[i][j] * nu_r[j].abs()).sum();
+        cubic[i] * x * x * x + c * x
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cubic_and_cross_terms_are_odd_in_their_own_velocity_and_even_in_the_other() {
+        let mut cross = [[0.0; 6]; 6];
+        cross[1][5] = 50.0;
+        let cubic = [4.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        for (sv, sr) in [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)] {
+            let nu = Vector6::new(-2.0, sv * 0.5, 0.0, 0.0, 0.0, sr * 0.2);
+            let f = nonlinear_damping_force(&cubic, &cross, &nu);
+            assert_eq!(f[0], -32.0);
+            assert!((f[1] - sv * 50.0 * 0.2 * 0.5).abs() < 1e-12);
+            assert_eq!(f[5], 0.0);
+        }
+        let mut bad = [[0.0; 6]; 6];
+        bad[2][2] = 1.0;
+        assert!(validate_nonlinear(&cubic, &bad).is_err());
+        bad[2][2] = 0.0;
+        bad[0][1] = -1.0;
+        assert!(validate_nonlinear(&cubic, &bad).is_err());
+    }
 
     #[test]
     fn table_interpolates_linearly_and_holds_outside() {

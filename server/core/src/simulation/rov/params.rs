@@ -5,7 +5,7 @@ use nalgebra::{Matrix6, Vector6};
 
 use super::actuators::Actuators;
 use super::current::Current;
-use super::damping::{LinearDamping, validate_quadratic};
+use super::damping::{LinearDamping, validate_nonlinear, validate_quadratic};
 use super::error::{SimError, finite};
 use super::restoring::Restoring;
 use crate::planning::dof::KNOT;
@@ -32,11 +32,12 @@ impl Tether {
 
 /// The 6-DOF ROV
 ///
-/// M ν̇_r + C(ν_r)ν_r + D_l(u_r)ν_r + D_q(ν_r)ν_r + g(η) = τ_a + τ_t,
+/// M ν̇_r + C(ν_r)ν_r + D_l(u_r)ν_r + D_q(ν_r)ν_r + D_c(ν_r)ν_r + g(η) = τ_a + τ_t,
 /// η̇ = J(η)ν, ν = ν_r + ν_c,
 ///
 /// the relative-velocity form for an irrotational current (Fossen 2011,
-/// sec. 10.3). τ_a is the applied τ after [`Actuators`], τ_t the [`Tether`].
+/// sec. 10.3). D_c(ν_r)ν_r holds the optional cubic and cross-flow
+/// damping (off by default). τ_a is the applied τ after [`Actuators`], τ_t the [`Tether`].
 /// Every optional effect is off by default, leaving the base case
 /// M ν̇ + D_l ν + g(η) = τ.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,6 +49,12 @@ pub struct RovTruth {
     pub damping: LinearDamping,
     /// Diagonal quadratic damping d_q,i (kg/m, kg·m²): D_q = diag(d_q,i |ν_r,i|).
     pub quadratic_damping: [f64; 6],
+    /// Diagonal cubic damping d_c,i (kg·s/m², kg·m²·s): d_c,i ν_r,i³ in DOF i.
+    pub cubic_damping: [f64; 6],
+    /// Cross-flow damping: entry [i][j] (j ≠ i) adds d_ij |ν_r,j| ν_r,i to
+    /// DOF i (e.g. sway damping growing with |r|); the diagonal must be 0
+    /// (it would be [`Self::quadratic_damping`]).
+    pub cross_damping: [[f64; 6]; 6],
     /// Include C(ν_r)ν_r with C from M (Fossen 2011, eq. 6.43).
     pub coriolis: bool,
     /// W, B, r_G, r_B for g(η).
@@ -67,6 +74,8 @@ impl RovTruth {
             m,
             damping,
             quadratic_damping: [0.0; 6],
+            cubic_damping: [0.0; 6],
+            cross_damping: [[0.0; 6]; 6],
             coriolis: false,
             restoring: Restoring::default(),
             tether: Tether::default(),
@@ -153,6 +162,7 @@ impl RovTruth {
         }
         self.damping.validate()?;
         validate_quadratic(&self.quadratic_damping)?;
+        validate_nonlinear(&self.cubic_damping, &self.cross_damping)?;
         let r = &self.restoring;
         finite(
             "restoring",

@@ -6,7 +6,7 @@
 use nalgebra::{DMatrix, Matrix6, Vector3, Vector6};
 
 use super::current::CurrentProcess;
-use super::damping::damping_force;
+use super::damping::{damping_force, nonlinear_damping_force};
 use super::error::{SimError, finite, non_negative};
 use super::kinematics::{eta_dot, rotation};
 use super::params::RovTruth;
@@ -133,6 +133,7 @@ impl RovTruth {
             }
             let mut rhs = tau + tether
                 - damping_force(&self.damping, &self.quadratic_damping, &nu_r)
+                - nonlinear_damping_force(&self.cubic_damping, &self.cross_damping, &nu_r)
                 - self.restoring.g(eta[3], eta[4]);
             if self.coriolis {
                 rhs -= coriolis_6dof(&self.m, &nu_r) * nu_r;

@@ -528,3 +528,37 @@ fn bad_input_is_a_typed_error_naming_the_field() {
     let err = bad.simulate(&DMatrix::zeros(100, 6), &c).unwrap_err();
     assert!(matches!(err, SimError::Diverged { .. }), "{err}");
 }
+
+#[test]
+fn cubic_and_cross_damping_reach_their_analytic_steady_states() {
+    // Surge: d·u + c·u³ = F; sway under a steady turn: (d_v + d_vr·|r|)·v =
+    // F_v with r = N/d_r (diagonal M, no Coriolis: the DOFs are decoupled).
+    let (d, c, f) = (1500.0, 2000.0, 3000.0);
+    let (dv, dvr, fv, dr, n) = (3000.0, 8000.0, 600.0, 5000.0, 1000.0);
+    let mut t = diagonal(
+        [5800.0, 9000.0, 11000.0, 2800.0, 15000.0, 15000.0],
+        [d, dv, 4000.0, 2000.0, 6000.0, dr],
+    );
+    t.cubic_damping[0] = c;
+    t.cross_damping[1][5] = dvr;
+    let rec = t
+        .simulate(&constant_tau(4000, [f, fv, 0.0, 0.0, 0.0, n]), &cfg())
+        .unwrap();
+    let last = row(&rec.nu, rec.len() - 1);
+    // Newton on d·u + c·u³ − F.
+    let mut u: f64 = f / d;
+    for _ in 0..50 {
+        u -= (d * u + c * u.powi(3) - f) / (d + 3.0 * c * u * u);
+    }
+    assert!((last[0] - u).abs() < 1e-6, "u = {} vs {u}", last[0]);
+    assert!(u < f / d - 0.5, "the cubic term is material");
+    let r = n / dr;
+    assert!((last[5] - r).abs() < 1e-9);
+    let v = fv / (dv + dvr * r.abs());
+    assert!((last[1] - v).abs() < 1e-6, "v = {} vs {v}", last[1]);
+    // Turning the other way damps sway alike (|r|).
+    let rec = t
+        .simulate(&constant_tau(4000, [f, fv, 0.0, 0.0, 0.0, -n]), &cfg())
+        .unwrap();
+    assert!((rec.nu[(rec.len() - 1, 1)] - v).abs() < 1e-6);
+}
