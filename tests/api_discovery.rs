@@ -234,6 +234,12 @@ async fn concealed_effects_are_named_through_the_service() {
     lag.actuators.time_constants[2] = 0.8;
     let mut delay = diagonal_truth();
     delay.actuators.delay_samples = 4;
+    let mut tether = diagonal_truth();
+    tether.tether.body_force = [0.0, 400.0, 0.0];
+    let mut current = diagonal_truth();
+    current.current = seatrial_core::simulation::rov::Current::Constant {
+        ned: [0.15, 0.1, 0.0],
+    };
     for (name, truth, effect, dof, ch) in [
         (
             "quadratic damping",
@@ -244,6 +250,8 @@ async fn concealed_effects_are_named_through_the_service() {
         ),
         ("actuator lag", lag, "actuator_lag", Some("heave"), "w"),
         ("input delay", delay, "common_input_delay", None, "u"),
+        ("tether", tether, "constant_load", Some("sway"), "v"),
+        ("current", current, "current", None, "v"),
     ] {
         let app = app().await;
         let cid = flown_campaign(&app, &truth).await;
@@ -289,4 +297,28 @@ async fn concealed_effects_are_named_through_the_service() {
         .await;
     assert!(d.json["report"]["effects"].as_array().unwrap().is_empty());
     assert!(d.json["augmented_model"].is_null());
+}
+
+/// Known failure, kept as a record: heave thrust saturated at 900 N on
+/// PI-flown planned runs is named "input delay in heave" (at the 1 s search
+/// limit, ambiguous with a lag) instead of saturation — the controller's
+/// commands ride the limit in long bursts, which looks like a late response.
+/// The open-loop proof case in the core passes.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+#[ignore = "known: saturation under PI control is named as an input delay"]
+async fn saturation_under_closed_loop_control() {
+    let mut truth = common::flights::diagonal_truth();
+    truth.actuators.saturation[2] = 900.0;
+    let app = app().await;
+    let cid = flown_campaign(&app, &truth).await;
+    let mid = identified(&app, &cid, "lambda_kf").await;
+    let job = run_job(&app, json!({ "kind": "discover", "model_id": mid })).await;
+    let did = job["result"]["discrepancy_id"].as_str().unwrap();
+    let d = app
+        .call("GET", "/api/discrepancies/{id}", &[did], None)
+        .await;
+    assert_eq!(
+        d.json["report"]["effects"][0]["effect"]["effect"],
+        "saturation"
+    );
 }
