@@ -135,29 +135,6 @@ fn six_dof_settings() -> EkfSettings {
     }
 }
 
-fn supply_config(trial: &TrialConfig) -> DpIdentConfig {
-    let ship = DpShip::supply_vessel();
-    let sq = |a: [f64; 3]| a.map(|v| v * v);
-    DpIdentConfig {
-        m: ship.m,
-        t: ship.t,
-        h: trial.h,
-        theta_init: [-0.1, -0.1, 0.0, 0.0, -0.1, 5e-3, 5e-3, 5e-3, 5e-3],
-        theta_init_std: [0.1, 0.1, 0.1, 0.1, 0.3, 5e-3, 5e-3, 5e-3, 5e-3],
-        r: sq([
-            trial.position_noise_std,
-            trial.position_noise_std,
-            trial.heading_noise_std,
-        ]),
-        p0_h: [1e-8; 3],
-        p0_b: sq([1e-3, 1e-3, 2e-4]),
-        q_h: [1e-10; 3],
-        q_b: sq(trial.bias_walk_std),
-        q_theta: 0.0,
-        sweeps: 2,
-    }
-}
-
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("ekf");
     g.sample_size(10);
@@ -169,7 +146,7 @@ fn bench(c: &mut Criterion) {
         paper::SAMPLES_PER_RUN,
         2024,
     );
-    let cfg = supply_config(&trial);
+    let cfg = DpIdentConfig::supply_vessel(&trial);
     let data = |i: usize| RunData {
         u: &runs[i].u,
         z: &runs[i].eta,

@@ -72,6 +72,38 @@ pub struct DpIdentConfig {
     pub sweeps: usize,
 }
 
+impl DpIdentConfig {
+    /// The settings a user would pick for Fossen's supply vessel flown as
+    /// `trial`: the paper's M and T (eq. 29–30), a generic initial guess
+    /// (not the truth) and the trial's noise model.
+    pub fn supply_vessel(trial: &crate::simulation::dp_ship::TrialConfig) -> Self {
+        let ship = DpShip::supply_vessel();
+        let sq = |a: [f64; 3]| a.map(|v| v * v);
+        DpIdentConfig {
+            m: ship.m,
+            t: ship.t,
+            h: trial.h,
+            // Damping time constants of ~ 10 Bis units, no coupling, and a
+            // thrust coefficient of a few 10⁻³ for every thruster.
+            theta_init: [-0.1, -0.1, 0.0, 0.0, -0.1, 5e-3, 5e-3, 5e-3, 5e-3],
+            theta_init_std: [0.1, 0.1, 0.1, 0.1, 0.3, 5e-3, 5e-3, 5e-3, 5e-3],
+            r: sq([
+                trial.position_noise_std,
+                trial.position_noise_std,
+                trial.heading_noise_std,
+            ]),
+            p0_h: [1e-8; 3],
+            p0_b: sq([1e-3, 1e-3, 2e-4]),
+            // A little noise on h keeps the EKF from growing overconfident
+            // (with ~0 it locks on biased θ″ for noisy positions).
+            q_h: [1e-10; 3],
+            q_b: sq(trial.bias_walk_std),
+            q_theta: 0.0,
+            sweeps: 2,
+        }
+    }
+}
+
 /// The result of one stage.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DpStageResult {

@@ -9,35 +9,6 @@ use crate::simulation::dp_ship::{
 };
 use crate::validation::{Predictor, ValidationRecord, nrmse_fit};
 
-/// The identification settings a user would pick: the paper's M and T, a
-/// generic initial guess (not the truth), and the trial's noise model.
-fn config(trial: &TrialConfig) -> DpIdentConfig {
-    let ship = DpShip::supply_vessel();
-    let sq = |a: [f64; 3]| a.map(|v| v * v);
-    DpIdentConfig {
-        m: ship.m,
-        t: ship.t,
-        h: trial.h,
-        // Damping time constants of ~ 10 Bis units, no coupling, and a
-        // thrust coefficient of a few 10⁻³ for every thruster.
-        theta_init: [-0.1, -0.1, 0.0, 0.0, -0.1, 5e-3, 5e-3, 5e-3, 5e-3],
-        theta_init_std: [0.1, 0.1, 0.1, 0.1, 0.3, 5e-3, 5e-3, 5e-3, 5e-3],
-        r: sq([
-            trial.position_noise_std,
-            trial.position_noise_std,
-            trial.heading_noise_std,
-        ]),
-        p0_h: [1e-8; 3],
-        p0_b: sq([1e-3, 1e-3, 2e-4]),
-        // A little noise on h keeps the EKF from growing overconfident
-        // (with ~0 it locks on biased θ″ for noisy positions).
-        q_h: [1e-10; 3],
-        q_b: sq(trial.bias_walk_std),
-        q_theta: 0.0,
-        sweeps: 2,
-    }
-}
-
 fn stages(runs: &[DpRun]) -> Vec<DpStage<'_>> {
     let data = |i: usize| RunData {
         u: &runs[i].u,
@@ -67,7 +38,7 @@ fn staged_parallel_ekf_recovers_the_supply_vessel() {
     let truth = DpShip::supply_vessel();
     let trial = TrialConfig::supply_vessel();
     let runs = simulate_campaign(&truth, &trial, paper::SAMPLES_PER_RUN, 2024);
-    let cfg = config(&trial);
+    let cfg = DpIdentConfig::supply_vessel(&trial);
     let mut reports = Vec::new();
     let mut sink = |f: f64, stage: &str| {
         reports.push((f, stage.to_string()));
@@ -152,7 +123,7 @@ fn identified_ship_predicts_validation_runs() {
     let truth = DpShip::supply_vessel();
     let trial = TrialConfig::supply_vessel();
     let runs = simulate_campaign(&truth, &trial, paper::SAMPLES_PER_RUN, 77);
-    let cfg = config(&trial);
+    let cfg = DpIdentConfig::supply_vessel(&trial);
     let model = |ship: DpShip| IdentifiedDpShip {
         ship,
         r: cfg.r,
@@ -229,7 +200,7 @@ fn errors_for_seed(
             );
         }
     }
-    let mut cfg = config(&trial);
+    let mut cfg = DpIdentConfig::supply_vessel(&trial);
     tune(&mut cfg);
     let id = identify_dp_ship(&cfg, &stages(&runs), &mut crate::estimation::NoProgress).unwrap();
     (
