@@ -357,7 +357,7 @@ impl Effect {
                     dof.name()
                 )
             }
-            Effect::Current => "ocean current (damping on ν − ν_c)".into(),
+            Effect::Current => "ocean current (relative velocity ν − ν_c)".into(),
             Effect::Coupling { dof, from } => {
                 format!("missing coupling from {} into {}", from.name(), dof.name())
             }
@@ -421,12 +421,17 @@ impl Effect {
                     return 0.0;
                 };
                 let (du, dv) = (ctx.d_ref[(row, iu)], ctx.d_ref[(row, iv)]);
+                let (mu, mv) = (ctx.m_ref[(row, iu)], ctx.m_ref[(row, iv)]);
+                let r = v(Dof::Yaw);
                 let (s, c) = eta[5].sin_cos();
-                // −D̄·ν_c with ν_c = R(ψ)ᵀ[V_N V_E]ᵀ = [V_N c + V_E s, −V_N s + V_E c].
+                // The hull feels ν_r = ν − ν_c, ν_c = R(ψ)ᵀ[V_N V_E]ᵀ =
+                // [V_N c + V_E s, −V_N s + V_E c]: M ν̇_r + D̄ ν_r = τ moves
+                // −D̄ ν_c and −M ν̇_c to the right, where the current turning
+                // in the body frame gives ν̇_c = r·[v_c, −u_c].
                 if p == 0 {
-                    -(du * c - dv * s)
+                    -(du * c - dv * s) + r * (mu * s + mv * c)
                 } else {
-                    -(du * s + dv * c)
+                    -(du * s + dv * c) - r * (mu * c - mv * s)
                 }
             }
             _ => 0.0,

@@ -487,6 +487,8 @@ pub fn discover(
             d_bar: rows_of(&model.d_bar),
             restoring: model.restoring,
             terms: model.terms.clone(),
+            m_ref: rows_of(&model.m_ref),
+            d_ref: rows_of(&model.d_ref),
         },
         validation,
         plots,

@@ -70,7 +70,7 @@ pub(crate) fn effect_text(t: &ModelTerm, h: f64) -> String {
             j = from.velocity_symbol()
         ),
         Effect::CoriolisFromM => format!(
-            "Coriolis–centripetal forces C(ν)ν built from the baseline M act, at scale {} (1 = as M predicts).",
+            "Coriolis–centripetal forces C(ν)ν built from the model's M act, at scale {} (1 = as M predicts).",
             pm(c(0), std_of(t, 0))
         ),
         Effect::CoriolisProduct { dof, a, b } => format!(

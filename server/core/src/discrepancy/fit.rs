@@ -78,6 +78,8 @@ pub(crate) struct FitOut {
     pub resid: Vec<Vec<f64>>,
     /// D̄ the current's regressors were built with.
     pub d_ref: DMatrix<f64>,
+    /// M the C(ν)ν regressors were built with.
+    pub m_ref: DMatrix<f64>,
 }
 
 impl FitOut {
@@ -188,26 +190,44 @@ impl<'a> Prepared<'a> {
         runs: &[usize],
         hac: bool,
     ) -> Option<FitOut> {
-        if !specs.iter().any(|s| s.effect == Effect::Current) {
-            return self.fit_with(specs, extra, runs, hac, &self.baseline.d_bar);
+        let current = specs.iter().any(|s| s.effect == Effect::Current);
+        let coriolis = specs.iter().any(|s| s.effect == Effect::CoriolisFromM);
+        let (mut m, mut d) = (self.baseline.m.clone(), self.baseline.d_bar.clone());
+        if !current && !coriolis {
+            return self.fit_with(specs, extra, runs, hac, &m, &d);
         }
-        // The current acts through D̄(ν − ν_c): its regressors need the D̄
-        // being fitted. A baseline identified with the current present has a
-        // biased D̄, so iterate to the fixed point (two passes suffice).
-        let mut d = self.baseline.d_bar.clone();
-        let mut f = self.fit_with(specs, extra, runs, false, &d)?;
+        // The current acts through D̄ and M on ν − ν_c, and C(ν) is built from M:
+        // their regressors need the D̄ and M being fitted. A baseline
+        // identified with the effect present has them biased (it absorbed
+        // the effect's linear part), so iterate to the fixed point.
+        let mut f = self.fit_with(specs, extra, runs, false, &m, &d)?;
         for pass in 0..3 {
-            d = self.d_bar_of(specs, &f, &d);
-            f = self.fit_with(specs, extra, runs, hac && pass == 2, &d)?;
+            let (m_new, d_new) = self.refitted(specs, &f, &m, &d);
+            m = m_new;
+            if current {
+                d = d_new;
+            }
+            f = self.fit_with(specs, extra, runs, hac && pass == 2, &m, &d)?;
         }
         Some(f)
     }
 
-    /// D̄ with the rows and coupling entries of `f` written into `d`.
-    fn d_bar_of(&self, specs: &[Spec], f: &FitOut, d: &DMatrix<f64>) -> DMatrix<f64> {
-        let mut d = d.clone();
+    /// (M, D̄) with the rows and coupling entries of `f` written into
+    /// (`m`, `d`).
+    fn refitted(
+        &self,
+        specs: &[Spec],
+        f: &FitOut,
+        m: &DMatrix<f64>,
+        d: &DMatrix<f64>,
+    ) -> (DMatrix<f64>, DMatrix<f64>) {
+        let (mut m, mut d) = (m.clone(), d.clone());
         for (ri, &r) in f.rows.iter().enumerate() {
-            for (k, &j) in self.structure[r].1.iter().enumerate() {
+            let (mf, df) = &self.structure[r];
+            for (k, &j) in mf.iter().enumerate() {
+                m[(r, j)] = f.base[ri].0[k];
+            }
+            for (k, &j) in df.iter().enumerate() {
                 d[(r, j)] = f.base[ri].1[k];
             }
         }
@@ -216,10 +236,11 @@ impl<'a> Prepared<'a> {
                 && let (Some(i), Some(j)) =
                     (self.baseline.index_of(dof), self.baseline.index_of(from))
             {
+                m[(i, j)] = f.theta[si][0];
                 d[(i, j)] = f.theta[si][1];
             }
         }
-        d
+        (m, d)
     }
 
     fn fit_with(
@@ -228,6 +249,7 @@ impl<'a> Prepared<'a> {
         extra: &[usize],
         runs: &[usize],
         hac: bool,
+        m_ref: &DMatrix<f64>,
         d_ref: &DMatrix<f64>,
     ) -> Option<FitOut> {
         let rows = self.rows_of(specs, extra);
@@ -251,11 +273,7 @@ impl<'a> Prepared<'a> {
             theta_index.push(p);
             p += s.effect.n_linear();
         }
-        let ctx = TermContext {
-            dofs,
-            m_ref: &self.baseline.m,
-            d_ref,
-        };
+        let ctx = TermContext { dofs, m_ref, d_ref };
         let mut hmat = DMatrix::<f64>::zeros(p, p);
         let mut bvec = vec![0.0; p];
         let mut blocks: Vec<Block> = Vec::new();
@@ -407,6 +425,7 @@ impl<'a> Prepared<'a> {
             cov,
             resid,
             d_ref: d_ref.clone(),
+            m_ref: m_ref.clone(),
         })
     }
 
@@ -414,25 +433,9 @@ impl<'a> Prepared<'a> {
     /// replaced, coupling entries set, and the terms attached.
     pub fn model(&self, specs: &[Spec], f: &FitOut, shape_std: &[Option<f64>]) -> AugmentedModel {
         let b = self.baseline;
-        let mut m = b.m.clone();
-        let mut d = b.d_bar.clone();
-        for (ri, &r) in f.rows.iter().enumerate() {
-            let (mf, df) = &self.structure[r];
-            for (k, &j) in mf.iter().enumerate() {
-                m[(r, j)] = f.base[ri].0[k];
-            }
-            for (k, &j) in df.iter().enumerate() {
-                d[(r, j)] = f.base[ri].1[k];
-            }
-        }
+        let (m, d) = self.refitted(specs, f, &b.m, &b.d_bar);
         let mut terms = Vec::with_capacity(specs.len());
         for (si, s) in specs.iter().enumerate() {
-            if let Effect::Coupling { dof, from } = s.effect
-                && let (Some(i), Some(j)) = (b.index_of(dof), b.index_of(from))
-            {
-                m[(i, j)] = f.theta[si][0];
-                d[(i, j)] = f.theta[si][1];
-            }
             let covariance = f
                 .theta_cov(si)
                 .map(|c| {
@@ -454,9 +457,20 @@ impl<'a> Prepared<'a> {
             m,
             d,
             b.restoring,
-            b.m.clone(),
+            f.m_ref.clone(),
             f.d_ref.clone(),
             terms,
+        )
+    }
+
+    /// (M_rr, D̄_rr) of row `r` (the `ri`-th of `f`) after the fit, where
+    /// the fit frees them.
+    pub fn row_diagonal(&self, f: &FitOut, ri: usize, r: usize) -> (Option<f64>, Option<f64>) {
+        let (mf, df) = &self.structure[r];
+        let (m, d) = &f.base[ri];
+        (
+            mf.iter().position(|&j| j == r).map(|k| m[k]),
+            df.iter().position(|&j| j == r).map(|k| d[k]),
         )
     }
 
@@ -561,7 +575,7 @@ impl Prepared<'_> {
             .collect();
         let ctx = TermContext {
             dofs,
-            m_ref: &self.baseline.m,
+            m_ref: &f.m_ref,
             d_ref: &f.d_ref,
         };
         let k = k.max(1);
@@ -738,7 +752,24 @@ pub(crate) fn profile(
         });
         specs
     };
-    let eval = |v: f64| -> Option<FitOut> { prep.fit(&specs_at(v), extra, runs, false) };
+    let lag = effect.shape() == Some(super::candidates::ShapeKind::LagTime);
+    // A refitted row must stay a hull: M_rr > 0, D̄_rr ≥ 0, and a lag must
+    // be the faster of the two poles. Lag T and the hull's M_rr/D̄_rr are
+    // interchangeable in 1/((1+sT)(D̄ + sM)) — the data cannot tell them
+    // apart — so the slow pole is the hull's and the fast one the
+    // thruster's, as on every ROV and ship.
+    let admissible = |f: &FitOut, v: f64| {
+        f.rows.iter().enumerate().all(|(ri, &r)| {
+            let (m, d) = prep.row_diagonal(f, ri, r);
+            m.is_none_or(|m| m > 0.0)
+                && d.is_none_or(|d| d >= 0.0)
+                && !(lag && matches!((m, d), (Some(m), Some(d)) if d > 0.0 && m / d <= v))
+        })
+    };
+    let eval = |v: f64| -> Option<FitOut> {
+        prep.fit(&specs_at(v), extra, runs, false)
+            .filter(|f| admissible(f, v))
+    };
     let sse = |v: f64| {
         eval(v)
             .and_then(|f| prep.kstep_rows(&specs_at(v), &f, extra, runs, k))

@@ -40,9 +40,10 @@ pub struct AugmentedModel {
     pub d_bar: DMatrix<f64>,
     /// g(η) of the baseline.
     pub restoring: Restoring,
-    /// M that C(ν) of a Coriolis term is built from (the baseline's).
+    /// M that C(ν) of a Coriolis term is built from (the fitted M, iterated
+    /// to a fixed point, or the baseline's when no C(ν)ν term is fitted).
     pub m_ref: DMatrix<f64>,
-    /// D̄ the current acts through (the baseline's).
+    /// D̄ the current acts through (likewise, for a current).
     pub d_ref: DMatrix<f64>,
     /// The added terms.
     pub terms: Vec<ModelTerm>,

@@ -20,8 +20,15 @@ pub struct Estimate {
     /// Estimate.
     pub value: f64,
     /// Standard deviation (HAC, or profile curvature for shapes); NaN if
-    /// unavailable.
+    /// unavailable, which JSON carries as null.
+    #[serde(deserialize_with = "nan_if_null")]
+    #[cfg_attr(feature = "openapi", schema(value_type = Option<f64>))]
     pub std: f64,
+}
+
+/// JSON has no NaN: serde_json writes it as null; read null back as NaN.
+fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 /// Whether a hypothesis made it into the model.
@@ -176,6 +183,10 @@ pub struct ModelReport {
     pub restoring: Restoring,
     /// Added terms with coefficients and covariances.
     pub terms: Vec<ModelTerm>,
+    /// M that a C(ν)ν term is built from.
+    pub m_ref: Vec<Vec<f64>>,
+    /// D̄ a current acts through.
+    pub d_ref: Vec<Vec<f64>>,
 }
 
 /// Everything discovery found.
@@ -202,4 +213,25 @@ pub struct DiscoveryReport {
     pub ambiguities: Vec<Ambiguity>,
     /// Structure left unexplained.
     pub unexplained: Vec<Unexplained>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Estimate;
+
+    #[test]
+    fn an_unavailable_std_travels_as_null_and_comes_back_nan() {
+        let e = Estimate {
+            name: "T_a (s)".into(),
+            value: 0.73,
+            std: f64::NAN,
+        };
+        let v = serde_json::to_value(&e).unwrap();
+        assert!(v["std"].is_null(), "{v}");
+        let back: Estimate = serde_json::from_value(v).unwrap();
+        assert!(back.std.is_nan() && back.value == 0.73);
+        let known: Estimate =
+            serde_json::from_str(r#"{"name":"d","value":1.0,"std":0.5}"#).unwrap();
+        assert_eq!(known.std, 0.5);
+    }
 }

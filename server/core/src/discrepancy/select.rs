@@ -80,7 +80,18 @@ fn shape_grid(prep: &Prepared<'_>, effect: Effect, runs: &[usize], c: &Criteria)
         }
         Some(ShapeKind::DelaySamples) => (1..=c.max_delay_samples).map(|d| d as f64).collect(),
         Some(ShapeKind::SaturationLevel) => {
-            quantiles(&[0.3, 0.4, 0.5, 0.6, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95, 0.98])
+            // Quantiles of the command, and a log grid down to 2 % of its
+            // largest value: under closed-loop control a hull that gets far
+            // less thrust than commanded winds the controller up to its own
+            // limit, so most commands sit far above the true τ_max.
+            let mut g = quantiles(&[0.3, 0.4, 0.5, 0.6, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95, 0.98]);
+            if let Some(&top) = prep.abs_tau_sorted(row, runs).last().filter(|t| **t > 0.0) {
+                let k = 12;
+                g.extend((0..k).map(|i| top * 0.02f64.powf(1.0 - i as f64 / k as f64)));
+            }
+            g.sort_by(f64::total_cmp);
+            g.dedup_by(|a, b| (*a - *b).abs() <= 0.02 * b.abs());
+            g
         }
         Some(ShapeKind::DeadZoneWidth) => quantiles(&[0.02, 0.05, 0.1, 0.15, 0.2, 0.3]),
         None => vec![],
@@ -114,6 +125,13 @@ pub(crate) fn score(
         let kappa = super::fit::long_run_inflation(&r0, prep.hac_lags.max(2 * k));
         let n_eff = (p.n as f64 / kappa).max(2.0);
         let lr = n_eff * (s0 / p.sse.max(f64::MIN_POSITIVE)).ln();
+        // An optimum on the edge of the search range is a bound, not an
+        // estimate (a saturation level at the smallest level tried, a delay
+        // at the longest): such a hypothesis is not significant. A delay of
+        // one sample is a real value, so only its upper edge counts.
+        let (lo, hi) = (grid[0], grid[grid.len() - 1]);
+        let at_edge = p.value >= hi * (1.0 - 1e-9) || (continuous && p.value <= lo * (1.0 + 1e-9));
+        let lr = if at_edge { 0.0 } else { lr };
         return Some(Scored {
             spec: Spec {
                 effect,

@@ -138,9 +138,10 @@ pub struct LpvPoint {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 pub struct PointAugmentation {
-    /// The baseline's M, from which a Coriolis term's C(ν) is built.
+    /// The M a Coriolis term's C(ν) is built from and a current's
+    /// M ν̇_c acts through (the refitted M when such a term was fitted).
     pub m_ref: Matrix,
-    /// The baseline's D̄, through which a current acts.
+    /// The D̄ through which a current acts (refitted likewise).
     pub d_ref: Matrix,
     /// The added terms with coefficients, covariances and shapes.
     pub terms: Vec<crate::discrepancy::ModelTerm>,
