@@ -76,10 +76,17 @@
 //!   estimate, and is not significant.
 //!
 //! Not done yet / weaker than it looks:
-//! - a current under PI-flown planned runs (one heading band) is named
-//!   first, but its magnitude comes out about half the truth (0.10 vs
-//!   0.18 m/s) and its sway fit improves only 0.43 → 0.64; open-loop runs
-//!   recover it to 1 %;
+//! - a current under PI-flown planned runs is named first, but its
+//!   magnitude comes out about half the truth (0.10 vs 0.18 m/s, direction
+//!   21° and 68° at the two speeds against 34°) and the sway fit improves
+//!   only 0.43 → 0.64; open-loop runs recover it to 1 %. Not the 20 Hz
+//!   command in a 10 Hz log (same at 10 Hz), not the baseline (D̄_uu 1595
+//!   and 1451 against 1500). The likely cause: at one grid speed under
+//!   speed hold, τ ≈ D̄(u_ref − u_c) is nearly constant, so u_c trades
+//!   against a small D̄ error (ΔD̄·u_ref/D̄) and the HAC std (± 0.008 m/s)
+//!   understates it. The current is a property of the site, not of the
+//!   speed: fitting one V_c across all grid points (or the four-heading
+//!   deciding run) is the fix, not built;
 //! - a current that varies slowly (random walk) is fitted as a constant and
 //!   named as a current (`proof::extra_cases`; seed 11: |V_c(0)| = 0.156,
 //!   fitted 0.18 m/s, 90 % of the gap; seed 14 names nothing); no
