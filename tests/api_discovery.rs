@@ -334,6 +334,14 @@ async fn concealed_effects_are_named_through_the_service() {
             assert!(a > b, "{name}: {ch} free run {b} → {a}");
             line += &format!("{} | {ch} free run {b:.3} → {a:.3}; ", e["label"]);
         }
+        // A steady current must not be called a drifting one (under speed
+        // hold its windows disagree with the manoeuvres, which the report
+        // must say as uncertainty, not as a random walk).
+        for p in d.json["report"]["points"].as_array().unwrap() {
+            if let Some(dr) = p["report"]["current_drift"].as_object() {
+                assert_eq!(dr["drifts"], false, "{name}: {}", dr["text"]);
+            }
+        }
         eprintln!("{name}: {line}({:.1} s)", t0.elapsed().as_secs_f64());
     }
     // The clean base: nothing named, no new version.

@@ -2,8 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::candidates::{LibrarySettings, library};
+use super::candidates::{Effect, LibrarySettings, library};
 use super::data::{Baseline, Record};
+use super::drift::current_drift;
 use super::error::DiscoveryError;
 use super::evidence::{effect_text, separating_evidence};
 use super::experiment::propose;
@@ -49,6 +50,8 @@ pub struct DiscoverySettings {
     pub max_delay_s: f64,
     /// Segment length of the location report (s).
     pub segment_s: f64,
+    /// Window of the test whether a fitted current is constant (s).
+    pub drift_window_s: f64,
     /// Points per plot series.
     pub plot_points: usize,
     /// Candidate families.
@@ -72,6 +75,7 @@ impl Default for DiscoverySettings {
             max_lag_s: 3.0,
             max_delay_s: 1.0,
             segment_s: 30.0,
+            drift_window_s: 15.0,
             plot_points: 400,
             library: LibrarySettings::default(),
             vessel: None,
@@ -97,6 +101,7 @@ impl DiscoverySettings {
         pos("max_lag_s", self.max_lag_s)?;
         pos("max_delay_s", self.max_delay_s)?;
         pos("segment_s", self.segment_s)?;
+        pos("drift_window_s", self.drift_window_s)?;
         pos("ambiguity_ratio", self.ambiguity_ratio)?;
         if !(self.min_cv_gain.is_finite() && self.max_delta_bic.is_finite()) {
             return Err(DiscoveryError::invalid(
@@ -420,7 +425,7 @@ pub fn discover(
         }
     }
 
-    let findings: Vec<Finding> = winners
+    let mut findings: Vec<Finding> = winners
         .iter()
         .enumerate()
         .map(|(i, w)| {
@@ -467,6 +472,24 @@ pub fn discover(
         })
         .collect();
 
+    // A current is fitted as a constant: test whether it is one.
+    let current_drift = current_drift(
+        &model,
+        &est,
+        &chosen,
+        settings.svf_time_constant_s,
+        skip,
+        hac_lags,
+        settings.drift_window_s,
+    );
+    if let Some(d) = &current_drift
+        && let Some(f) = findings.iter_mut().find(|f| f.effect == Effect::Current)
+    {
+        f.evidence.push(d.text.clone());
+        if d.varies {
+            f.effect_text = format!("{} {}", f.effect_text, d.text);
+        }
+    }
     let summary = summary(
         &location,
         &findings,
@@ -481,6 +504,7 @@ pub fn discover(
         location,
         hypotheses,
         findings,
+        current_drift,
         model: ModelReport {
             dofs: model.dofs.clone(),
             m: rows_of(&model.m),

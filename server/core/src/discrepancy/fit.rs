@@ -46,6 +46,8 @@ pub(crate) struct Prepared<'a> {
     runs: Vec<PrepRun>,
     /// Per row: free M columns and free D̄ columns of the baseline.
     structure: Vec<(Vec<usize>, Vec<usize>)>,
+    /// The baseline's M and D̄ are held, not refitted ([`Self::frozen`]).
+    frozen: bool,
     /// 1/σ_i of the baseline's equation error per row.
     pub weights: Vec<f64>,
     /// Long-run variance inflation of the residuals (≥ 1).
@@ -148,6 +150,7 @@ impl<'a> Prepared<'a> {
             skip,
             runs,
             structure,
+            frozen: false,
             weights: vec![1.0; n],
             kappa: 1.0,
             hac_lags,
@@ -168,6 +171,17 @@ impl<'a> Prepared<'a> {
         let null = prep.fit(&[], &all_rows, &all, false)?;
         prep.kappa = long_run_inflation(&null.resid, hac_lags);
         Some(prep)
+    }
+
+    /// The same runs with the baseline's M and D̄ held: fits then estimate
+    /// only the terms' coefficients (the window test of a current, where a
+    /// short window would trade M, D̄ against the current).
+    pub fn frozen(mut self) -> Self {
+        self.frozen = true;
+        for s in &mut self.structure {
+            *s = (vec![], vec![]);
+        }
+        self
     }
 
     /// Rows touched by `specs` plus `extra`, sorted.
@@ -299,8 +313,17 @@ impl<'a> Prepared<'a> {
                 } else {
                     pr.lam_tau[r].clone()
                 };
+                let held = |k: usize| {
+                    if !self.frozen {
+                        return 0.0;
+                    }
+                    let (m, d) = (&self.baseline.m, &self.baseline.d_bar);
+                    (0..dofs.len())
+                        .map(|j| m[(r, j)] * pr.dlam_nu[j][k] + d[(r, j)] * pr.lam_nu[j][k])
+                        .sum::<f64>()
+                };
                 let y: Vec<f64> = (self.skip..len)
-                    .map(|k| w * (lam_tau_a[k] - pr.lam_g[r][k]))
+                    .map(|k| w * (lam_tau_a[k] - pr.lam_g[r][k] - held(k)))
                     .collect();
                 let mut idx = Vec::new();
                 let mut cols: Vec<Vec<f64>> = Vec::new();

@@ -87,10 +87,16 @@
 //!   understates it. The current is a property of the site, not of the
 //!   speed: fitting one V_c across all grid points (or the four-heading
 //!   deciding run) is the fix, not built;
-//! - a current that varies slowly (random walk) is fitted as a constant and
-//!   named as a current (`proof::extra_cases`; seed 11: |V_c(0)| = 0.156,
-//!   fitted 0.18 m/s, 90 % of the gap; seed 14 names nothing); no
-//!   time-varying current term;
+//! - a current that varies slowly (random walk) is named as a current and
+//!   kept in the model as its mean; [`drift`] then refits the current in
+//!   15 s windows (M, D̄ held), tests their spread (χ²) and whether they
+//!   wander (von Neumann ratio), and gives the random walk's σ (seeds
+//!   11–13: 0.0108, 0.0094, 0.0075 against 0.01 m/s per √s; steady
+//!   currents pass as steady). Held-out free runs cannot follow a
+//!   wandering current (seed 14 names nothing); an observer with the
+//!   current as a state is the model for that, not built. On PI-flown
+//!   runs a steady current's windows disagree without wandering, and the
+//!   report says the current's size is uncertain rather than drifting;
 //! - ambiguity is judged pairwise: a current at one heading looks like two
 //!   constant loads (surge + sway) together, which is not flagged;
 //! - cubic and cross-flow damping are separate families from quadratic
@@ -117,6 +123,7 @@
 pub mod candidates;
 pub mod data;
 pub mod discover;
+pub mod drift;
 pub mod error;
 pub mod evidence;
 pub mod experiment;

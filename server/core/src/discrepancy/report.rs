@@ -203,6 +203,10 @@ pub struct DiscoveryReport {
     pub hypotheses: Vec<HypothesisReport>,
     /// Chosen terms, in the order chosen.
     pub findings: Vec<Finding>,
+    /// Whether a chosen current is constant (window by window), if one was
+    /// chosen.
+    #[serde(default)]
+    pub current_drift: Option<super::drift::CurrentDrift>,
     /// The augmented model.
     pub model: ModelReport,
     /// Before/after on validation runs, per channel.
