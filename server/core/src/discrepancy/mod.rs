@@ -107,8 +107,9 @@
 //!   and both are named over quadratic damping, but no case conceals a
 //!   quadratic and a cubic term in the same DOF, nor a cross-flow term
 //!   driven by a DOF outside the horizontal plane; the library offers
-//!   n·(n − 1) cross-flow candidates (30 for six DOFs); the fitted
-//!   cross-flow coefficient is not constrained to be dissipative;
+//!   n·(n − 1) cross-flow candidates (30 for six DOFs); a damping term
+//!   (quadratic, cubic, cross-flow) with a negative coefficient, which
+//!   would feed energy into the hull, is not significant;
 //! - the std of the C(ν) scale (≈ 5·10⁻⁴) does not carry the uncertainty
 //!   of the M it is built from;
 //! - the noise floor assumes noise on ν only: attitude noise ≳ 1e-3 rad

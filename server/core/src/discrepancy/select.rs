@@ -13,7 +13,7 @@
 //! equation-error statistics only screen; held-out simulation decides, so
 //! a term that fits noise in the equation but not the vessel never joins.
 
-use super::candidates::{Effect, ShapeKind};
+use super::candidates::{Effect, Family, ShapeKind};
 use super::data::Record;
 use super::fit::{FitOut, Prepared, Spec, profile};
 use crate::validation::nrmse_fit;
@@ -165,6 +165,17 @@ pub(crate) fn score(
     } else {
         lr.max(0.0).sqrt()
     };
+    // Damping must dissipate: θ|ν_j|ν_i, θν_i³ put power θ|ν_j|ν_i², θν_i⁴
+    // into the water only for θ ≥ 0. A negative one is the fit bending
+    // another misfit, not a damping term.
+    let dissipative = !matches!(
+        effect.family(),
+        Family::QuadraticDamping | Family::CubicDamping | Family::CrossDamping
+    ) || fit
+        .theta
+        .last()
+        .is_some_and(|t| t.iter().all(|x| *x >= 0.0));
+    let z = if dissipative { z } else { 0.0 };
     Some(Scored {
         spec,
         fit,

@@ -49,6 +49,49 @@ fn quadratic_damping_coefficient_is_recovered_with_honest_uncertainty() {
     assert!(sd < 300.0);
 }
 
+/// A damping term must dissipate. With 3000 N·s²/m² of surge |u|u in the
+/// truth it is significant; with the logged τ_X shifted so that the data
+/// ask for −3000 (a hull that gains energy with speed) the fit says −3000
+/// and the screen refuses it.
+#[test]
+fn a_damping_term_that_would_inject_energy_is_not_significant() {
+    use crate::discrepancy::select::{Criteria, score};
+    let mut t = clean_truth();
+    t.quadratic_damping[0] = 3000.0;
+    let s = scenario(t, 2, 3, 0, 90.0);
+    let c = Criteria {
+        min_z: 4.0,
+        max_delta_bic: -10.0,
+        min_cv_gain: 0.01,
+        cv_candidates: 5,
+        max_lag_s: 3.0,
+        max_delay_samples: 10,
+        k_step: 10,
+    };
+    let effect = Effect::QuadraticDamping { dof: Dof::Surge };
+    let all: Vec<usize> = (0..s.est.len()).collect();
+    let prep = Prepared::new(&s.baseline, &s.est, 0.5, 25, 30).unwrap();
+    let ok = score(&prep, &[], effect, &all, &c).unwrap();
+    assert!(
+        ok.fit.theta[0][0] > 2500.0 && ok.z >= 4.0,
+        "{:?} z {}",
+        ok.fit.theta,
+        ok.z
+    );
+    let mut flipped = s.est.clone();
+    for r in &mut flipped {
+        for k in 0..r.len() {
+            let u = r.nu[(k, 0)];
+            r.tau[(k, 0)] -= 6000.0 * u.abs() * u;
+        }
+    }
+    let prep = Prepared::new(&s.baseline, &flipped, 0.5, 25, 30).unwrap();
+    let bad = score(&prep, &[], effect, &all, &c).unwrap();
+    assert!(bad.fit.theta[0][0] < -2500.0, "{:?}", bad.fit.theta);
+    assert_eq!(bad.z, 0.0);
+    assert!(!bad.significant(&c));
+}
+
 #[test]
 fn bad_input_is_a_typed_error_naming_the_field() {
     use crate::discrepancy::discover::{DiscoverySettings, discover};
