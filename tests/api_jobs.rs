@@ -8,7 +8,7 @@ mod common;
 use std::time::{Duration, Instant};
 
 use common::jobs::{config, registry};
-use common::sim::{self, all_columns, multipart, simulate};
+use common::sim::{self, all_columns, simulate};
 use common::{TestApp, rov_profile};
 use serde_json::{Value, json};
 
@@ -76,13 +76,8 @@ async fn upload_run(app: &TestApp, cid: &str) -> String {
         0.0,
         1,
     );
-    let (ct, body) = multipart(&[("file", Some("run.csv"), &csv)]);
     let r = app
-        .raw(
-            "POST",
-            &format!("/api/campaigns/{cid}/runs"),
-            Some((&ct, body)),
-        )
+        .upload_run(cid, &[("file", Some("run.csv"), &csv)])
         .await;
     assert_eq!(r.status, 201, "{}", r.text);
     r.json["id"].as_str().unwrap().to_string()

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::sim::{self, all_columns, multipart, simulate};
+use common::sim::{self, all_columns, simulate};
 use common::{Resp, TestApp, rov_profile};
 use serde_json::{Value, json};
 
@@ -30,14 +30,7 @@ async fn rov_campaign(app: &TestApp, extra: Value) -> (String, String) {
 }
 
 async fn upload(app: &TestApp, cid: &str, parts: &[(&str, Option<&str>, &str)]) -> Resp {
-    let (ct, body) = multipart(parts);
-    let r = app
-        .raw(
-            "POST",
-            &format!("/api/campaigns/{cid}/runs"),
-            Some((&ct, body)),
-        )
-        .await;
+    let r = app.upload_run(cid, parts).await;
     app.check_contract("POST", "/api/campaigns/{id}/runs", &r);
     r
 }

@@ -8,7 +8,6 @@ use seatrial_core::simulation::rov::RovTruth;
 use seatrial_core::simulation::trials::{TrialSettings, fly_experiment};
 use serde_json::{Value, json};
 
-use super::sim::multipart;
 use super::{TestApp, rov_profile};
 
 /// The Surveyor-like truth without restoring: what the λ model at each grid
@@ -89,15 +88,13 @@ pub async fn upload_planned(app: &TestApp, cid: &str, plan: &Value, code: &str, 
         .and_then(|e| e["id"].as_str())
         .unwrap_or_else(|| panic!("experiment {code} not in the stored plan"));
     let meta = json!({ "experiment_id": eid }).to_string();
-    let (ct, body) = multipart(&[
-        ("meta", None, &meta),
-        ("file", Some(&format!("{code}.csv")), csv),
-    ]);
     let r = app
-        .raw(
-            "POST",
-            &format!("/api/campaigns/{cid}/runs"),
-            Some((&ct, body)),
+        .upload_run(
+            cid,
+            &[
+                ("meta", None, &meta),
+                ("file", Some(&format!("{code}.csv")), csv),
+            ],
         )
         .await;
     assert_eq!(r.status, 201, "{code}: {}", r.text);

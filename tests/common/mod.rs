@@ -135,6 +135,18 @@ impl TestApp {
         r
     }
 
+    /// Uploads a run to campaign `cid` as multipart `parts` (name, file
+    /// name, content), without contract checks.
+    pub async fn upload_run(&self, cid: &str, parts: &[(&str, Option<&str>, &str)]) -> Resp {
+        let (ct, body) = sim::multipart(parts);
+        self.raw(
+            "POST",
+            &format!("/api/campaigns/{cid}/runs"),
+            Some((&ct, body)),
+        )
+        .await
+    }
+
     /// Sends a request without contract checks (for malformed bodies etc.).
     pub async fn raw(&self, method: &str, path: &str, body: Option<(&str, String)>) -> Resp {
         let mut req = Request::builder().method(method).uri(path);
