@@ -143,6 +143,33 @@ async fn every_documented_operation_is_exercised_and_answers() {
         .await;
     assert_eq!(r.status, 201, "{}", r.text);
     let rid = r.json["id"].as_str().unwrap().to_string();
+    // A two-file run, for the clock-offset routes.
+    let split = simulate(10, 10.0, 300.0, [300.0; 6], 2.0, 1e-4);
+    let control = sim::csv(
+        &split,
+        &["tau_X", "tau_Y", "tau_Z", "tau_K", "tau_M", "tau_N", "z"],
+        4.0,
+        1,
+    );
+    let nav = sim::csv(
+        &split,
+        &[
+            "u", "v", "w", "p", "q", "r", "x", "y", "z", "phi", "theta", "psi",
+        ],
+        0.0,
+        1,
+    );
+    let r = app
+        .upload_run(
+            &cid,
+            &[
+                ("control", Some("c.csv"), &control),
+                ("nav", Some("n.csv"), &nav),
+            ],
+        )
+        .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let split_rid = r.json["id"].as_str().unwrap().to_string();
     // A finished job (its event stream ends at once).
     let jid = job(&app, json!({ "n": 100 })).await;
     for _ in 0..3000 {
@@ -164,6 +191,8 @@ async fn every_documented_operation_is_exercised_and_answers() {
                 vec![&cid, &eid]
             } else if template.starts_with("/api/vessels/") {
                 vec![&vid]
+            } else if template.starts_with("/api/runs/") && template.ends_with("/clock-offset") {
+                vec![&split_rid]
             } else if template.starts_with("/api/runs/") {
                 vec![&rid]
             } else if template.starts_with("/api/jobs/") {
@@ -227,6 +256,15 @@ async fn every_documented_operation_is_exercised_and_answers() {
                         "/api/models/compare?a={a}&b={b}&run_id={r}",
                         &[&mid, &mid, &rid],
                         None,
+                    )
+                    .await
+                }
+                ("put", t) if t.ends_with("/clock-offset") => {
+                    app.call(
+                        "PUT",
+                        template,
+                        &args,
+                        Some(json!({ "clock_offset_s": 4.0 })),
                     )
                     .await
                 }

@@ -44,6 +44,10 @@ fn every_fixed_route_of_the_contract_is_documented() {
         ("post", "/api/jobs/{id}/cancel"),
         ("post", "/api/jobs/{id}/retry"),
         ("get", "/api/jobs/{id}/events"),
+        ("get", "/api/campaigns/{id}/clock-offset"),
+        ("put", "/api/campaigns/{id}/clock-offset"),
+        ("get", "/api/runs/{id}/clock-offset"),
+        ("put", "/api/runs/{id}/clock-offset"),
     ] {
         assert!(
             spec["paths"][path][method].is_object(),

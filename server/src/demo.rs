@@ -148,6 +148,7 @@ pub async fn upload_all(
                 &prof,
                 &[("file".to_string(), path)],
                 &RunMeta::default(),
+                &Default::default(),
                 planned.as_ref(),
             )
         })

@@ -3,6 +3,7 @@
 //! validate models. Numerics live in `seatrial-core`; this crate is the thin
 //! layer of storage (SQLite via sqlx) and HTTP (axum).
 
+pub mod clock;
 pub mod demo;
 pub mod error;
 pub mod http;

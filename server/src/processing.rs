@@ -9,7 +9,9 @@ use std::path::PathBuf;
 
 use std::collections::BTreeMap;
 
-use seatrial_core::alignment::{AlignmentReport, OffsetOptions, align_logs};
+use seatrial_core::alignment::{
+    AlignmentReport, OffsetOptions, OffsetPriors, align_logs_with, check_user_offset,
+};
 use seatrial_core::logs::Gap;
 use seatrial_core::logs::{
     LogRole, ParseOptions, ParsedLog, input_columns, output_columns, parse_log, to_uniform,
@@ -37,6 +39,11 @@ pub struct RunMeta {
     pub shared_channel: Option<String>,
     /// Resampling rate (Hz); default the log's own rate (the lower of the two for two-file runs).
     pub rate_hz: Option<f64>,
+    /// Clock offset of a two-file run set by hand (s, added to navigation
+    /// time stamps to put them on the control clock; within ±86 400 s).
+    /// It overrides the offset estimated from the shared channel; change or
+    /// clear it later with `PUT /api/runs/{id}/clock-offset`.
+    pub clock_offset_s: Option<f64>,
 }
 
 impl RunMeta {
@@ -227,16 +234,36 @@ fn logged_column(schedule_column: &str) -> String {
     }
 }
 
+/// The request field an alignment error about a prior offset concerns.
+fn prior_field(core_field: &str) -> &'static str {
+    match core_field {
+        "priors.user_run_s" => "meta.clock_offset_s",
+        "priors.user_campaign_s" => "campaign.clock_offset_s",
+        "priors.pooled" => "campaign.pooled_clock_offset",
+        _ => "shared_channel",
+    }
+}
+
 /// Parses, aligns (two-file runs) and resamples a stored run into one
 /// uniform record; what was found (rows, gaps, warnings, alignment) goes into
-/// `summary`. Identification jobs load accepted runs through this too, so the
-/// record they fit is the one the quality report scored.
+/// `summary`. Two-file runs are merged with the offset chosen from `priors`
+/// (set by hand for the run or campaign, the campaign's pooled offset) and
+/// their own estimate, see [`seatrial_core::alignment::choose_offset`];
+/// `priors.user_run_s` is the run's hand-set offset (at upload,
+/// `meta.clock_offset_s`). Identification jobs load accepted runs through
+/// this too, so the record they fit is the one the quality report scored
+/// (unless the campaign's offsets changed since: jobs use the current ones).
 pub fn load_record(
     vessel: &VesselProfile,
     files: &[(String, PathBuf)],
     meta: &RunMeta,
+    priors: &OffsetPriors,
     summary: &mut RunSummary,
 ) -> Result<UniformRecord, ProcessError> {
+    if let Some(v) = priors.user_run_s {
+        check_user_offset("meta.clock_offset_s", v)
+            .map_err(|e| ProcessError::new("meta.clock_offset_s", e.message()))?;
+    }
     if let Some(r) = meta.rate_hz
         && !(r.is_finite() && r > 0.0 && r <= 1000.0)
     {
@@ -277,14 +304,22 @@ pub fn load_record(
         let nav = parse(vessel, np, LogRole::Nav, "nav", Some(shared))?;
         note("control", &control, summary);
         note("nav", &nav, summary);
-        let (rec, report) = align_logs(
+        let (rec, report) = align_logs_with(
             &control.table,
             &nav.table,
             shared,
             meta.rate_hz,
             &OffsetOptions::default(),
+            priors,
         )
-        .map_err(|e| ProcessError::new("shared_channel", e.to_string()))?;
+        .map_err(|e| {
+            let field = prior_field(e.field());
+            if field == "shared_channel" {
+                ProcessError::new(field, e.to_string())
+            } else {
+                ProcessError::new(field, e.message())
+            }
+        })?;
         summary
             .warnings
             .extend(report.warnings.iter().map(|w| RunWarning {
@@ -299,15 +334,17 @@ pub fn load_record(
     Ok(rec)
 }
 
-/// Parses, aligns, resamples and scores a run.
+/// Parses, aligns (with `priors`, see [`load_record`]), resamples and
+/// scores a run.
 pub fn process_run(
     vessel: &VesselProfile,
     files: &[(String, PathBuf)],
     meta: &RunMeta,
+    priors: &OffsetPriors,
     planned: Option<&(StoredExperiment, Schedule)>,
 ) -> Result<Processed, ProcessError> {
     let mut summary = RunSummary::default();
-    let rec = load_record(vessel, files, meta, &mut summary)?;
+    let rec = load_record(vessel, files, meta, priors, &mut summary)?;
     let dofs: Vec<DofChannels> = vessel
         .dofs
         .iter()

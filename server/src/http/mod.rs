@@ -4,6 +4,7 @@
 //! itself and a test holds the two together.
 
 pub mod campaigns;
+pub mod clock_offsets;
 pub mod discrepancies;
 pub mod export;
 pub mod health;
@@ -117,6 +118,14 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(runs::raw_run))
         .routes(routes!(runs::run_quality))
         .routes(routes!(runs::coverage))
+        .routes(routes!(
+            clock_offsets::get_campaign_clock_offset,
+            clock_offsets::put_campaign_clock_offset
+        ))
+        .routes(routes!(
+            clock_offsets::get_run_clock_offset,
+            clock_offsets::put_run_clock_offset
+        ))
         .routes(routes!(jobs::submit_job, jobs::list_jobs))
         .routes(routes!(jobs::get_job))
         .routes(routes!(jobs::cancel_job))

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use super::query::ApiQuery;
 use super::{AppState, blocking, found};
+use crate::clock::CampaignClocks;
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::processing::{self, RunMeta, RunSummary};
 use crate::storage::models::{self, ModelSummary, StoredModel};
@@ -272,6 +273,9 @@ pub async fn compare_models(
         &campaign.vessel_id,
     )?;
     let meta = RunMeta::of_stored(run.summary.as_ref());
+    let priors = CampaignClocks::load(&s.db, &run.campaign_id)
+        .await?
+        .priors_for(Some(&run.id));
     let files: Vec<_> = run
         .files
         .iter()
@@ -286,7 +290,7 @@ pub async fn compare_models(
     let (run_id, run_name) = (run.id.clone(), run.name.clone());
     let reports = blocking(move || -> Result<Vec<serde_json::Value>, ApiError> {
         let mut summary = RunSummary::default();
-        let record = processing::load_record(&profile, &files, &meta, &mut summary)
+        let record = processing::load_record(&profile, &files, &meta, &priors, &mut summary)
             .map_err(|e| ApiError::invalid("run_id", e.message))?;
         let input = RunInput {
             run_id: run_id.clone(),

@@ -11,17 +11,20 @@ use serde::Deserialize;
 
 use super::json::parse_json;
 use super::{AppState, blocking, found};
+use seatrial_core::alignment::{OffsetPriors, check_user_offset};
+
+use crate::clock::CampaignClocks;
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::processing::{self, Coverage, RunMeta};
 use crate::storage::blobs::BlobWriter;
 use crate::storage::runs::{self, NewFile, Run};
-use crate::storage::{campaigns, plans, vessels};
+use crate::storage::{campaigns, clock_offsets, plans, vessels};
 
 /// The multipart form of an upload (documentation of the parts).
 #[derive(Debug, utoipa::ToSchema)]
 #[allow(dead_code)]
 pub struct UploadForm {
-    /// JSON metadata: `{"experiment_id"?, "name"?, "shared_channel"? (default "z"), "rate_hz"?}`.
+    /// JSON metadata: `{"experiment_id"?, "name"?, "shared_channel"? (default "z"), "rate_hz"?, "clock_offset_s"? (two-file runs: the offset set by hand, s)}`.
     meta: Option<RunMeta>,
     /// A single log with every column the vessel needs.
     #[schema(value_type = Option<String>, format = Binary)]
@@ -193,6 +196,16 @@ pub async fn upload_run(
             ));
         }
     };
+    if let Some(v) = meta.clock_offset_s {
+        if layout == "single" {
+            return Err(ApiError::invalid(
+                "meta.clock_offset_s",
+                "a single-file run has one clock: a clock offset applies to two-file runs (control + nav)",
+            ));
+        }
+        check_user_offset("meta.clock_offset_s", v)
+            .map_err(|e| ApiError::invalid("meta.clock_offset_s", e.message()))?;
+    }
     let planned = match &meta.experiment_id {
         Some(eid) => Some(
             plans::experiment(&s.db, &campaign.id, eid)
@@ -229,12 +242,22 @@ pub async fn upload_run(
         .iter()
         .map(|f| (f.role.clone(), s.blobs.path(&f.blob.sha256)))
         .collect();
+    let priors = OffsetPriors {
+        user_run_s: meta.clock_offset_s,
+        ..CampaignClocks::load(&s.db, &campaign.id)
+            .await?
+            .priors_for(None)
+    };
+    let user_offset = meta.clock_offset_s;
     let outcome = blocking(move || {
-        processing::process_run(&vessel.profile, &inputs, &meta, planned.as_ref())
+        processing::process_run(&vessel.profile, &inputs, &meta, &priors, planned.as_ref())
     })
     .await?;
     match outcome {
         Ok(done) => {
+            if user_offset.is_some() {
+                clock_offsets::set_run_offset(&s.db, &run.id, user_offset).await?;
+            }
             runs::finish(
                 &s.db,
                 &run.id,

@@ -120,7 +120,7 @@ impl JobHandler for Discover {
                 let s: DiscoverCampaignSettings =
                     parse_settings(&settings).map_err(|(f, m)| JobFailure::field(f, m))?;
                 progress.update(0.0, "reading runs")?;
-                let inputs = run_inputs::read(&profile, &stored)?;
+                let (inputs, _) = run_inputs::read(&profile, &stored)?;
                 let forces = generalized_force_columns(&profile);
                 let mut sub = SubProgress::new(progress, 0.05, 0.98);
                 let out = discover_campaign(

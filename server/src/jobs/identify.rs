@@ -172,7 +172,7 @@ impl JobHandler for Identify {
                 .unwrap_or(Lineage::New);
             Ok(compute(move |progress: &mut dyn Progress| {
                 progress.update(0.0, "reading runs")?;
-                let inputs = run_inputs::read(&profile, &stored)?;
+                let (inputs, clocks) = run_inputs::read(&profile, &stored)?;
                 let mut sub = seatrial_core::estimation::SubProgress::new(progress, 0.05, 0.95);
                 let forces = generalized_force_columns(&profile);
                 let out: Result<Identified, IdentifyError> = match method.as_str() {
@@ -193,11 +193,14 @@ impl JobHandler for Identify {
                         identify_n4sid_campaign(&profile, &forces, &inputs, &s, &mut sub)
                     }
                 };
-                let out = out.map_err(|e| match e {
+                let mut out = out.map_err(|e| match e {
                     IdentifyError::Cancelled => JobFailure::Cancelled,
                     e => JobFailure::field(e.field().to_string(), e.to_string()),
                 })?;
-                Ok(NewModelOutput(NewModel {
+                out.document
+                    .notes
+                    .extend(clocks.iter().map(run_inputs::RunClock::note));
+                let model = NewModel {
                     lineage,
                     campaign_id,
                     vessel_id,
@@ -215,14 +218,16 @@ impl JobHandler for Identify {
                         .map_err(|e| JobFailure::new(e.to_string()))?,
                     validation: serde_json::to_value(&out.validation)
                         .map_err(|e| JobFailure::new(e.to_string()))?,
-                }))
+                };
+                Ok(NewModelOutput(model, clocks))
             }))
         })
     }
 }
 
-/// A model to store when the job succeeds.
-pub struct NewModelOutput(pub NewModel);
+/// A model to store when the job succeeds, and the clock offsets its
+/// two-file runs were read with (reported in the job's result).
+pub struct NewModelOutput(pub NewModel, pub Vec<run_inputs::RunClock>);
 
 impl Persist for NewModelOutput {
     fn persist<'a>(
@@ -231,12 +236,14 @@ impl Persist for NewModelOutput {
         job: &'a Job,
     ) -> BoxFuture<'a, anyhow::Result<serde_json::Value>> {
         Box::pin(async move {
-            let mut m = self.0;
+            let NewModelOutput(mut m, clocks) = *self;
             m.job_id = Some(job.id.clone());
             let saved = models::insert(conn, m).await?;
-            Ok(
-                serde_json::json!({ "model_id": saved.id, "version": saved.version, "lineage_id": saved.lineage_id }),
-            )
+            let mut result = serde_json::json!({ "model_id": saved.id, "version": saved.version, "lineage_id": saved.lineage_id });
+            if !clocks.is_empty() {
+                result["clock_offsets"] = serde_json::to_value(&clocks)?;
+            }
+            Ok(result)
         })
     }
 }

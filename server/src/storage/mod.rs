@@ -4,6 +4,7 @@
 
 pub mod blobs;
 pub mod campaigns;
+pub mod clock_offsets;
 pub mod discrepancies;
 pub mod jobs;
 pub mod models;

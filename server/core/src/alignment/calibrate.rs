@@ -2,17 +2,24 @@
 //! (`ambiguity.rs`) to the reported standard deviation, the `informative`
 //! flag and its reason in words.
 //!
-//! `σ² = (κ·σ_local)² + (R/2)²`, with `R` the distance from the estimate to
-//! the farthest plausible offset outside the refinement window: ±2σ then
-//! covers every offset the data cannot rule out. `κ = 1.25` widens the local
+//! `σ² = max(κ·σ_local, 0.005·dt)² + (R/2)²`, with `R` the distance from
+//! the estimate to the farthest plausible offset outside the refinement
+//! window (`dt` the slower log's interval): ±2σ then covers every offset
+//! the data cannot rule out, and no estimate claims a precision finer than
+//! the refinement resolves on noise-free logs. `κ = 1.25` widens the local
 //! error, whose root-mean-square ratio to the actual error was measured at
 //! 1.14 on short noisy records (`tests/offset.rs`); with it the ±2σ
 //! coverage of strong runs meets 95 % (`tests/calibration.rs`).
 
 use super::ambiguity::{Plausible, Shape};
+use super::warnings::offset_words;
 
 /// Widening of the local standard error (see the module documentation).
 pub(crate) const LOCAL_STD_FACTOR: f64 = 1.25;
+/// Smallest standard deviation, in intervals of the slower log: the
+/// resolution of the refinement (interpolation, prefilter, minimizer) on
+/// noise-free logs, where the local error alone claims microseconds.
+pub(crate) const RESOLUTION_SAMPLES: f64 = 0.005;
 /// Largest standard deviation, in intervals of the slower log, of an
 /// informative estimate.
 pub(crate) const INFORMATIVE_STD_SAMPLES: f64 = 0.25;
@@ -55,7 +62,7 @@ pub(crate) fn calibrate(e: &Evidence) -> Calibrated {
             .map(|&m| (offset_of(m) - e.offset_s).abs())
             .fold(0.0, f64::max)
     });
-    let local = LOCAL_STD_FACTOR * e.local_std_s;
+    let local = (LOCAL_STD_FACTOR * e.local_std_s).max(RESOLUTION_SAMPLES * e.dt_slow);
     let std_error_s = (local * local + 0.25 * reach * reach).sqrt();
     let alternatives_s: Vec<f64> = e
         .plausible
@@ -114,15 +121,17 @@ pub(crate) fn calibrate(e: &Evidence) -> Calibrated {
         Some((_, None)) if std_error_s > limit => (
             false,
             format!(
-                "imprecise: ±{std_error_s:.3} s is more than a quarter of the slower log's {:.3} s sample interval",
+                "imprecise: {} is more than a quarter of the slower log's {:.3} s sample interval",
+                offset_words(e.offset_s, Some(std_error_s)),
                 e.dt_slow
             ),
         ),
         Some((_, None)) => (
             true,
             format!(
-                "one offset fits clearly best: no other in the search range fits as well (correlation {:.3}, ±{std_error_s:.4} s)",
-                e.rho
+                "one offset fits clearly best: no other in the search range fits as well (correlation {:.3}; {})",
+                e.rho,
+                offset_words(e.offset_s, Some(std_error_s))
             ),
         ),
     };

@@ -66,3 +66,4 @@ pub use error::AlignError;
 pub use merge::{AlignmentReport, align_logs, align_logs_with};
 pub use offset::{Confidence, OffsetEstimate, OffsetOptions, estimate_offset};
 pub use pool::{OUTLIER_Z, PooledOffset, RejectedRun, RunOffset, pool_offsets};
+pub use warnings::offset_words;

@@ -25,6 +25,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::warnings::offset_words;
+
 /// Leave-one-out |z| beyond which a run is inconsistent with the others.
 pub const OUTLIER_Z: f64 = 4.0;
 
@@ -190,8 +192,10 @@ pub fn pool_offsets(runs: &[RunOffset]) -> Option<PooledOffset> {
         (r, name)
     }) {
         warnings.push(format!(
-            "run “{name}” is left out: its offset {:.3} ± {:.3} s disagrees with the pooled {offset_s:.3} s (z = {:.1}); its computers' clocks may have been reset",
-            r.offset_s, r.std_s, r.z
+            "run “{name}” is left out: its offset {} disagrees with the pooled {} (z = {:.1}); its computers' clocks may have been reset",
+            offset_words(r.offset_s, Some(r.std_s)),
+            offset_words(offset_s, Some(std_s)),
+            r.z
         ));
     }
     Some(PooledOffset {

@@ -31,6 +31,18 @@ pub(crate) fn fmt_num(v: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
+/// An offset with its standard deviation, with the digits the σ supports:
+/// `7.43002 ± 0.00050 s`, `1.699 ± 272.840 s`, `7.500 s` (no σ: set by hand).
+pub fn offset_words(offset_s: f64, std_s: Option<f64>) -> String {
+    match std_s {
+        Some(s) if s > 0.0 && s.is_finite() => {
+            let d = ((-s.log10()).ceil() as i64 + 1).clamp(3, 6) as usize;
+            format!("{offset_s:.d$} ± {s:.d$} s")
+        }
+        _ => format!("{offset_s:.3} s"),
+    }
+}
+
 /// The source of an offset in words ("hand-set run", "pooled", …).
 pub(crate) fn source_words(source: OffsetSource) -> &'static str {
     match source {
@@ -84,8 +96,9 @@ pub(crate) fn offset_warnings(c: &Context) -> Vec<String> {
     let ch = c.chosen;
     let own_words = |o: &OffsetEstimate| {
         format!(
-            "its own estimate is {:.3} ± {:.3} s ({})",
-            o.offset_s, o.std_error_s, o.reason
+            "its own estimate is {} ({})",
+            offset_words(o.offset_s, Some(o.std_error_s)),
+            o.reason
         )
     };
     match ch.source {
@@ -94,16 +107,20 @@ pub(crate) fn offset_warnings(c: &Context) -> Vec<String> {
                 && o.confidence == Confidence::Medium
             {
                 w.push(format!(
-                    "the clock offset is only moderately certain (correlation {:.2}, peak ratio {:.2}, ±{:.3} s); {plot}",
-                    o.correlation, o.peak_ratio, o.std_error_s
+                    "the clock offset {} is only moderately certain (correlation {:.2}, peak ratio {:.2}); {plot}",
+                    offset_words(o.offset_s, Some(o.std_error_s)),
+                    o.correlation,
+                    o.peak_ratio
                 ));
             }
         }
         OffsetSource::WeakOwn => {
             if let Some(o) = c.own {
                 w.push(format!(
-                    "THE CLOCK OFFSET IS NOT RELIABLE: {:.3} ± {:.3} s is this run's own estimate, which is not informative — {}. No campaign offset was available to replace it: set the run's or the campaign's offset by hand, or upload a run of this campaign whose {} changes clearly; {plot}",
-                    o.offset_s, o.std_error_s, o.reason, c.shared
+                    "THE CLOCK OFFSET IS NOT RELIABLE: {} is this run's own estimate, which is not informative — {}. No campaign offset was available to replace it: set the run's or the campaign's offset by hand, or upload a run of this campaign whose {} changes clearly; {plot}",
+                    offset_words(o.offset_s, Some(o.std_error_s)),
+                    o.reason,
+                    c.shared
                 ));
             }
         }
@@ -126,8 +143,8 @@ pub(crate) fn offset_warnings(c: &Context) -> Vec<String> {
                 .own
                 .map_or_else(String::new, |o| format!("; {}", own_words(o)));
             w.push(format!(
-                "the clock offset {:.3} s is the {} one{own}",
-                ch.offset_s,
+                "the clock offset {} is the {} one{own}",
+                offset_words(ch.offset_s, None),
                 source_words(ch.source)
             ));
         }
@@ -140,11 +157,10 @@ pub(crate) fn offset_warnings(c: &Context) -> Vec<String> {
         let z = (o.offset_s - ch.offset_s) / o.std_error_s.hypot(ch.std_s.unwrap_or(0.0));
         if z.abs() > DISAGREE_Z {
             w.push(format!(
-                "the run's own informative estimate {:.3} ± {:.3} s disagrees with the {} offset {:.3} s used (z = {z:.1})",
-                o.offset_s,
-                o.std_error_s,
+                "the run's own informative estimate {} disagrees with the {} offset {} used (z = {z:.1})",
+                offset_words(o.offset_s, Some(o.std_error_s)),
                 source_words(ch.source),
-                ch.offset_s
+                offset_words(ch.offset_s, ch.std_s)
             ));
         }
     }
@@ -152,8 +168,9 @@ pub(crate) fn offset_warnings(c: &Context) -> Vec<String> {
         let z = (o.offset_s - p.offset_s) / o.std_error_s.hypot(p.std_s);
         if z.abs() > DISAGREE_Z {
             w.push(format!(
-                "this run's offset {:.3} ± {:.3} s disagrees with the campaign's pooled {:.3} ± {:.3} s (z = {z:.1}): were its computers' clocks reset?",
-                o.offset_s, o.std_error_s, p.offset_s, p.std_s
+                "this run's offset {} disagrees with the campaign's pooled {} (z = {z:.1}): were its computers' clocks reset?",
+                offset_words(o.offset_s, Some(o.std_error_s)),
+                offset_words(p.offset_s, Some(p.std_s))
             ));
         }
     }
