@@ -70,6 +70,10 @@ export const api = {
   run: (rid) => request('GET', `/api/runs/${enc(rid)}`),
   quality: (rid) => request('GET', urls.quality(rid)),
   coverage: (id) => request('GET', `/api/campaigns/${enc(id)}/coverage`),
+  // Clock offsets of two-file runs (s; null clears the one set by hand).
+  campaignClockOffset: (id) => request('GET', `/api/campaigns/${enc(id)}/clock-offset`),
+  setCampaignClockOffset: (id, s) => request('PUT', `/api/campaigns/${enc(id)}/clock-offset`, { clock_offset_s: s }),
+  setRunClockOffset: (rid, s) => request('PUT', `/api/runs/${enc(rid)}/clock-offset`, { clock_offset_s: s }),
   // Background jobs (identification, discovery) and the models they store.
   jobs: (campaignId) => request('GET', `/api/jobs${campaignId ? `?campaign_id=${enc(campaignId)}` : ''}`),
   job: (jid) => request('GET', `/api/jobs/${enc(jid)}`),

@@ -11,6 +11,7 @@ import { DURATIONS, gridText } from './campaigns.js';
 import { schedulePlot, psdPlot, destroyPlots } from './plots.js';
 import { runsSection } from './runs.js';
 import { identifySection } from './identify.js';
+import { campaignOffsetPanel } from './offsetpanel.js';
 
 const isExcitedWithAnalysis = (c) => c.excited && c.analysis;
 
@@ -101,6 +102,7 @@ export async function campaignPage(view, id) {
       h('dt', null, 'Durations'), h('dd', null, DURATIONS.filter((d) => durs[d.key] != null).map((d) => `${d.label.toLowerCase()} ${fmt(durs[d.key])} s`).join(' · ') || 'defaults'),
       h('dt', null, 'Seed'), h('dd', { class: 'mono' }, c.seed ?? 'default')),
     runsHost,
+    campaignOffsetPanel(c.id),
     identifyHost,
     h('h2', { class: 'section-title' }, 'Plan'),
     planHost);

@@ -10,6 +10,7 @@ import { h, fill } from './forms.js';
 import { PALETTE, psdUnit } from './plots.js';
 import { spectrumPlot, singularValuePlot, syncX, exact } from './runplots.js';
 import { verdictBadge, statusBadge, coverageBadge, errorWhere, errorText, rawLinks } from './runs.js';
+import { runOffsetPanel } from './offsetpanel.js';
 
 const GOOD_COHERENCE = 0.8; // server: quality::verdict::GOOD_COHERENCE (the reasons quote it)
 
@@ -177,7 +178,7 @@ export async function runPage(view, rid) {
           h('dt', null, 'Files'), h('dd', null, filesTable(run))),
         // Alignment warnings are shown with the alignment.
         warningsList((s.warnings || []).filter((x) => !(s.alignment && x.file === 'alignment')))),
-      s.alignment ? h('div', null, h('h2', null, 'Alignment'), alignmentBox(s.alignment)) : null),
+      run.layout === 'split' ? h('div', null, h('h2', null, 'Alignment'), runOffsetPanel(run), s.alignment ? alignmentBox(s.alignment) : null) : null),
 
     run.status === 'accepted' ? qualityHost : null);
 
