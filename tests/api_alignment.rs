@@ -15,11 +15,6 @@ use serde_json::{Value, json};
 /// The campaign's clock offset: control stamps = nav stamps + 7.43 s.
 const TRUTH: f64 = 7.43;
 
-const CONTROL: [&str; 7] = ["tau_X", "tau_Y", "tau_Z", "tau_K", "tau_M", "tau_N", "z"];
-const NAV: [&str; 12] = [
-    "u", "v", "w", "p", "q", "r", "x", "y", "z", "phi", "theta", "psi",
-];
-
 async fn campaign(app: &TestApp) -> String {
     let r = app
         .call("POST", "/api/vessels", &[], Some(rov_profile()))
@@ -44,10 +39,7 @@ fn strong(seed: u64) -> (String, String) {
         3.0,
         1e-4,
     );
-    (
-        sim::csv(&run, &CONTROL, TRUTH, 2),
-        sim::csv(&run, &NAV, 0.0, 1),
-    )
+    sim::two_file_csv(&run, TRUTH, 2)
 }
 
 /// A run at steady depth: the horizontal DOFs are excited, the depth holds
@@ -70,9 +62,9 @@ fn weak(seed: u64) -> (String, String) {
     };
     let (zc, zn) = (depth(&mut rng), depth(&mut rng));
     run.eta[2] = zc;
-    let control = sim::csv(&run, &CONTROL, TRUTH, 2);
+    let (control, _) = sim::two_file_csv(&run, TRUTH, 2);
     run.eta[2] = zn;
-    (control, sim::csv(&run, &NAV, 0.0, 1))
+    (control, sim::two_file_csv(&run, TRUTH, 2).1)
 }
 
 async fn upload(

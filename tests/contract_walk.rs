@@ -145,20 +145,7 @@ async fn every_documented_operation_is_exercised_and_answers() {
     let rid = r.json["id"].as_str().unwrap().to_string();
     // A two-file run, for the clock-offset routes.
     let split = simulate(10, 10.0, 300.0, [300.0; 6], 2.0, 1e-4);
-    let control = sim::csv(
-        &split,
-        &["tau_X", "tau_Y", "tau_Z", "tau_K", "tau_M", "tau_N", "z"],
-        4.0,
-        1,
-    );
-    let nav = sim::csv(
-        &split,
-        &[
-            "u", "v", "w", "p", "q", "r", "x", "y", "z", "phi", "theta", "psi",
-        ],
-        0.0,
-        1,
-    );
+    let (control, nav) = sim::two_file_csv(&split, 4.0, 1);
     let r = app
         .upload_run(
             &cid,

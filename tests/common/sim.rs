@@ -109,6 +109,23 @@ pub fn csv(run: &SimRun, cols: &[&str], t_offset: f64, every: usize) -> String {
     s
 }
 
+/// The controller's log of a two-file run: forces and the shared depth.
+pub const CONTROL_COLUMNS: [&str; 7] = ["tau_X", "tau_Y", "tau_Z", "tau_K", "tau_M", "tau_N", "z"];
+/// The navigation computer's log of a two-file run: velocities and pose.
+pub const NAV_COLUMNS: [&str; 12] = [
+    "u", "v", "w", "p", "q", "r", "x", "y", "z", "phi", "theta", "psi",
+];
+
+/// The (control, nav) CSVs of a two-file run: the controller's clock
+/// `offset_s` ahead of the navigation computer's, control every
+/// `control_every`-th sample.
+pub fn two_file_csv(run: &SimRun, offset_s: f64, control_every: usize) -> (String, String) {
+    (
+        csv(run, &CONTROL_COLUMNS, offset_s, control_every),
+        csv(run, &NAV_COLUMNS, 0.0, 1),
+    )
+}
+
 /// All 18 columns of a 6-DOF single-file log.
 pub fn all_columns() -> Vec<&'static str> {
     FORCES

@@ -140,6 +140,17 @@ async fn campaign_view(s: &AppState, campaign_id: &str) -> ApiResult<CampaignClo
     })
 }
 
+/// A 422 naming `field` unless `run` has two files.
+fn two_file(run: &Run, field: &str) -> ApiResult<()> {
+    if run.layout == "split" {
+        return Ok(());
+    }
+    Err(ApiError::invalid(
+        field,
+        "a single-file run has one clock: clock offsets apply to two-file runs (control + nav)",
+    ))
+}
+
 /// Reads `{"clock_offset_s": seconds | null}`: 422 naming the field for a
 /// value that is not a finite number of seconds within a day.
 fn requested_offset(body: &Value) -> ApiResult<Option<f64>> {
@@ -234,12 +245,7 @@ pub async fn get_run_clock_offset(
     Path(id): Path<String>,
 ) -> ApiResult<Json<RunClockOffset>> {
     let run = found(runs::get(&s.db, &id).await?, "run", &id)?;
-    if run.layout != "split" {
-        return Err(ApiError::invalid(
-            "id",
-            "a single-file run has one clock: clock offsets apply to two-file runs",
-        ));
-    }
+    two_file(&run, "id")?;
     let clocks = CampaignClocks::load(&s.db, &run.campaign_id).await?;
     Ok(Json(view_of(&run, &clocks)))
 }
@@ -264,12 +270,7 @@ pub async fn put_run_clock_offset(
 ) -> ApiResult<Json<Run>> {
     let run = found(runs::get(&s.db, &id).await?, "run", &id)?;
     let offset = requested_offset(&body)?;
-    if run.layout != "split" {
-        return Err(ApiError::invalid(
-            "clock_offset_s",
-            "a single-file run has one clock: clock offsets apply to two-file runs (control + nav)",
-        ));
-    }
+    two_file(&run, "clock_offset_s")?;
     let campaign = found(
         campaigns::get(&s.db, &run.campaign_id).await?,
         "campaign",

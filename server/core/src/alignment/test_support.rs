@@ -196,6 +196,35 @@ impl LogSpec {
     }
 }
 
+/// Control over true [0, duration] on clock `true + 100`, nav over a random
+/// sub-window (up to 10 % off each end) on clock `true + 100 − offset`; ±1 %
+/// stamp jitter, white noise `noise` on both.
+fn log_pair(
+    rng: &mut Rng,
+    (control_hz, nav_hz): (f64, f64),
+    duration: f64,
+    offset: f64,
+    noise: f64,
+) -> (LogSpec, LogSpec) {
+    let control = LogSpec {
+        rate_hz: control_hz,
+        start: 0.0,
+        end: duration,
+        clock: 100.0,
+        jitter: 0.01,
+        noise,
+    };
+    let nav = LogSpec {
+        rate_hz: nav_hz,
+        start: rng.range(0.0, 0.1 * duration),
+        end: duration - rng.range(0.0, 0.1 * duration),
+        clock: 100.0 - offset,
+        jitter: 0.01,
+        noise,
+    };
+    (control, nav)
+}
+
 /// A case of the accuracy sweeps: truth, control and nav logs of a shared
 /// depth channel. Nav stamps = true + `control.clock − offset`.
 pub(crate) struct Case {
@@ -223,22 +252,7 @@ pub(crate) fn make_case(
         Depth::lively(&mut rng, duration)
     };
     let noise = depth.std(0.0, duration) * 10f64.powf(-snr_db / 20.0);
-    let control = LogSpec {
-        rate_hz: control_hz,
-        start: 0.0,
-        end: duration,
-        clock: 100.0,
-        jitter: 0.01,
-        noise,
-    };
-    let nav = LogSpec {
-        rate_hz: nav_hz,
-        start: rng.range(0.0, 0.1 * duration),
-        end: duration - rng.range(0.0, 0.1 * duration),
-        clock: 100.0 - offset,
-        jitter: 0.01,
-        noise,
-    };
+    let (control, nav) = log_pair(&mut rng, (control_hz, nav_hz), duration, offset, noise);
     let c = control.sample(|t| depth.eval(t), &mut rng);
     let n = nav.sample(|t| depth.eval(t), &mut rng);
     Case {
@@ -309,22 +323,7 @@ pub(crate) fn make_run(kind: RunKind, seed: u64, offset: f64) -> Case {
     };
     let own = |rng: &mut Rng| Depth::drift(rng, wander, 0.01, 0.0);
     let (wander_c, wander_n) = (own(&mut rng), own(&mut rng));
-    let control = LogSpec {
-        rate_hz: 10.0,
-        start: 0.0,
-        end: duration,
-        clock: 100.0,
-        jitter: 0.01,
-        noise,
-    };
-    let nav = LogSpec {
-        rate_hz: 20.0,
-        start: rng.range(0.0, 0.1 * duration),
-        end: duration - rng.range(0.0, 0.1 * duration),
-        clock: 100.0 - offset,
-        jitter: 0.01,
-        noise,
-    };
+    let (control, nav) = log_pair(&mut rng, (10.0, 20.0), duration, offset, noise);
     let c = control.sample(|t| depth.eval(t) + wander_c.eval(t), &mut rng);
     let n = nav.sample(|t| depth.eval(t) + wander_n.eval(t), &mut rng);
     Case {
