@@ -277,7 +277,7 @@ pub fn identify_lambda_campaign(
             .iter()
             .map(|s| {
                 let (gamma, nu) = gamma_nu(s, n, g)?;
-                Ok(Experiment { h: s.h, nu, gamma })
+                Ok(Experiment::new(s.h, nu, gamma))
             })
             .collect()
     };

@@ -172,11 +172,7 @@ pub fn identify_baseline(p: &VesselProfile, restoring: Restoring, runs: &[Record
     };
     let exps: Vec<Experiment> = runs
         .iter()
-        .map(|r| Experiment {
-            h: r.h,
-            nu: r.nu.clone(),
-            gamma: &r.tau - g_of(r),
-        })
+        .map(|r| Experiment::new(r.h, r.nu.clone(), &r.tau - g_of(r)))
         .collect();
     let settings = LambdaSettings::new(
         Dof::ALL.to_vec(),
