@@ -4,7 +4,7 @@
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
-use crate::kinematics::skew;
+use crate::kinematics::{Trig, skew};
 use crate::vessel::Vessel;
 
 fn split(v: &Vector6<f64>) -> (Vector3<f64>, Vector3<f64>) {
@@ -99,8 +99,12 @@ pub fn restoring_lumped(
     phi: f64,
     theta: f64,
 ) -> Vector6<f64> {
-    let (sf, cf) = phi.sin_cos();
-    let (st, ct) = theta.sin_cos();
+    restoring_trig(w_minus_b, zg_w_minus_zb_b, &Trig::new(phi, theta, 0.0))
+}
+
+/// g(η) from precomputed sines and cosines.
+pub fn restoring_trig(w_minus_b: f64, zg_w_minus_zb_b: f64, t: &Trig) -> Vector6<f64> {
+    let (sf, cf, st, ct) = (t.sf, t.cf, t.st, t.ct);
     Vector6::new(
         w_minus_b * st,
         -w_minus_b * ct * sf,

@@ -9,8 +9,8 @@
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
-use crate::forces::coriolis_force;
-use crate::kinematics::{attitude_transform, rotation_zyx};
+use crate::forces::{coriolis_force, restoring_trig};
+use crate::kinematics::{Trig, rotation_zyx};
 use crate::vessel::Vessel;
 
 /// The plant's state: pose η (NED), velocity over ground ν (body) and the
@@ -50,7 +50,9 @@ pub struct Plant {
     vessel: Vessel,
     m_rb: Matrix6<f64>,
     m_a: Matrix6<f64>,
+    m: Matrix6<f64>,
     m_inv: Matrix6<f64>,
+    zg_w_minus_zb_b: f64,
     has_current: bool,
 }
 
@@ -62,7 +64,9 @@ impl Plant {
             vessel: vessel.clone(),
             m_rb: vessel.m_rb(),
             m_a: vessel.m_a(),
+            m,
             m_inv: m.try_inverse().expect("M is positive definite"),
+            zg_w_minus_zb_b: vessel.zg_w_minus_zb_b(),
             has_current: vessel.current_ned != Vector3::zeros(),
         }
     }
@@ -108,23 +112,28 @@ impl Plant {
             ),
             None => (self.limit(tau_cmd), Vector6::zeros()),
         };
-        let (phi, theta, psi) = (x.eta[3], x.eta[4], x.eta[5]);
-        let r = rotation_zyx(phi, theta, psi);
-        let nu_c = self.current_body(&x.eta);
-        let nu_r = x.nu - nu_c;
-        let hydro = coriolis_force(&self.m_rb, &x.nu)
-            + coriolis_force(&self.m_a, &nu_r)
-            + v.damping_force(&nu_r)
-            + v.restoring(&x.eta);
+        let trig = Trig::new(x.eta[3], x.eta[4], x.eta[5]);
+        let r = trig.rotation();
+        let restoring = restoring_trig(v.w_minus_b, self.zg_w_minus_zb_b, &trig);
+        let (nu_r, coriolis) = if self.has_current {
+            let nu_r = x.nu - self.current_body(&x.eta);
+            let c = coriolis_force(&self.m_rb, &x.nu) + coriolis_force(&self.m_a, &nu_r);
+            (nu_r, c)
+        } else {
+            // ν_r = ν: C_RB(ν)ν + C_A(ν)ν = C(ν)ν with M (C is linear in M)
+            (x.nu, coriolis_force(&self.m, &x.nu))
+        };
+        let hydro = coriolis + v.damping_force(&nu_r) + restoring;
         let mut nu_dot = self.m_inv * (tau + v.tether - hydro);
         if self.has_current {
+            let nu_c = x.nu - nu_r;
             let c1 = Vector3::new(nu_c[0], nu_c[1], nu_c[2]);
             let w = Vector3::new(x.nu[3], x.nu[4], x.nu[5]);
             let dc = c1.cross(&w);
             nu_dot += Vector6::new(dc.x, dc.y, dc.z, 0.0, 0.0, 0.0);
         }
         let p = r * x.nu.fixed_rows::<3>(0);
-        let a = attitude_transform(phi, theta) * x.nu.fixed_rows::<3>(3);
+        let a = trig.attitude_transform() * x.nu.fixed_rows::<3>(3);
         State {
             eta: Vector6::new(p.x, p.y, p.z, a.x, a.y, a.z),
             nu: nu_dot,
@@ -162,6 +171,6 @@ impl Plant {
 
     /// Kinetic energy ½ νᵀ M ν (Fossen 2011, eq. 3.77 with M = M_RB + M_A).
     pub fn kinetic_energy(&self, nu: &Vector6<f64>) -> f64 {
-        0.5 * nu.dot(&((self.m_rb + self.m_a) * nu))
+        0.5 * nu.dot(&(self.m * nu))
     }
 }
