@@ -13,6 +13,8 @@ pub enum Json {
     Bool(bool),
     /// A number (non-finite prints as null).
     Num(f64),
+    /// An unsigned integer, printed exactly (seeds).
+    UInt(u64),
     /// A string.
     Str(String),
     /// An array.
@@ -54,6 +56,9 @@ impl Json {
                 let _ = write!(out, "{x}");
             }
             Json::Num(_) => out.push_str("null"),
+            Json::UInt(n) => {
+                let _ = write!(out, "{n}");
+            }
             Json::Str(s) => write_str(out, s),
             Json::Arr(items) if items.iter().all(|i| matches!(i, Json::Num(_))) => {
                 out.push('[');

@@ -190,7 +190,7 @@ impl Campaign {
         let runs = self.runs.iter().map(run_json).collect();
         Json::obj([
             ("generator", Json::str("seatrial-truth")),
-            ("seed", Json::Num(self.seed as f64)),
+            ("seed", Json::UInt(self.seed)),
             ("clock_offset_s", Json::Num(self.clock_offset_s)),
             (
                 "clock_offset_convention",
@@ -236,8 +236,8 @@ fn run_json(r: &Run) -> Json {
         ("duration_s", Json::Num(m.duration_s)),
         ("clock_offset_s", Json::Num(m.clock_offset_s)),
         ("saturated_fraction", Json::Num(m.saturated_fraction)),
-        ("rows", Json::Num(r.log.t.len() as f64)),
-        ("nav_rows", Json::Num(r.nav.t.len() as f64)),
+        ("rows", Json::UInt(r.log.t.len() as u64)),
+        ("nav_rows", Json::UInt(r.nav.t.len() as u64)),
         (
             "files",
             Json::obj([
