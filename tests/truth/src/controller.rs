@@ -2,7 +2,8 @@
 //! (noisy) state, as on the Surveyor ROV (thesis §1.4: SISO PID loops per
 //! degree of freedom, automatic roll and pitch):
 //! - PI loops on u, v, w, r: τᵢ = Kpᵢ eᵢ + Kiᵢ ∫eᵢ, e = ν_ref − ν_meas;
-//! - PD attitude loops on φ, θ: τ = Kp (Θ_ref − Θ_meas) − Kd ω_meas;
+//! - PD attitude loops on φ, θ: τ = Kp (Θ_ref − Θ_meas) − Kd ω_meas, with
+//!   Kp = Î ω² + ½ ẑ_G W and Kd = 2ζ √(Kp Î);
 //! - feed-forward of a NOMINAL ĝ(η_meas) (eq. 4.6 with the team's W − B and
 //!   z_G W − z_B B, off the truth by 20–40 %);
 //! - τ_cmd = feedback + ĝ(η), clipped at per-DOF limits, with conditional
@@ -72,20 +73,23 @@ impl ControllerConfig {
         let mut kp = Vector6::zeros();
         let mut ki = Vector6::zeros();
         let mut kd = Vector6::zeros();
+        let mut off = || 1.0 + rng.sign() * rng.range(0.2, 0.4);
+        let nominal_w_minus_b = vessel.w_minus_b * off();
+        let nominal_zg_w_minus_zb_b = vessel.zg_w_minus_zb_b() * off();
         for i in 0..6 {
             let nominal = m[(i, i)] * rng.range(0.8, 1.2);
             let w = BANDWIDTH[i];
             if i == 3 || i == 4 {
-                kp[i] = nominal * w * w;
-                kd[i] = 2.0 * ATTITUDE_ZETA * nominal * w;
+                // The feed-forward cancels ĝ, so the loop's stiffness is
+                // Kp + (z_G W − ẑ_G W): half the nominal righting moment in
+                // Kp keeps it positive when ĝ overshoots the truth by 40 %.
+                kp[i] = nominal * w * w + 0.5 * nominal_zg_w_minus_zb_b.abs();
+                kd[i] = 2.0 * ATTITUDE_ZETA * (kp[i] * nominal).sqrt();
             } else {
                 kp[i] = nominal * w;
                 ki[i] = kp[i] * w / 3.0;
             }
         }
-        let mut off = || 1.0 + rng.sign() * rng.range(0.2, 0.4);
-        let nominal_w_minus_b = vessel.w_minus_b * off();
-        let nominal_zg_w_minus_zb_b = vessel.zg_w_minus_zb_b() * off();
         ControllerConfig {
             kp,
             ki,

@@ -1,27 +1,39 @@
 //! Vessels to fly: seeded random ROVs within published-size ranges, and a
 //! fixed Surveyor-like work-class vehicle.
 //!
-//! Damping is set through time constants: for DOF i the effective damping at
-//! a reference speed a_i is d_i = M_ii / T_i, split into a linear part
-//! α d_i (of which a fraction β grows with |u|, referred to u = 1 m/s) and a
-//! quadratic part (1 − α) d_i / a_i.
+//! Damping is set through time constants T_i: the damping of DOF i at its
+//! reference speed a_i is d_i = M_ii / T_i (at u = 1 m/s in surge, at u = 0
+//! in the other DOFs), split into a linear part α d_i and a quadratic part
+//! (1 − α) d_i / a_i.
+//!
+//! The speed-scheduled part D_lu|u| plays the hull's lift and cross-flow
+//! drag: it keeps the vessel directionally stable. Without it the Munk
+//! moments of C_A(ν_r)ν_r, (M₂₂ − M₁₁)uv in yaw and (M₃₃ − M₁₁)uw in pitch,
+//! make the sway–yaw and heave–pitch pairs statically unstable at speed
+//! (Fossen 2011, §7.5.2; Routh–Hurwitz on the linearized pair:
+//! d_v d_r > M₁₁(M₂₂ − M₁₁)u²). So D_lu,v D_lu,r ≥ κ M₁₁(M₂₂ − M₁₁) and
+//! D_lu,w D_lu,q ≥ κ M₁₁(M₃₃ − M₁₁), κ = [`DIRECTIONAL_MARGIN`], split in
+//! proportion to the inertias; surge and roll get D_lu = β D_l0 (per m/s).
 
-use nalgebra::{Vector3, Vector6};
+use nalgebra::{Matrix6, Vector3, Vector6};
 
 use crate::rng::{Rng, derive_seed};
 use crate::vessel::{Actuator, GRAVITY, Vessel};
 
-/// Reference speeds at which the time constants hold: 1.0 m/s in surge,
+/// Reference DOF speeds a_i of the time constants: 1.0 m/s in surge,
 /// 0.5 m/s in sway and heave, 0.3 rad/s in roll, pitch and yaw.
 pub const DAMPING_REFERENCE_SPEED: [f64; 6] = [1.0, 0.5, 0.5, 0.3, 0.3, 0.3];
+
+/// κ: static directional stability margin of the speed-scheduled damping.
+pub const DIRECTIONAL_MARGIN: f64 = 1.2;
 
 /// Seawater density (kg/m³).
 const RHO: f64 = 1025.0;
 
-/// Damping for time constants `t` (s), linear fractions `alpha` and
-/// speed-scheduled fractions `beta`, given the diagonal of M.
+/// (D_l0, D_lu, D_q) for time constants `t` (s), linear fractions `alpha`
+/// and scheduled fractions `beta`, given M (see the module notes).
 fn damping_from_time_constants(
-    m_diag: &Vector6<f64>,
+    m: &Matrix6<f64>,
     t: &Vector6<f64>,
     alpha: &Vector6<f64>,
     beta: &Vector6<f64>,
@@ -30,11 +42,24 @@ fn damping_from_time_constants(
     let mut lu = Vector6::zeros();
     let mut q = Vector6::zeros();
     for i in 0..6 {
-        let d = m_diag[i] / t[i];
+        let d = m[(i, i)] / t[i];
         let lin = alpha[i] * d;
-        l0[i] = lin * (1.0 - beta[i]);
-        lu[i] = lin * beta[i]; // per (m/s) of |u|, referred to 1 m/s
         q[i] = (1.0 - alpha[i]) * d / DAMPING_REFERENCE_SPEED[i];
+        if i == 0 {
+            // surge: l0 + lu·(1 m/s) + q·(1 m/s) = d
+            l0[i] = lin * (1.0 - beta[i]);
+            lu[i] = lin * beta[i];
+        } else {
+            l0[i] = lin;
+            lu[i] = beta[i] * lin;
+        }
+    }
+    // λ with λ² M_jj M_kk = κ M₁₁ (M_jj − M₁₁): lu_j = λ M_jj, lu_k = λ M_kk
+    for (j, k) in [(1, 5), (2, 4)] {
+        let munk = (m[(j, j)] - m[(0, 0)]).max(0.0);
+        let lambda = (DIRECTIONAL_MARGIN * m[(0, 0)] * munk / (m[(j, j)] * m[(k, k)])).sqrt();
+        lu[j] = lu[j].max(lambda * m[(j, j)]);
+        lu[k] = lu[k].max(lambda * m[(k, k)]);
     }
     (l0, lu, q)
 }
@@ -46,7 +71,8 @@ impl Vessel {
     /// - I_g of that box times a factor ∈ [0.8, 1.2] per axis;
     /// - added mass ∈ [30, 100] % of m (translation) or of I_o,ii (rotation);
     /// - time constants ∈ [1, 6] s, linear fraction α ∈ [0.3, 0.7],
-    ///   speed-scheduled fraction β ∈ [0.1, 0.4];
+    ///   speed-scheduled fraction β ∈ [0.1, 0.4], raised in sway, heave,
+    ///   pitch and yaw for directional stability (module notes);
     /// - z_G ∈ [0.03, 0.15] m, z_B = 0, W − B ∈ [−40, 80] N;
     /// - no current, no tether, ideal actuators.
     pub fn draw(seed: u64) -> Vessel {
@@ -95,12 +121,12 @@ impl Vessel {
             actuator: Actuator::default(),
             size: Vector3::new(l, b, h),
         };
-        let m_diag = v.m().diagonal();
+        let m = v.m();
         (
             v.damping_linear,
             v.damping_linear_per_speed,
             v.damping_quadratic,
-        ) = damping_from_time_constants(&m_diag, &t, &alpha, &beta);
+        ) = damping_from_time_constants(&m, &t, &alpha, &beta);
         v
     }
 
@@ -143,12 +169,12 @@ impl Vessel {
             size: Vector3::new(l, b, h),
         };
         let t = Vector6::new(4.0, 3.0, 3.0, 1.5, 1.5, 2.0);
-        let m_diag = v.m().diagonal();
+        let m = v.m();
         (
             v.damping_linear,
             v.damping_linear_per_speed,
             v.damping_quadratic,
-        ) = damping_from_time_constants(&m_diag, &t, &Vector6::repeat(0.5), &Vector6::repeat(0.25));
+        ) = damping_from_time_constants(&m, &t, &Vector6::repeat(0.5), &Vector6::repeat(0.25));
         v
     }
 }
@@ -168,16 +194,37 @@ mod tests {
             assert!(m.cholesky().is_some(), "M must be positive definite");
             assert!((m - m.transpose()).norm() < 1e-9);
             for i in 0..6 {
-                // effective damping at the reference speed gives T in [1, 6] s
+                // damping at the reference speed gives T in [1, 6] s
                 let a = DAMPING_REFERENCE_SPEED[i];
+                let u = if i == 0 { 1.0 } else { 0.0 };
                 let d = v.damping_linear[i]
-                    + v.damping_linear_per_speed[i]
+                    + v.damping_linear_per_speed[i] * u
                     + v.damping_quadratic[i] * a;
                 let t = m[(i, i)] / d;
                 assert!((1.0 - 1e-9..6.0 + 1e-9).contains(&t), "dof {i}: T = {t}");
             }
         }
         assert_ne!(Vessel::draw(1), Vessel::draw(2));
+    }
+
+    #[test]
+    fn drawn_vessels_are_directionally_stable_at_every_speed() {
+        // ν̇ = −M⁻¹ D̄(u₀) ν, D̄ the tangent including C(ν)'s Munk terms:
+        // every eigenvalue of M⁻¹ D̄ has a positive real part.
+        for seed in 0..51 {
+            let v = if seed == 50 {
+                Vessel::surveyor_like()
+            } else {
+                Vessel::draw(seed)
+            };
+            let m_inv = v.m().try_inverse().unwrap();
+            for u0 in [0.2, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0] {
+                let a = m_inv * v.linearization(u0).d_bar;
+                for e in a.complex_eigenvalues().iter() {
+                    assert!(e.re > 0.0, "seed {seed} at {u0} m/s: eigenvalue {e}");
+                }
+            }
+        }
         assert_eq!(Vessel::draw(1), Vessel::draw(1));
     }
 }

@@ -40,16 +40,16 @@ fn tangent_matches_central_differences() {
 fn effective_sway_damping_is_the_statistical_not_the_tangent_linearization() {
     let v = Vessel::draw(4);
     let spec = CampaignSpec {
-        grid_speeds: vec![1.0],
+        grid_speeds: vec![0.5],
         dynamic_dofs: vec![Dof::Sway],
         validation_duration_s: 60.0,
         ..CampaignSpec::default()
     };
     let c = fly_campaign(&v, &spec, 4);
-    let runs = c.runs_at(1.0, Role::Dynamic);
+    let runs = c.runs_at(0.5, Role::Dynamic);
     assert_eq!(runs.len(), 1);
     let eff = effective_linearization(&v, &runs);
-    let tan = v.linearization(1.0);
+    let tan = v.linearization(0.5);
     // quadratic sway damping q|v|v fitted by a line: slope q cov(|v|v, v)/var(v)
     // (≈ q E|v|³/E v² for a zero-mean excitation)
     let vs: Vec<f64> = runs[0].truth.nu.column(1).iter().copied().collect();
@@ -66,7 +66,7 @@ fn effective_sway_damping_is_the_statistical_not_the_tangent_linearization() {
         eff.d_bar[(1, 1)]
     );
     assert!(
-        predicted > 0.2 * tan.d_bar[(1, 1)],
+        predicted > 0.1 * tan.d_bar[(1, 1)],
         "the test needs visible quadratic damping"
     );
     // Not exact: the yaw rate and roll the sway motion induces are

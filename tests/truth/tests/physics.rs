@@ -26,16 +26,10 @@ fn at_rest() -> State {
 fn steady_surge_speed_is_the_root_of_linear_plus_quadratic_damping() {
     for seed in 0..5 {
         // W = B so surge sees no restoring force; z_G W still rights pitch.
-        // Equal translational added mass removes the Munk moment
-        // (A_33 − A_11)uw, which at speed can beat z_G W and leave the open
-        // loop in a slow heave–pitch limit cycle instead of a steady state.
-        let mut v = Vessel {
+        let v = Vessel {
             w_minus_b: 0.0,
             ..Vessel::draw(seed)
         };
-        let a = v.added_mass[0];
-        v.added_mass[1] = a;
-        v.added_mass[2] = a;
         let plant = Plant::new(&v);
         for tau_x in [40.0, -25.0, 150.0] {
             let tau = Vector6::new(tau_x, 0.0, 0.0, 0.0, 0.0, 0.0);

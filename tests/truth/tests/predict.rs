@@ -96,11 +96,21 @@ fn true_model_predicts_a_flown_validation_run() {
         let e1 = rms(&(&p.one_step - &log.nu), j, 1);
         let e10 = rms(&(&p.k_step - &log.nu), j, 10);
         let ep = rms(&(&persistence - &log.nu), j, 10);
+        let er = rms(&(&p.restarted_10s - &log.nu), j, 0);
+        let ef = rms(&(&p.free_run - &log.nu), j, 0);
+        let spread = run.truth.nu.column(j).variance().sqrt();
         let sigma = c.spec.noise.nu_std(j);
-        println!("ν_{j}: 1-step {e1:.4}, 10-step {e10:.4}, persistence {ep:.4}, σ {sigma}");
+        println!(
+            "ν_{j}: 1-step {e1:.4}, 10-step {e10:.4}, restarted {er:.4}, free {ef:.4}, persistence {ep:.4}, std {spread:.4}, σ {sigma}"
+        );
         assert!(
             e10 < 0.5 * ep,
             "ν_{j}: the true model must beat persistence"
+        );
+        // the open-loop vessel is stable, so even free runs stay on track
+        assert!(
+            er < 0.25 * spread && ef < 0.5 * spread,
+            "ν_{j}: {er} / {ef} of {spread}"
         );
         assert!(e1 < 4.0 * sigma + 0.2 * e10, "ν_{j}: 1-step error {e1}");
     }
