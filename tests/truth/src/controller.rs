@@ -47,7 +47,7 @@ pub struct ControllerConfig {
     pub ki: Vector6<f64>,
     /// Rate gains of the attitude loops (zero elsewhere).
     pub kd: Vector6<f64>,
-    /// |τ_cmd,i| ≤ limits[i].
+    /// |τ_cmd,i| ≤ `limits[i]`.
     pub limits: Vector6<f64>,
     /// The team's W − B (N).
     pub nominal_w_minus_b: f64,

@@ -18,8 +18,8 @@ fn join(a: &Vector3<f64>, b: &Vector3<f64>) -> Vector6<f64> {
     Vector6::new(a.x, a.y, a.z, b.x, b.y, b.z)
 }
 
-/// C(ν) from a symmetric inertia matrix M (Fossen 2011, Thm 3.2, eq. 3.46;
-/// the same form gives C_A(ν_r) from M_A, eq. 6.43):
+/// C(ν) from a symmetric inertia matrix M (Fossen 2011, Thm 3.2;
+/// the same form gives C_A(ν_r) from M_A, ch. 6):
 /// C(ν) = [[0, −S(M₁₁ν₁ + M₁₂ν₂)], [−S(M₁₁ν₁ + M₁₂ν₂), −S(M₂₁ν₁ + M₂₂ν₂)]].
 /// Skew-symmetric for every ν, so νᵀC(ν)ν = 0.
 pub fn coriolis_matrix(m: &Matrix6<f64>, nu: &Vector6<f64>) -> Matrix6<f64> {

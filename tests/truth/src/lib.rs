@@ -39,4 +39,4 @@ pub use predict::{
 };
 pub use signals::SignalKind;
 pub use vessel::{Actuator, Vessel};
-pub use vessel_draw::DAMPING_REFERENCE_SPEED;
+pub use vessel_draw::{DAMPING_REFERENCE_SPEED, DIRECTIONAL_MARGIN};

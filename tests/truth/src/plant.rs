@@ -169,7 +169,7 @@ impl Plant {
         s
     }
 
-    /// Kinetic energy ½ νᵀ M ν (Fossen 2011, eq. 3.77 with M = M_RB + M_A).
+    /// Kinetic energy ½ νᵀ M ν with M = M_RB + M_A (Fossen 2011, ch. 3).
     pub fn kinetic_energy(&self, nu: &Vector6<f64>) -> f64 {
         0.5 * nu.dot(&(self.m * nu))
     }

@@ -22,7 +22,7 @@ pub struct Actuator {
 
 /// True parameters of a 6-DOF ROV.
 ///
-/// Damping (Fossen 2011, §6.4, diagonal linear + quadratic):
+/// Damping (Fossen 2011, ch. 6: diagonal linear + quadratic):
 /// D(ν_r)ν_r with D(ν_r) = D_l0 + D_lu·|u_r| + D_q·diag(|ν_r|), all diagonal.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Vessel {
@@ -94,7 +94,7 @@ impl Vessel {
         out
     }
 
-    /// M_A = diag(added mass) (Fossen 2011, eq. 6.39 with only diagonal terms).
+    /// M_A = diag(added mass): only the diagonal of Fossen's M_A (2011, ch. 6).
     pub fn m_a(&self) -> Matrix6<f64> {
         Matrix6::from_diagonal(&self.added_mass)
     }

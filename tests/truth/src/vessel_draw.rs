@@ -10,8 +10,8 @@
 //! drag: it keeps the vessel directionally stable. Without it the Munk
 //! moments of C_A(ν_r)ν_r, (M₂₂ − M₁₁)uv in yaw and (M₃₃ − M₁₁)uw in pitch,
 //! make the sway–yaw and heave–pitch pairs statically unstable at speed
-//! (Fossen 2011, §7.5.2; Routh–Hurwitz on the linearized pair:
-//! d_v d_r > M₁₁(M₂₂ − M₁₁)u²). So D_lu,v D_lu,r ≥ κ M₁₁(M₂₂ − M₁₁) and
+//! (Routh–Hurwitz on the linearized pair needs d_v d_r > M₁₁(M₂₂ − M₁₁)u²).
+//! So D_lu,v D_lu,r ≥ κ M₁₁(M₂₂ − M₁₁) and
 //! D_lu,w D_lu,q ≥ κ M₁₁(M₃₃ − M₁₁), κ = [`DIRECTIONAL_MARGIN`], split in
 //! proportion to the inertias; surge and roll get D_lu = β D_l0 (per m/s).
 

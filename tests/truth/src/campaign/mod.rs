@@ -148,7 +148,7 @@ pub struct RunMeta {
     pub amplitude: f64,
     /// Half period (square) or bit time (PRBS) (s); None otherwise.
     pub switch_time_s: Option<f64>,
-    /// Forward speeds flown in order (validation staircase; else [u₀]).
+    /// Forward speeds flown in order (validation staircase; else `[u₀]`).
     pub speeds: Vec<f64>,
     /// First log stamp (s), control clock.
     pub start_s: f64,
