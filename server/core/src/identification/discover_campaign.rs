@@ -602,14 +602,21 @@ mod tests {
         runs
     }
 
+    /// The λ model without g(η) and constant loads, so that the restoring,
+    /// tether and load effects the cases conceal are missing from it.
     fn baseline(runs: &[RunInput]) -> Identified {
         let profile = surveyor_rov();
+        let settings = LambdaCampaignSettings {
+            estimate_restoring: false,
+            constant_loads: false,
+            ..LambdaCampaignSettings::default()
+        };
         identify_lambda_campaign(
             &profile,
             &[0.5, 1.0],
             &force_columns(&profile),
             runs,
-            &LambdaCampaignSettings::default(),
+            &settings,
             &mut NoProgress,
         )
         .unwrap()
@@ -757,7 +764,11 @@ mod tests {
             &grid,
             &force_columns(&profile),
             &runs,
-            &LambdaCampaignSettings::default(),
+            &LambdaCampaignSettings {
+                estimate_restoring: false,
+                constant_loads: false,
+                ..LambdaCampaignSettings::default()
+            },
             &mut NoProgress,
         )
         .unwrap();

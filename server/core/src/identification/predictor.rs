@@ -40,6 +40,7 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                         matrix(&p.m, "M")?,
                         matrix(&p.d_bar, "D̄")?,
                     )
+                    .and_then(|m| m.with_load(super::augmented::load_of(doc, p)))
                     .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?,
                 );
             }

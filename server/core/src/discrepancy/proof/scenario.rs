@@ -48,6 +48,7 @@ pub fn restoring_of(t: &RovTruth) -> Restoring {
         w_minus_b: r.weight - r.buoyancy,
         zg_w_minus_zb_b: r.r_g[2] * r.weight - r.r_b[2] * r.buoyancy,
         tether_pitch_moment: 0.0,
+        constant: [0.0; 6],
     }
 }
 
