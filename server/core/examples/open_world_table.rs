@@ -19,6 +19,7 @@ fn main() {
             structure = it.next().map(|s| match s.as_str() {
                 "diagonal" => StructureChoice::Diagonal,
                 "coupled" => StructureChoice::Coupled,
+                "symmetric" => StructureChoice::Symmetric,
                 _ => StructureChoice::Auto,
             });
         } else if let Ok(s) = a.parse::<u64>() {
@@ -41,7 +42,12 @@ fn main() {
         );
         let mut worst: Vec<_> = r.z.iter().collect();
         worst.sort_by(|a, b| b.z().abs().total_cmp(&a.z().abs()));
-        for z in worst.iter().take(12) {
+        let filter = std::env::var("SHOW").ok();
+        let shown: Vec<_> = match &filter {
+            Some(f) => r.z.iter().filter(|z| z.name.contains(f.as_str())).collect(),
+            None => worst.iter().take(12).copied().collect(),
+        };
+        for z in shown {
             println!(
                 "  {:<22} est {:>11.4} truth {:>11.4} σ {:>9.4} z {:>7.1}",
                 z.name,

@@ -72,19 +72,13 @@ pub(crate) fn functions_of(eta: &DMatrix<f64>, which: Functions) -> DMatrix<f64>
 /// The exogenous specification for `dofs`: the constant acts on every DOF,
 /// sin θ on surge (W−B) and pitch (z_G W − z_B B), cos θ sin φ on sway and
 /// roll. Prior std of F: ten times the DOF's force limit (weak).
-pub(crate) fn specification(
-    profile: &VesselProfile,
-    dofs: &[Dof],
-    which: Functions,
-) -> Exogenous {
+pub(crate) fn specification(profile: &VesselProfile, dofs: &[Dof], which: Functions) -> Exogenous {
     let n = dofs.len();
     let names: Vec<String> = match which {
         Functions::Constant => vec![CONSTANT.into()],
-        Functions::ConstantAndRestoring => vec![
-            CONSTANT.into(),
-            SIN_THETA.into(),
-            COS_THETA_SIN_PHI.into(),
-        ],
+        Functions::ConstantAndRestoring => {
+            vec![CONSTANT.into(), SIN_THETA.into(), COS_THETA_SIN_PHI.into()]
+        }
     };
     let pattern = DMatrix::from_fn(n, names.len(), |i, j| match j {
         0 => true,

@@ -12,14 +12,13 @@ use super::document::{
 };
 use super::error::IdentifyError;
 use super::joint_restoring::{Functions, PooledRestoring, load, specification};
+use super::lambda_coriolis::fit_points;
 use super::lambda_data::{experiment, per_point, static_holds};
 use super::lambda_physical::enforce;
 use super::lambda_structure::choose_structure;
 use super::outcome::{Identified, RunValidation};
 use super::roles::assign_roles;
-use crate::estimation::lambda::{
-    Experiment, LambdaEstimate, LambdaSettings, MIN_T_OVER_H, Prior, identify_lpv,
-};
+use crate::estimation::lambda::{Experiment, LambdaEstimate, LambdaSettings, MIN_T_OVER_H, Prior};
 use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
 use crate::estimation::{Progress, SubProgress};
 use crate::logs::schema::pose_column;
@@ -33,9 +32,15 @@ use crate::validation::{ValidationRecord, ValidationSettings, validate};
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum StructureChoice {
-    /// Propose the coupling from partial coherence between DOFs (default).
+    /// Port–starboard symmetry (default for 6-DOF and 3-DOF vessels) plus
+    /// any pair the partial coherence between DOFs proposes; for other DOF
+    /// sets the coherence proposal alone.
     #[default]
     Auto,
+    /// Port–starboard (xz-plane) symmetry: surge, heave and pitch couple
+    /// among themselves, sway, roll and yaw among themselves (Fossen 2011,
+    /// sec. 7.5: the longitudinal and lateral subsystems).
+    Symmetric,
     /// Each DOF alone (the thesis's first, uncoupled LPV model).
     Diagonal,
     /// Every entry of A and B free.
@@ -92,6 +97,11 @@ pub struct LambdaCampaignSettings {
     /// part of W − B, the offset of the damping's linearization at speed).
     #[serde(default = "default_true")]
     pub constant_loads: bool,
+    /// Take the couplings of C(ν)ν at the grid speed from the estimated M
+    /// (Fossen 2011, eq. 6.43; 6-DOF and 3-DOF horizontal models), so the
+    /// structure constrains the damping D and D̄ = D + J_C(M, u₀).
+    #[serde(default = "default_true")]
+    pub coriolis_from_m: bool,
 }
 
 fn default_threshold() -> f64 {
@@ -116,6 +126,7 @@ impl Default for LambdaCampaignSettings {
             scheduling: SchedulingChoice::Interpolate,
             estimate_restoring: true,
             constant_loads: true,
+            coriolis_from_m: true,
         }
     }
 }
@@ -289,10 +300,12 @@ pub fn identify_lambda_campaign(
         ));
         let joint = {
             let mut sub = SubProgress::new(progress, 0.05, 0.4);
-            identify_lpv(
+            fit_points(
                 &points_of(build(None, Some(Functions::ConstantAndRestoring))?),
                 &lambda_settings,
+                settings.coriolis_from_m,
                 &mut sub,
+                &mut notes,
             )
             .map_err(lambda_error)?
         };
@@ -319,7 +332,14 @@ pub fn identify_lambda_campaign(
     let estimates = {
         let from = if with_restoring { 0.4 } else { 0.1 };
         let mut sub = SubProgress::new(progress, from, 0.8);
-        identify_lpv(&points_of(exps.clone()), &lambda_settings, &mut sub).map_err(lambda_error)?
+        fit_points(
+            &points_of(exps.clone()),
+            &lambda_settings,
+            settings.coriolis_from_m,
+            &mut sub,
+            &mut notes,
+        )
+        .map_err(lambda_error)?
     };
 
     // 3. Sub-models, physical structure enforced, parameters.
@@ -330,7 +350,14 @@ pub fn identify_lambda_campaign(
     for (speed, est) in &estimates {
         let idx = grid.iter().position(|g| g == speed).unwrap_or(0);
         let (load, load_std) = joint_load(est, n);
-        let physical = enforce(&dofs, est, &load, &exps[idx], *speed)?;
+        let physical = enforce(
+            &dofs,
+            est,
+            &load,
+            &exps[idx],
+            *speed,
+            settings.coriolis_from_m,
+        )?;
         findings.extend(physical.findings);
         let model = physical.model;
         for i in 0..n {
@@ -511,10 +538,7 @@ fn restoring_doc(
         ));
     }
     RestoringDoc {
-        parameters: vec![
-            row("W−B", wb, "N"),
-            row("z_G·W − z_B·B", bg, "N·m"),
-        ],
+        parameters: vec![row("W−B", wb, "N"), row("z_G·W − z_B·B", bg, "N·m")],
         evidence,
         params: pooled.params(),
     }

@@ -26,7 +26,12 @@ pub(crate) struct PointData {
     pub run_ids: Vec<Vec<String>>,
 }
 
-fn segs(run: &RunInput, cols: &[String], outputs: &[String], min: usize) -> Result<Vec<Segment>, IdentifyError> {
+fn segs(
+    run: &RunInput,
+    cols: &[String],
+    outputs: &[String],
+    min: usize,
+) -> Result<Vec<Segment>, IdentifyError> {
     segments(run, cols, outputs, min)
         .map_err(|e| IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string()))
 }
@@ -113,8 +118,14 @@ pub(crate) fn static_holds(
     if holds.is_empty() {
         return Ok(None);
     }
-    let taus: Vec<DMatrix<f64>> = holds.iter().map(|s| s.u.columns(0, 6).into_owned()).collect();
-    let etas: Vec<DMatrix<f64>> = holds.iter().map(|s| s.u.columns(6, 6).into_owned()).collect();
+    let taus: Vec<DMatrix<f64>> = holds
+        .iter()
+        .map(|s| s.u.columns(0, 6).into_owned())
+        .collect();
+    let etas: Vec<DMatrix<f64>> = holds
+        .iter()
+        .map(|s| s.u.columns(6, 6).into_owned())
+        .collect();
     let records: Vec<StaticRecord<'_>> = holds
         .iter()
         .zip(taus.iter().zip(&etas))
@@ -149,9 +160,9 @@ pub(crate) fn experiment(
     let with_eta = seg.u.ncols() >= n + 6;
     let eta = with_eta.then(|| seg.u.columns(n, 6).into_owned());
     let gamma = match (restoring, &eta) {
-        (Some(r), Some(eta)) => r.gamma(&tau, eta).map_err(|e| {
-            IdentifyError::invalid(format!("runs[{}]", seg.run_id), e.to_string())
-        })?,
+        (Some(r), Some(eta)) => r
+            .gamma(&tau, eta)
+            .map_err(|e| IdentifyError::invalid(format!("runs[{}]", seg.run_id), e.to_string()))?,
         _ => tau,
     };
     let rows = seg.y.nrows();

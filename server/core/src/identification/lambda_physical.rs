@@ -8,6 +8,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::error::IdentifyError;
+use super::lambda_coriolis::coriolis_jacobian;
 use crate::estimation::lambda::{Experiment, LambdaEstimate};
 use crate::models::{LinearVesselModel, project_physical};
 use crate::planning::dof::Dof;
@@ -44,37 +45,78 @@ fn percent(x: f64) -> String {
 }
 
 /// The stored sub-model at `speed` from the estimate `est` with load
-/// `load`, projected onto the physical set when it is not physical.
+/// `load`, projected onto the physical set when it is not physical. With
+/// `coriolis`, the damping checked and projected is D = D̄ − J_C(M, u₀) —
+/// at speed D̄ carries C(ν)'s linearization, whose symmetric part is not
+/// definite (the Munk moment), and only D must dissipate.
 pub(crate) fn enforce(
     dofs: &[Dof],
     est: &LambdaEstimate,
     load: &DVector<f64>,
     exps: &[Experiment],
     speed: f64,
+    coriolis: bool,
 ) -> Result<Enforced, IdentifyError> {
     let at = |m: &DMatrix<f64>, d: &DMatrix<f64>| {
         LinearVesselModel::new(dofs.to_vec(), m.clone(), d.clone())
             .and_then(|x| x.with_load(load.clone()))
     };
-    let raw = at(&est.m, &est.d_bar);
-    let violations = match &raw {
-        Ok(m) => m
-            .check_structure(TOL)
-            .map(|r| r.violations)
-            .unwrap_or_default(),
-        Err(e) => vec![e.to_string()],
+    let n = dofs.len();
+    let jc = |m: &DMatrix<f64>| {
+        coriolis
+            .then(|| coriolis_jacobian(m, dofs, speed))
+            .flatten()
+            .unwrap_or_else(|| DMatrix::zeros(n, n))
     };
+    let j0 = jc(&est.m);
+    let p = project_physical(&est.m, &(&est.d_bar - &j0));
+    let asym = {
+        let norm = est.m.norm();
+        if norm > 0.0 {
+            (&est.m - est.m.transpose()).norm() / norm
+        } else {
+            0.0
+        }
+    };
+    let raw = at(&est.m, &est.d_bar);
+    let mut violations = Vec::new();
+    if let Err(e) = &raw {
+        violations.push(e.to_string());
+    }
+    if asym > TOL {
+        violations.push(format!("M is not symmetric (‖M − Mᵀ‖/‖M‖ = {asym:.3})"));
+    }
+    if p.m_raised > 0 {
+        violations.push(format!(
+            "M has {} eigenvalue(s) that are not clearly positive",
+            p.m_raised
+        ));
+    }
+    if p.d_removed > 0 {
+        let what = if coriolis {
+            "the damping D = D̄ − J_C(M, u₀)"
+        } else {
+            "D̄"
+        };
+        violations.push(format!(
+            "{what} would feed energy into the vehicle in {} direction(s)",
+            p.d_removed
+        ));
+    }
     if violations.is_empty() {
         return Ok(Enforced {
             model: raw.map_err(|e| IdentifyError::invalid("model", e.to_string()))?,
             findings: Vec::new(),
         });
     }
-    let p = project_physical(&est.m, &est.d_bar);
-    let model = at(&p.m, &p.d_bar).map_err(|e| {
+    let d_bar = &p.d_bar + jc(&p.m);
+    let model = at(&p.m, &d_bar).map_err(|e| {
         IdentifyError::invalid("model", format!("at {speed:.2} m/s, after projection: {e}"))
     })?;
-    let cost = match (raw.ok().and_then(|r| one_step_rss(&r, exps)), one_step_rss(&model, exps)) {
+    let cost = match (
+        raw.ok().and_then(|r| one_step_rss(&r, exps)),
+        one_step_rss(&model, exps),
+    ) {
         (Some(before), Some(after)) => {
             let parts: Vec<String> = dofs
                 .iter()
@@ -93,29 +135,13 @@ pub(crate) fn enforce(
         }
         _ => "the unconstrained estimate could not be simulated, so its fit is not compared".into(),
     };
-    let mut what = Vec::new();
-    if p.m_raised > 0 {
-        what.push(format!(
-            "{} eigenvalue(s) of M raised to the floor",
-            p.m_raised
-        ));
-    } else {
-        what.push("M symmetrized".into());
-    }
-    if p.d_removed > 0 {
-        what.push(format!(
-            "{} energy-producing direction(s) of D̄ removed",
-            p.d_removed
-        ));
-    }
     Ok(Enforced {
         model,
         findings: vec![format!(
-            "at {speed:.2} m/s the estimate was not physical ({}); stored the nearest physical M and D̄ instead ({}; M changed by {}, D̄ by {}); cost: {cost}",
+            "at {speed:.2} m/s the estimate was not physical ({}); stored the nearest physical M and D̄ instead (M changed by {}, D̄ by {}); cost: {cost}",
             violations.join("; "),
-            what.join(", "),
             percent(p.m_change),
-            percent(p.d_change),
+            percent((&d_bar - &est.d_bar).norm() / est.d_bar.norm().max(f64::MIN_POSITIVE)),
         )],
     })
 }

@@ -17,6 +17,21 @@ pub(crate) struct ChosenStructure {
     pub name: &'static str,
 }
 
+/// Port–starboard symmetry: DOFs couple within the longitudinal (surge,
+/// heave, pitch) and lateral (sway, roll, yaw) subsystems.
+pub(crate) fn symmetric_pattern(dofs: &[Dof]) -> DMatrix<bool> {
+    let lateral = |d: Dof| matches!(d, Dof::Sway | Dof::Roll | Dof::Yaw);
+    DMatrix::from_fn(dofs.len(), dofs.len(), |i, j| {
+        lateral(dofs[i]) == lateral(dofs[j])
+    })
+}
+
+/// True for the DOF sets whose symmetric structure is standard: the full
+/// 6-DOF set and the 3-DOF horizontal one.
+fn has_symmetric_form(dofs: &[Dof]) -> bool {
+    dofs == Dof::ALL || dofs == [Dof::Surge, Dof::Sway, Dof::Yaw]
+}
+
 /// Chooses the structure from the settings; `auto` proposes it from
 /// `all` (every estimation experiment) and says why in `notes`.
 pub(crate) fn choose_structure(
@@ -39,6 +54,7 @@ pub(crate) fn choose_structure(
             name: "diagonal",
         },
         StructureChoice::Coupled => coupled(CouplingMask::full(n)),
+        StructureChoice::Symmetric => coupled(CouplingMask::from_pattern(&symmetric_pattern(dofs))),
         StructureChoice::Custom => {
             let rows = settings.coupling.as_ref().ok_or_else(|| {
                 IdentifyError::invalid(
@@ -76,6 +92,33 @@ pub(crate) fn choose_structure(
                     )
                 })
                 .collect();
+            if has_symmetric_form(dofs) {
+                let base = symmetric_pattern(dofs);
+                let extra: Vec<String> = proposal
+                    .evidence
+                    .iter()
+                    .filter(|p| proposal.mask.a[(p.output, p.input)] && !base[(p.output, p.input)])
+                    .map(|p| {
+                        format!(
+                            "{}←{} (partial coherence {:.2})",
+                            dofs[p.output].name(),
+                            dofs[p.input].name(),
+                            p.median_partial_coherence
+                        )
+                    })
+                    .collect();
+                notes.push(if extra.is_empty() {
+                    "structure: port–starboard symmetry (surge–heave–pitch and sway–roll–yaw coupled); the data propose no coupling across the two".into()
+                } else {
+                    format!(
+                        "structure: port–starboard symmetry plus couplings the data propose: {}",
+                        extra.join(", ")
+                    )
+                });
+                let pattern =
+                    DMatrix::from_fn(n, n, |i, j| base[(i, j)] || proposal.mask.a[(i, j)]);
+                return Ok(coupled(CouplingMask::from_pattern(&pattern)));
+            }
             notes.push(if pairs.is_empty() {
                 "coupling proposal: no DOF pair is coupled above the threshold; diagonal model"
                     .into()

@@ -8,12 +8,13 @@
 #![allow(dead_code)]
 
 use nalgebra::DMatrix;
+use nalgebra::DVector;
 use seatrial_core::estimation::NoProgress;
 use seatrial_core::identification::{
     LambdaCampaignSettings, RunInput, identify_lambda_campaign, lambda_campaign::StructureChoice,
 };
 use seatrial_core::logs::{LogRole, ParseOptions, parse_log, to_uniform};
-use seatrial_core::models::StructureReport;
+use seatrial_core::models::{coriolis, project_physical};
 use seatrial_core::planning::campaign::ExperimentFamily;
 use seatrial_core::planning::dof::Dof;
 use seatrial_core::planning::examples::surveyor_rov;
@@ -55,7 +56,8 @@ pub struct SeedReport {
     pub seed: u64,
     pub z: Vec<ZScore>,
     pub fits: Vec<ChannelFit>,
-    pub structure: Vec<StructureReport>,
+    /// Per grid point: speed, physical, and why not.
+    pub physical: Vec<(f64, bool, String)>,
     pub findings: Vec<String>,
     pub notes: Vec<String>,
 }
@@ -135,10 +137,7 @@ impl Affine {
                 i += 1;
             }
         }
-        let theta = x
-            .svd(true, true)
-            .solve(&y, 1e-12)
-            .expect("least squares");
+        let theta = x.svd(true, true).solve(&y, 1e-12).expect("least squares");
         Affine { theta }
     }
 
@@ -155,7 +154,12 @@ impl Affine {
     }
 }
 
-fn column_fit(measured: &DMatrix<f64>, predicted: &DMatrix<f64>, j: usize, skip: usize) -> Option<f64> {
+fn column_fit(
+    measured: &DMatrix<f64>,
+    predicted: &DMatrix<f64>,
+    j: usize,
+    skip: usize,
+) -> Option<f64> {
     let m: Vec<f64> = measured.column(j).iter().skip(skip).copied().collect();
     let p: Vec<f64> = predicted.column(j).iter().skip(skip).copied().collect();
     nrmse_fit(&m, &p)
@@ -180,8 +184,15 @@ pub fn evaluate(seed: u64, described: bool, settings: &LambdaCampaignSettings) -
         .map(|d| d.force_column().to_string())
         .collect();
     let grid: Vec<f64> = spec.grid_speeds.clone();
-    let out = identify_lambda_campaign(&profile, &grid, &columns, &inputs, settings, &mut NoProgress)
-        .expect("identification succeeds");
+    let out = identify_lambda_campaign(
+        &profile,
+        &grid,
+        &columns,
+        &inputs,
+        settings,
+        &mut NoProgress,
+    )
+    .expect("identification succeeds");
     let doc = &out.document;
     let lpv = doc.lpv.as_ref().expect("an LPV model");
 
@@ -198,13 +209,23 @@ pub fn evaluate(seed: u64, described: bool, settings: &LambdaCampaignSettings) -
             .collect();
         let lin = effective_linearization(&vessel, &runs);
         let name = |g: &str, i: usize, j: usize| {
-            format!("{g}[{},{}]@{:.2}", Dof::ALL[i].name(), Dof::ALL[j].name(), point.speed_mps)
+            format!(
+                "{g}[{},{}]@{:.2}",
+                Dof::ALL[i].name(),
+                Dof::ALL[j].name(),
+                point.speed_mps
+            )
         };
         for i in 0..6 {
             for j in 0..6 {
                 for (g, est, std, truth) in [
                     ("M", point.m[i][j], point.m_std[i][j], lin.m[(i, j)]),
-                    ("D̄", point.d_bar[i][j], point.d_bar_std[i][j], lin.d_bar[(i, j)]),
+                    (
+                        "D̄",
+                        point.d_bar[i][j],
+                        point.d_bar_std[i][j],
+                        lin.d_bar[(i, j)],
+                    ),
                 ] {
                     if std > 0.0 && std.is_finite() {
                         z.push(ZScore {
@@ -283,15 +304,49 @@ pub fn evaluate(seed: u64, described: bool, settings: &LambdaCampaignSettings) -
             one_step_affine: column_fit(&val_run.log.nu, &aff, j, 1),
         })
         .collect();
-    let structure = Vec::new();
+    let physical = lpv
+        .points
+        .iter()
+        .map(|p| {
+            let m = DMatrix::from_fn(6, 6, |i, j| p.m[i][j]);
+            let d = DMatrix::from_fn(6, 6, |i, j| p.d_bar[i][j]);
+            (p.speed_mps, physical(&m, &d, p.speed_mps))
+        })
+        .map(|(s, (ok, why))| (s, ok, why))
+        .collect();
     SeedReport {
         seed,
         z,
         fits,
-        structure,
+        physical,
         findings: doc.structure_findings.clone(),
         notes: doc.notes.clone(),
     }
+}
+
+/// M symmetric positive definite and D = D̄ − J_C(M, u₀) dissipative, with
+/// J_C the linearization of C(ν)ν (from the model's own M) at ν₀ = (u₀, 0…).
+fn physical(m: &DMatrix<f64>, d_bar: &DMatrix<f64>, u0: f64) -> (bool, String) {
+    let f = |nu: &DVector<f64>| coriolis(m, nu).expect("6-DOF") * nu;
+    let mut jc = DMatrix::zeros(6, 6);
+    for c in 0..6 {
+        let mut e = DVector::zeros(6);
+        e[0] = u0;
+        let (mut p, mut q) = (e.clone(), e.clone());
+        p[c] += 1.0;
+        q[c] -= 1.0;
+        jc.set_column(c, &((f(&p) - f(&q)) / 2.0));
+    }
+    let asym = (m - m.transpose()).norm() / m.norm();
+    let proj = project_physical(m, &(d_bar - &jc));
+    let ok = asym < 1e-9 && proj.m_raised == 0 && proj.d_removed == 0;
+    (
+        ok,
+        format!(
+            "M asymmetry {asym:.2e}, {} non-positive M eigenvalue(s), {} energy-producing D direction(s)",
+            proj.m_raised, proj.d_removed
+        ),
+    )
 }
 
 /// The default settings, or one structure.
