@@ -42,6 +42,8 @@ async fn stored_model(app: &TestApp, cid: &str, vid: &str) -> String {
             structure: "diagonal".into(),
             coupling: vec![vec![true]],
             points: vec![LpvPoint {
+                load: None,
+                load_std: None,
                 speed_mps: 0.5,
                 m: vec![vec![5800.0]],
                 m_std: vec![vec![50.0]],

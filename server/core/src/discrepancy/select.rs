@@ -223,7 +223,14 @@ pub(crate) fn cv_gain(
         let rec = &prep.records[held];
         let a = free_run_fits(&m0, rec, &channels);
         let b = free_run_fits(&m1, rec, &channels);
-        let g = b.iter().zip(&a).map(|(b, a)| b - a).sum::<f64>();
+        // A free run that diverges has a fit of −∞: below −1 (twice the
+        // error of the mean) every fit counts as −1, so a gain is finite.
+        let floor = |x: &f64| if x.is_finite() { x.max(-1.0) } else { -1.0 };
+        let g = b
+            .iter()
+            .zip(&a)
+            .map(|(b, a)| floor(b) - floor(a))
+            .sum::<f64>();
         gains.push(g);
     }
     (!gains.is_empty()).then(|| gains.iter().sum::<f64>() / gains.len() as f64)
