@@ -36,7 +36,8 @@ fn log<'a>(logs: &'a [(String, String)], code: &str) -> &'a str {
 }
 
 async fn patch(app: &TestApp, rid: &str, body: Value) -> common::Resp {
-    app.call("PATCH", "/api/runs/{id}", &[rid], Some(body)).await
+    app.call("PATCH", "/api/runs/{id}", &[rid], Some(body))
+        .await
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -64,7 +65,10 @@ async fn runs_are_described_by_the_supervisor_the_plan_or_their_data() {
     let g = d["grid_speed_mps"]["value"].as_f64().unwrap();
     assert!((g - KNOT).abs() < 1e-9, "{g}");
     assert!(
-        d["grid_speed_mps"]["reason"].as_str().unwrap().contains("1.00 kn"),
+        d["grid_speed_mps"]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("1.00 kn"),
         "{d}"
     );
     assert!(d["notes"].is_null());
@@ -129,7 +133,12 @@ async fn runs_are_described_by_the_supervisor_the_plan_or_their_data() {
     assert_eq!(d["signal"]["value"], "prbs");
 
     // PATCH: set, then null reverts to the inferred value.
-    let r = patch(&app, &rid, json!({ "role": "validation", "grid_speed_mps": 0.6 })).await;
+    let r = patch(
+        &app,
+        &rid,
+        json!({ "role": "validation", "grid_speed_mps": 0.6 }),
+    )
+    .await;
     assert_eq!(r.status, 200, "{}", r.text);
     let d = &r.json["description"];
     assert_eq!(
@@ -148,8 +157,16 @@ async fn runs_are_described_by_the_supervisor_the_plan_or_their_data() {
     assert_eq!(d["grid_speed_mps"]["source"], "inferred");
     assert_eq!(d["notes"]["value"], "checked");
     // The runs list carries the same descriptions.
-    let list = app.call("GET", "/api/campaigns/{id}/runs", &[&cid], None).await;
-    let a = list.json.as_array().unwrap().iter().find(|r| r["id"] == rid.as_str()).unwrap();
+    let list = app
+        .call("GET", "/api/campaigns/{id}/runs", &[&cid], None)
+        .await;
+    let a = list
+        .json
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["id"] == rid.as_str())
+        .unwrap();
     assert_eq!(a["description"]["notes"]["value"], "checked");
     // A planned run's role can be corrected too: the user wins over the plan.
     let pid = planned["id"].as_str().unwrap();
@@ -164,9 +181,18 @@ async fn runs_are_described_by_the_supervisor_the_plan_or_their_data() {
         (json!({ "role": "dynamics" }), "role"),
         (json!({ "grid_speed_mps": -0.1 }), "grid_speed_mps"),
         (json!({ "grid_speed_kn": 9.0 }), "grid_speed_kn"),
-        (json!({ "grid_speed_mps": 0.5, "grid_speed_kn": 1.0 }), "grid_speed_kn"),
-        (json!({ "excited_dofs": ["surge", "drift"] }), "excited_dofs[1]"),
-        (json!({ "excited_dofs": ["surge", "surge"] }), "excited_dofs[1]"),
+        (
+            json!({ "grid_speed_mps": 0.5, "grid_speed_kn": 1.0 }),
+            "grid_speed_kn",
+        ),
+        (
+            json!({ "excited_dofs": ["surge", "drift"] }),
+            "excited_dofs[1]",
+        ),
+        (
+            json!({ "excited_dofs": ["surge", "surge"] }),
+            "excited_dofs[1]",
+        ),
         (json!({ "signal": "chirp" }), "signal"),
         (json!({ "notes": "x".repeat(2001) }), "notes"),
         (json!({ "colour": "red" }), "colour"),
@@ -179,7 +205,11 @@ async fn runs_are_described_by_the_supervisor_the_plan_or_their_data() {
     let r = patch(&app, &rid, json!({ "notes": "x".repeat(2001) })).await;
     assert_eq!(r.json["limit"], 2000.0);
     let r = patch(&app, &rid, json!({ "grid_speed_kn": 9.0 })).await;
-    assert!((r.json["limit"].as_f64().unwrap() - 4.3).abs() < 1e-9, "{}", r.text);
+    assert!(
+        (r.json["limit"].as_f64().unwrap() - 4.3).abs() < 1e-9,
+        "{}",
+        r.text
+    );
     let r = app.call("GET", "/api/runs/{id}", &[&rid], None).await;
     assert_eq!(r.json["description"]["role"]["source"], "inferred");
     assert_eq!(r.json["description"]["notes"]["value"], "checked");
@@ -195,27 +225,42 @@ async fn runs_are_described_by_the_supervisor_the_plan_or_their_data() {
     assert_eq!(r.status, 400, "{}", r.text);
 
     // Upload metadata is checked the same way, before anything is recorded.
-    let before = app.call("GET", "/api/campaigns/{id}/runs", &[&cid], None).await;
+    let before = app
+        .call("GET", "/api/campaigns/{id}/runs", &[&cid], None)
+        .await;
     for (meta, field) in [
         (json!({ "role": "warmup" }), "meta.role"),
         (json!({ "grid_speed_kn": -1 }), "meta.grid_speed_kn"),
-        (json!({ "excited_dofs": ["sway", "sway"] }), "meta.excited_dofs[1]"),
+        (
+            json!({ "excited_dofs": ["sway", "sway"] }),
+            "meta.excited_dofs[1]",
+        ),
         (json!({ "color": "red" }), "meta.color"),
     ] {
         let m = meta.to_string();
         let r = app
-            .upload_run(&cid, &[("meta", None, &m), ("file", Some("x.csv"), "t\n0\n")])
+            .upload_run(
+                &cid,
+                &[("meta", None, &m), ("file", Some("x.csv"), "t\n0\n")],
+            )
             .await;
         app.check_contract("POST", "/api/campaigns/{id}/runs", &r);
         assert_eq!(r.status, 422, "{meta}: {}", r.text);
         assert_eq!(r.json["field"], field, "{meta}: {}", r.text);
     }
-    let after = app.call("GET", "/api/campaigns/{id}/runs", &[&cid], None).await;
-    assert_eq!(before.json.as_array().unwrap().len(), after.json.as_array().unwrap().len());
+    let after = app
+        .call("GET", "/api/campaigns/{id}/runs", &[&cid], None)
+        .await;
+    assert_eq!(
+        before.json.as_array().unwrap().len(),
+        after.json.as_array().unwrap().len()
+    );
 
     // Coverage: the planned run covers its experiment; the others are
     // unassigned, not failures of adherence.
-    let c = app.call("GET", "/api/campaigns/{id}/coverage", &[&cid], None).await;
+    let c = app
+        .call("GET", "/api/campaigns/{id}/coverage", &[&cid], None)
+        .await;
     assert_eq!(c.status, 200);
     let unassigned = c.json["unassigned_runs"].as_array().unwrap();
     assert_eq!(unassigned.len(), 3, "{}", c.json);
@@ -243,12 +288,18 @@ async fn a_dp_vessel_refuses_dofs_and_roles_it_does_not_have() {
     assert_eq!(r.status, 201, "{}", r.text);
     let cid = r.json["id"].as_str().unwrap();
     for (meta, field) in [
-        (json!({ "excited_dofs": ["surge", "heave"] }), "meta.excited_dofs[1]"),
+        (
+            json!({ "excited_dofs": ["surge", "heave"] }),
+            "meta.excited_dofs[1]",
+        ),
         (json!({ "role": "static" }), "meta.role"),
     ] {
         let m = meta.to_string();
         let r = app
-            .upload_run(cid, &[("meta", None, &m), ("file", Some("x.csv"), "t\n0\n")])
+            .upload_run(
+                cid,
+                &[("meta", None, &m), ("file", Some("x.csv"), "t\n0\n")],
+            )
             .await;
         assert_eq!(r.status, 422, "{meta}: {}", r.text);
         assert_eq!(r.json["field"], field, "{}", r.text);
@@ -305,7 +356,10 @@ async fn identification_uses_the_inferred_roles_of_unplanned_runs() {
         .map(|(_, id)| id.clone())
         .collect();
     rec.sort();
-    assert_eq!(est, rec, "estimation runs: the recursive ones, no static run");
+    assert_eq!(
+        est, rec,
+        "estimation runs: the recursive ones, no static run"
+    );
     assert_eq!(m.json["validation_run_ids"], json!([ids["VAL-r1"]]));
     // The λ model has a sub-model at both grid speeds (inferred speeds).
     let points = m.json["document"]["lpv"]["points"].as_array().unwrap();

@@ -148,7 +148,12 @@ impl DescriptionChange {
                                 "{} is not modelled by {} (its DOFs: {})",
                                 d.name(),
                                 vessel.name,
-                                vessel.dofs.iter().map(|d| d.name()).collect::<Vec<_>>().join(", ")
+                                vessel
+                                    .dofs
+                                    .iter()
+                                    .map(|d| d.name())
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
                             ),
                         ));
                     }
@@ -212,7 +217,11 @@ pub fn from_value<T: DeserializeOwned>(v: Value, prefix: &str) -> Result<T, ApiE
             Some(f) => format!("{prefix}{f}"),
             None => prefix.trim_end_matches('.').to_string(),
         };
-        let field = if field.is_empty() { "body".into() } else { field };
+        let field = if field.is_empty() {
+            "body".into()
+        } else {
+            field
+        };
         ApiError::invalid(field.clone(), format!("{field}: {msg}"))
     })
 }

@@ -109,7 +109,11 @@ impl Row {
             .as_deref()
             .map(serde_json::from_str::<InferredDescription>)
             .transpose()?;
-        Ok(describe_run(&self.user()?, plan.as_ref(), inferred.as_ref()))
+        Ok(describe_run(
+            &self.user()?,
+            plan.as_ref(),
+            inferred.as_ref(),
+        ))
     }
 }
 
@@ -330,9 +334,9 @@ pub async fn set_description(
 /// One run.
 pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Run>> {
     let row = sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!("{FROM} WHERE r.id = $1")))
-    .bind(id)
-    .fetch_optional(db)
-    .await?;
+        .bind(id)
+        .fetch_optional(db)
+        .await?;
     match row {
         Some(r) => Ok(Some(with_files(db, r).await?)),
         None => Ok(None),

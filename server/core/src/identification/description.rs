@@ -473,7 +473,10 @@ mod tests {
         let d = describe_run(&user, Some(&plan), Some(&inf));
         assert_eq!(d.family, Some(ExperimentFamily::DpSurge));
         assert_eq!(RunRole::from_name("recursive"), Some(RunRole::Recursive));
-        assert_eq!(RunSignal::from_name("random_binary"), Some(RunSignal::RandomBinary));
+        assert_eq!(
+            RunSignal::from_name("random_binary"),
+            Some(RunSignal::RandomBinary)
+        );
         assert!(RunRole::from_name("dynamics").is_none());
     }
 }

@@ -317,8 +317,7 @@ fn constant_input_is_insufficient_and_named() {
     );
     // No plan: nothing to repeat, and not exciting a DOF is no failure of the run.
     assert!(
-        d.reason.contains("fly a run that excites it")
-            && !d.reason.contains("planned schedule"),
+        d.reason.contains("fly a run that excites it") && !d.reason.contains("planned schedule"),
         "{}",
         d.reason
     );

@@ -82,8 +82,7 @@ const ACT_REPEAT: &str = "repeat it following the planned schedule";
 /// The action for an input that is not excited in a run matched to no
 /// planned experiment: there is no schedule to repeat, and a run flown for
 /// other DOFs is no failure of this one.
-const ACT_EXCITE: &str =
-    "if this DOF is to be identified, fly a run that excites it (the run is matched to no planned experiment)";
+const ACT_EXCITE: &str = "if this DOF is to be identified, fly a run that excites it (the run is matched to no planned experiment)";
 const ACT_SNR: &str = "fly it again with twice the amplitude or a slower PRBS clock";
 const ACT_NYQUIST: &str = "log the inputs at the controller rate";
 const ACT_INDEPENDENT: &str =

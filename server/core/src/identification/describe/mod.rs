@@ -33,11 +33,17 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::description::{RunRole, RunSignal, dof_words, speed_words};
+use super::description::{RunRole, RunSignal, dof_words};
 use crate::planning::campaign::ExperimentFamily;
 use crate::planning::vessel::{InputChannels, ThrusterKind, VesselKind, VesselProfile};
 use crate::planning::{Dof, KNOT};
 use crate::timeseries::UniformRecord;
+
+mod signal;
+mod speed;
+
+pub use signal::{CHIP_MAX_DEVIATION, MIN_INTERVALS, SQUARE_MAX_CV};
+pub use speed::{MIN_BIN_SHARE, SPEED_WINDOW_TIME_CONSTANTS};
 
 /// Velocity scale of surge (m/s): twice the default speed excursion of a
 /// dynamic surge run (0.3 kn, thesis Table 3.1), so that a default surge
@@ -53,38 +59,15 @@ pub const NOISE_FLOOR: f64 = 0.03;
 /// coupling leaking into a neighbouring DOF stays below it.
 pub const RELATIVE_LEVEL: f64 = 0.25;
 
-/// Moving-average window of the forward speed, in surge time constants
-/// (≥ 30 s): long enough to average out a dynamic surge excitation (a square
-/// wave of period 10·T), short enough to see the validation run's steps.
-pub const SPEED_WINDOW_TIME_CONSTANTS: f64 = 10.0;
-
-/// Smallest share of the run the smoothed speed must spend in a second grid
-/// bin for the speed to count as wandering across the grid.
-pub const MIN_BIN_SHARE: f64 = 0.15;
-
 /// A ROV run exciting at least this many DOFs at once is a recursive run
 /// (thesis Table 3.1); fewer make a dynamic run.
 pub const RECURSIVE_MIN_DOFS: usize = 3;
-
-/// Largest coefficient of variation of the switching intervals of a square
-/// wave (its half-periods are equal).
-pub const SQUARE_MAX_CV: f64 = 0.15;
-
-/// Largest mean deviation of the switching intervals from whole chips
-/// (fraction of a chip) for a PRBS.
-pub const CHIP_MAX_DEVIATION: f64 = 0.15;
 
 /// Largest share of a velocity's variance one step may explain in an
 /// excited DOF: a square wave of two periods is ≈ 0.33 one step, short
 /// PRBS runs of the planner flown under PI control ≤ 0.6; a step-and-hold
 /// (a static run, even one the controller overshoots) ≥ 0.73.
 pub const STEP_MAX_SHARE: f64 = 0.67;
-
-/// Fewest switching intervals to tell a signal.
-pub const MIN_INTERVALS: usize = 4;
-
-/// Bin width of a one-point grid (m/s): the thesis's grid spacing 0.5 kn.
-const SINGLE_POINT_BIN_MPS: f64 = 0.5 * KNOT;
 
 /// How much one DOF moved in a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -357,115 +340,6 @@ fn excited_dofs(acts: &[DofActivity]) -> (Vec<Dof>, String) {
     (dofs, reason)
 }
 
-/// Forward speed: mean, and the shares of the run the smoothed speed spends
-/// in each grid bin (grid index → share), largest first.
-fn speed_bins(
-    rec: &UniformRecord,
-    u: &[f64],
-    grid: &[f64],
-    window_s: f64,
-) -> (f64, Vec<(usize, f64)>) {
-    let (mean, _) = mean_std(rec, u);
-    let bin = |v: f64| -> usize {
-        if grid.len() == 1 {
-            // Pseudo-bins of 0.5 kn about the one grid point.
-            let k = ((v - grid[0]) / SINGLE_POINT_BIN_MPS).round();
-            (k + 1000.0).clamp(0.0, 2000.0) as usize
-        } else {
-            super::roles::nearest_grid_index(grid, v)
-        }
-    };
-    let w = ((window_s * rec.sample_rate_hz).round() as usize).max(1);
-    let mut counts = std::collections::BTreeMap::<usize, usize>::new();
-    let mut total = 0usize;
-    for b in blocks(rec, u) {
-        let half = w.min(b.len()) / 2;
-        let mut prefix = vec![0.0; b.len() + 1];
-        for (k, x) in b.iter().enumerate() {
-            prefix[k + 1] = prefix[k] + x;
-        }
-        for k in 0..b.len() {
-            let lo = k.saturating_sub(half);
-            let hi = (k + half + 1).min(b.len());
-            let avg = (prefix[hi] - prefix[lo]) / (hi - lo) as f64;
-            *counts.entry(bin(avg)).or_default() += 1;
-            total += 1;
-        }
-    }
-    let mut shares: Vec<(usize, f64)> = counts
-        .into_iter()
-        .map(|(i, c)| (i, c as f64 / total.max(1) as f64))
-        .collect();
-    shares.sort_by(|a, b| b.1.total_cmp(&a.1));
-    (mean, shares)
-}
-
-/// What the speed says: (grid speed, its reason, mean, wandering reason).
-fn grid_speed(
-    rec: &UniformRecord,
-    profile: &VesselProfile,
-    grid: &[f64],
-) -> (Option<f64>, String, Option<f64>, Option<String>) {
-    let Some(u) = rec.column(Dof::Surge.velocity_symbol()) else {
-        return (None, "the log has no forward speed u".into(), None, None);
-    };
-    if grid.is_empty() {
-        let (m, _) = mean_std(rec, u);
-        return (
-            None,
-            "the campaign has no grid speeds".into(),
-            Some(m),
-            None,
-        );
-    }
-    let window = (SPEED_WINDOW_TIME_CONSTANTS * profile.limit(Dof::Surge).time_constant_s).max(30.0);
-    let (mean, shares) = speed_bins(rec, u, grid, window);
-    let visited: Vec<&(usize, f64)> = shares.iter().filter(|s| s.1 >= MIN_BIN_SHARE).collect();
-    if visited.len() >= 2 && grid.len() > 1 {
-        let mut v: Vec<&(usize, f64)> = visited.clone();
-        v.sort_by_key(|s| s.0);
-        let list = v
-            .iter()
-            .map(|(i, s)| format!("{:.2} kn ({:.0} %)", grid[*i] / KNOT, 100.0 * s))
-            .collect::<Vec<_>>()
-            .join(", ");
-        let why = format!(
-            "the forward speed ({window:.0} s moving average) moves across the grid: near {list} of the run"
-        );
-        return (
-            None,
-            format!("{why}; no single grid speed (mean {})", speed_words(mean)),
-            Some(mean),
-            Some(why),
-        );
-    }
-    if visited.len() >= 2 {
-        let why = format!(
-            "the forward speed ({window:.0} s moving average) moves by more than 0.5 kn about the one grid speed"
-        );
-        return (None, why.clone(), Some(mean), Some(why));
-    }
-    let i = super::roles::nearest_grid_index(grid, mean);
-    let g = grid[i];
-    let spacing = if grid.len() > 1 {
-        grid.windows(2).map(|w| (w[1] - w[0]).abs()).fold(f64::INFINITY, f64::min)
-    } else {
-        SINGLE_POINT_BIN_MPS
-    };
-    let off = mean - g;
-    let mut reason = format!(
-        "mean forward speed {} is {:.3} m/s {} the grid point {}",
-        speed_words(mean),
-        off.abs(),
-        if off >= 0.0 { "above" } else { "below" },
-        speed_words(g)
-    );
-    if off.abs() > 0.5 * spacing {
-        reason.push_str(" — outside the grid: check the campaign's grid");
-    }
-    (Some(g), reason, Some(mean), None)
-}
-
 /// Thruster kinds driven in a run (DP vessels): those whose commands are
 /// active in the sense of [`activity`] (scores are command std / max command).
 fn driven_kinds(rec: &UniformRecord, profile: &VesselProfile) -> Vec<ThrusterKind> {
@@ -474,8 +348,9 @@ fn driven_kinds(rec: &UniformRecord, profile: &VesselProfile) -> Vec<ThrusterKin
         .iter()
         .enumerate()
         .map(|(i, t)| {
-            rec.column(&format!("thr_{}", i + 1))
-                .map_or(0.0, |c| mean_std(rec, c).1 / t.max_command.max(f64::MIN_POSITIVE))
+            rec.column(&format!("thr_{}", i + 1)).map_or(0.0, |c| {
+                mean_std(rec, c).1 / t.max_command.max(f64::MIN_POSITIVE)
+            })
         })
         .collect();
     let top = levels.iter().copied().fold(0.0, f64::max);
@@ -530,7 +405,11 @@ fn role(
     let names: Vec<Dof> = excited.iter().map(|a| a.dof).collect();
     if profile.kind == VesselKind::Dp3 {
         let kinds = driven_kinds(rec, profile);
-        let list = kinds.iter().map(|k| kind_name(*k)).collect::<Vec<_>>().join(", ");
+        let list = kinds
+            .iter()
+            .map(|k| kind_name(*k))
+            .collect::<Vec<_>>()
+            .join(", ");
         return match kinds.as_slice() {
             [k] => {
                 let (fam, si) = match k {
@@ -581,136 +460,9 @@ fn role(
         (
             RunRole::Dynamic,
             ExperimentFamily::Dynamic,
-            format!(
-                "{} excited at a steady forward speed",
-                dof_words(&names)
-            ),
+            format!("{} excited at a steady forward speed", dof_words(&names)),
         )
     }
-}
-
-/// Two-level signal: ≥ 80 % of the samples within ±25 % of the half-range
-/// (5th–95th percentile) from one of the two levels.
-fn two_level(rec: &UniformRecord, col: &[f64]) -> Option<(f64, f64)> {
-    let mut v: Vec<f64> = blocks(rec, col).flatten().copied().collect();
-    if v.len() < 10 {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
-    let (lo, hi) = (q(0.05), q(0.95));
-    let (mid, a) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-    if a <= 0.0 {
-        return None;
-    }
-    let near = v
-        .iter()
-        .filter(|x| ((*x - mid).abs() - a).abs() <= 0.25 * a)
-        .count();
-    (near as f64 >= 0.8 * v.len() as f64).then_some((mid, a))
-}
-
-/// Signal and why, from the most excited DOF.
-fn signal(
-    rec: &UniformRecord,
-    inputs: &[String],
-    acts: &[DofActivity],
-) -> (RunSignal, String) {
-    let Some((j, best)) = acts
-        .iter()
-        .enumerate()
-        .filter(|(_, a)| a.excited)
-        .max_by(|a, b| a.1.score.total_cmp(&b.1.score))
-    else {
-        return (
-            RunSignal::Other,
-            "nothing switches: no excitation signal (holds or steps)".into(),
-        );
-    };
-    let d = best.dof;
-    let (name, col, lo, hi, why_col) = match rec.column(&inputs[j]).and_then(|c| two_level(rec, c).map(|l| (c, l))) {
-        Some((c, (mid, a))) => (
-            inputs[j].as_str(),
-            c,
-            mid - 0.5 * a,
-            mid + 0.5 * a,
-            "the two-level input",
-        ),
-        None => {
-            let c = rec.column(d.velocity_symbol()).unwrap_or_default();
-            let (m, s) = mean_std(rec, c);
-            (
-                d.velocity_symbol(),
-                c,
-                m - 0.5 * s,
-                m + 0.5 * s,
-                "the velocity (the input is not two-level: closed-loop control)",
-            )
-        }
-    };
-    let h = 1.0 / rec.sample_rate_hz;
-    let intervals: Vec<f64> = switch_times(rec, col, lo, hi)
-        .iter()
-        .flat_map(|s| s.windows(2).map(|w| (w[1] - w[0]) as f64 * h).collect::<Vec<_>>())
-        .collect();
-    let what = format!("switching of {} {name}", why_col);
-    if intervals.len() < MIN_INTERVALS {
-        return (
-            RunSignal::Other,
-            format!(
-                "{what}: {} complete interval(s), too few to tell square from PRBS",
-                intervals.len()
-            ),
-        );
-    }
-    let n = intervals.len() as f64;
-    let mean = intervals.iter().sum::<f64>() / n;
-    let cv = (intervals.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt() / mean;
-    if cv < SQUARE_MAX_CV {
-        return (
-            RunSignal::Square,
-            format!(
-                "{what}: {} half-periods of {mean:.2} s, all alike (variation {:.0} %) — a square wave",
-                intervals.len(),
-                100.0 * cv
-            ),
-        );
-    }
-    // Chip: the typical shortest interval, refined over whole multiples.
-    let min = intervals.iter().copied().fold(f64::INFINITY, f64::min);
-    let short: Vec<f64> = intervals.iter().copied().filter(|&x| x <= 1.5 * min).collect();
-    let mut chip = short.iter().sum::<f64>() / short.len() as f64;
-    let multiples = |c: f64| -> Vec<f64> { intervals.iter().map(|x| (x / c).round().max(1.0)).collect() };
-    let mut k = multiples(chip);
-    for _ in 0..3 {
-        chip = intervals.iter().sum::<f64>() / k.iter().sum::<f64>();
-        k = multiples(chip);
-    }
-    let dev = intervals
-        .iter()
-        .zip(&k)
-        .map(|(x, m)| (x / chip - m).abs())
-        .sum::<f64>()
-        / n;
-    let kmax = k.iter().copied().fold(0.0, f64::max);
-    if dev < CHIP_MAX_DEVIATION && kmax >= 2.0 {
-        return (
-            RunSignal::Prbs,
-            format!(
-                "{what}: {} intervals, each a whole number (1–{kmax:.0}) of {chip:.2} s chips (mean deviation {:.0} % of a chip) — a PRBS (or random binary)",
-                intervals.len(),
-                100.0 * dev
-            ),
-        );
-    }
-    (
-        RunSignal::Other,
-        format!(
-            "{what}: intervals neither alike (variation {:.0} %) nor whole chips (deviation {:.0} % of {chip:.2} s)",
-            100.0 * cv,
-            100.0 * dev
-        ),
-    )
 }
 
 /// Infers what `rec` is. `inputs` are the generalized-force columns of the
@@ -729,14 +481,17 @@ pub fn infer_description(
             profile.dofs.len()
         )));
     }
-    if rec.valid.iter().map(|b| b.len()).sum::<usize>() < 10 || !(rec.sample_rate_hz > 0.0) {
+    if rec.valid.iter().map(|b| b.len()).sum::<usize>() < 10
+        || !(rec.sample_rate_hz.is_finite() && rec.sample_rate_hz > 0.0)
+    {
         return Err(DescribeError("fewer than 10 valid samples".into()));
     }
     let acts = activity(rec, profile, inputs)?;
-    let (grid_speed_mps, grid_speed_reason, mean, wandering) = grid_speed(rec, profile, grid);
+    let (grid_speed_mps, grid_speed_reason, mean, wandering) =
+        speed::grid_speed(rec, profile, grid);
     let (excited_dofs, excited_dofs_reason) = excited_dofs(&acts);
     let (role, family, role_reason) = role(rec, profile, &acts, wandering.as_deref());
-    let (signal, signal_reason) = signal(rec, inputs, &acts);
+    let (signal, signal_reason) = signal::signal(rec, inputs, &acts);
     Ok(InferredDescription {
         role,
         role_reason,
@@ -753,5 +508,4 @@ pub fn infer_description(
 }
 
 #[cfg(test)]
-#[path = "describe_tests.rs"]
 mod tests;

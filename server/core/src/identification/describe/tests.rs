@@ -20,10 +20,19 @@ fn grid() -> Vec<f64> {
 #[derive(Clone, Copy)]
 enum Drive {
     Hold,
-    Prbs { amp: f64, chip_s: f64, seed: u64 },
-    Square { amp: f64, half_s: f64 },
+    Prbs {
+        amp: f64,
+        chip_s: f64,
+        seed: u64,
+    },
+    Square {
+        amp: f64,
+        half_s: f64,
+    },
     /// Ramp over 5 s from 0 to `amp` after 5 s, then hold.
-    Step { amp: f64 },
+    Step {
+        amp: f64,
+    },
 }
 
 impl Drive {
@@ -49,7 +58,12 @@ impl Drive {
 /// A synthetic ROV run: each DOF first order, ν̇ = (τ/D − ν)/T with D =
 /// max force / max velocity, τ open loop; surge trimmed to `speed(t)`.
 /// DVL/gyro-like noise on ν, a little on τ.
-fn synth(duration_s: f64, speed: impl Fn(f64) -> f64, drives: [Drive; 6], seed: u64) -> UniformRecord {
+fn synth(
+    duration_s: f64,
+    speed: impl Fn(f64) -> f64,
+    drives: [Drive; 6],
+    seed: u64,
+) -> UniformRecord {
     let p = surveyor_rov();
     let n = (duration_s * FS) as usize;
     let mut rng = SplitMix64::new(seed);
@@ -68,7 +82,11 @@ fn synth(duration_s: f64, speed: impl Fn(f64) -> f64, drives: [Drive; 6], seed: 
         let mut nu = if j == 0 { speed(0.0) } else { 0.0 };
         let (mut tau, mut vel) = (Vec::with_capacity(n), Vec::with_capacity(n));
         for k in 0..n {
-            let trim = if j == 0 { dmp * speed(k as f64 / FS) } else { 0.0 };
+            let trim = if j == 0 {
+                dmp * speed(k as f64 / FS)
+            } else {
+                0.0
+            };
             let f = trim + drives[j].level(k, &chips) * l.max_force;
             tau.push(f + 5.0 * rng.normal());
             vel.push(nu + noise_nu[j] * rng.normal());
@@ -93,7 +111,11 @@ fn synth(duration_s: f64, speed: impl Fn(f64) -> f64, drives: [Drive; 6], seed: 
 
 fn infer(rec: &UniformRecord) -> InferredDescription {
     let p = surveyor_rov();
-    let inputs: Vec<String> = p.dofs.iter().map(|d| d.force_column().to_string()).collect();
+    let inputs: Vec<String> = p
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
     infer_description(rec, &p, &inputs, &grid()).unwrap()
 }
 
@@ -115,12 +137,21 @@ fn each_dof_excited_alone_is_a_dynamic_run_at_its_grid_speed() {
         };
         let rec = synth(300.0, |_| KNOT, only(j, drive), 10 + j as u64);
         let d = infer(&rec);
-        assert_eq!(d.excited_dofs, vec![*dof], "{dof:?}: {}", d.excited_dofs_reason);
+        assert_eq!(
+            d.excited_dofs,
+            vec![*dof],
+            "{dof:?}: {}",
+            d.excited_dofs_reason
+        );
         assert_eq!(d.role, RunRole::Dynamic, "{dof:?}: {}", d.role_reason);
         assert_eq!(d.family, ExperimentFamily::Dynamic);
         let g = d.grid_speed_mps.expect("a grid speed");
         assert!((g - KNOT).abs() < 1e-12, "{dof:?}: {}", d.grid_speed_reason);
-        assert!(d.grid_speed_reason.contains("1.00 kn"), "{}", d.grid_speed_reason);
+        assert!(
+            d.grid_speed_reason.contains("1.00 kn"),
+            "{}",
+            d.grid_speed_reason
+        );
         assert_eq!(d.signal, RunSignal::Prbs, "{dof:?}: {}", d.signal_reason);
         assert!(d.signal_reason.contains("4.0"), "{}", d.signal_reason);
     }
@@ -131,7 +162,13 @@ fn a_square_wave_has_regular_half_periods() {
     let rec = synth(
         300.0,
         |_| 1.5 * KNOT,
-        only(1, Drive::Square { amp: 0.3, half_s: 15.0 }),
+        only(
+            1,
+            Drive::Square {
+                amp: 0.3,
+                half_s: 15.0,
+            },
+        ),
         4,
     );
     let d = infer(&rec);
@@ -149,7 +186,11 @@ fn a_held_run_with_noise_is_static_and_says_how_far_its_speed_was_from_the_grid(
     assert!(d.excited_dofs.is_empty(), "{}", d.excited_dofs_reason);
     assert!(d.role_reason.contains("noise floor"), "{}", d.role_reason);
     assert!((d.grid_speed_mps.unwrap() - 1.5 * KNOT).abs() < 1e-12);
-    assert!(d.grid_speed_reason.contains("above the grid point"), "{}", d.grid_speed_reason);
+    assert!(
+        d.grid_speed_reason.contains("above the grid point"),
+        "{}",
+        d.grid_speed_reason
+    );
     let mean = d.mean_forward_speed_mps.unwrap();
     assert!((mean - 1.55 * KNOT).abs() < 0.01, "{mean}");
     assert_eq!(d.signal, RunSignal::Other);
@@ -160,8 +201,17 @@ fn a_step_and_hold_is_a_static_run_of_that_dof() {
     let rec = synth(80.0, |_| KNOT, only(2, Drive::Step { amp: 0.4 }), 6);
     let d = infer(&rec);
     assert_eq!(d.role, RunRole::Static, "{}", d.role_reason);
-    assert_eq!(d.excited_dofs, vec![Dof::Heave], "{}", d.excited_dofs_reason);
-    assert!(d.role_reason.contains("heave steps once"), "{}", d.role_reason);
+    assert_eq!(
+        d.excited_dofs,
+        vec![Dof::Heave],
+        "{}",
+        d.excited_dofs_reason
+    );
+    assert!(
+        d.role_reason.contains("heave steps once"),
+        "{}",
+        d.role_reason
+    );
 }
 
 #[test]
@@ -176,7 +226,12 @@ fn every_dof_at_once_at_one_speed_is_recursive() {
     }
     let d = infer(&synth(400.0, |_| 2.0 * KNOT, drives, 7));
     assert_eq!(d.role, RunRole::Recursive, "{}", d.role_reason);
-    assert_eq!(d.excited_dofs, Dof::ALL.to_vec(), "{}", d.excited_dofs_reason);
+    assert_eq!(
+        d.excited_dofs,
+        Dof::ALL.to_vec(),
+        "{}",
+        d.excited_dofs_reason
+    );
     assert!((d.grid_speed_mps.unwrap() - 2.0 * KNOT).abs() < 1e-12);
 }
 
@@ -216,7 +271,11 @@ fn a_speed_stepping_through_the_grid_is_a_validation_run() {
 fn too_little_data_or_mismatched_inputs_are_errors() {
     let p = surveyor_rov();
     let rec = synth(0.5, |_| 0.0, [Drive::Hold; 6], 1);
-    let inputs: Vec<String> = p.dofs.iter().map(|d| d.force_column().to_string()).collect();
+    let inputs: Vec<String> = p
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
     assert!(infer_description(&rec, &p, &inputs, &grid()).is_err());
     let rec = synth(60.0, |_| 0.0, [Drive::Hold; 6], 1);
     assert!(infer_description(&rec, &p, &inputs[..2], &grid()).is_err());
