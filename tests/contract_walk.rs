@@ -232,6 +232,15 @@ async fn every_documented_operation_is_exercised_and_answers() {
                     )
                     .await
                 }
+                ("patch", "/api/runs/{id}") => {
+                    app.call(
+                        "PATCH",
+                        template,
+                        &args,
+                        Some(json!({ "role": "dynamic", "grid_speed_kn": 1.0, "notes": "walked" })),
+                    )
+                    .await
+                }
                 ("post", "/api/vessels") => {
                     app.call("POST", template, &args, Some(rov_profile())).await
                 }

@@ -44,6 +44,8 @@ fn every_fixed_route_of_the_contract_is_documented() {
         ("post", "/api/jobs/{id}/cancel"),
         ("post", "/api/jobs/{id}/retry"),
         ("get", "/api/jobs/{id}/events"),
+        ("get", "/api/runs/{id}"),
+        ("patch", "/api/runs/{id}"),
     ] {
         assert!(
             spec["paths"][path][method].is_object(),

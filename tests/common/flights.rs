@@ -99,3 +99,46 @@ pub async fn upload_planned(app: &TestApp, cid: &str, plan: &Value, code: &str, 
         .await;
     assert_eq!(r.status, 201, "{code}: {}", r.text);
 }
+
+/// Creates the Surveyor and a campaign from `spec` (no `vessel_id`), plans
+/// it, and flies the planned experiments whose codes `keep` accepts
+/// (≤ 240 s each) through `truth`. Returns the campaign id, the stored plan
+/// and the `(code, csv)` logs, not uploaded.
+pub async fn flown_logs(
+    app: &TestApp,
+    spec: Value,
+    truth: &RovTruth,
+    keep: impl Fn(&str) -> bool,
+) -> (String, Value, Vec<(String, String)>) {
+    let r = app
+        .call("POST", "/api/vessels", &[], Some(rov_profile()))
+        .await;
+    let vid = r.json["id"].as_str().unwrap().to_string();
+    let mut body = spec.clone();
+    body["vessel_id"] = json!(vid);
+    let r = app.call("POST", "/api/campaigns", &[], Some(body)).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let cid = r.json["id"].as_str().unwrap().to_string();
+    let plan = app
+        .call("POST", "/api/campaigns/{id}/plan", &[&cid], None)
+        .await;
+    assert_eq!(plan.status, 201, "{}", plan.text);
+    let profile = seatrial_core::planning::examples::surveyor_rov();
+    let core_spec: CampaignSpec = serde_json::from_value(spec).unwrap();
+    let core_plan = generate_plan(&profile, &core_spec).unwrap();
+    let settings = TrialSettings {
+        max_duration_s: Some(240.0),
+        seed: 3,
+        ..TrialSettings::default()
+    };
+    let logs = core_plan
+        .experiments
+        .iter()
+        .filter(|p| keep(&p.experiment.code))
+        .map(|p| {
+            let flown = fly_experiment(&profile, truth, p, &settings).unwrap();
+            (p.experiment.code.clone(), flown.csv)
+        })
+        .collect();
+    (cid, plan.json, logs)
+}

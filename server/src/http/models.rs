@@ -13,10 +13,10 @@ use serde::{Deserialize, Serialize};
 use super::query::ApiQuery;
 use super::{AppState, blocking, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
-use crate::processing::{self, RunMeta, RunSummary};
+use crate::jobs::run_inputs::StoredRun;
+use crate::processing::{self, RunSummary};
 use crate::storage::models::{self, ModelSummary, StoredModel};
 use crate::storage::{campaigns, runs, vessels};
-use seatrial_core::identification::RunInput;
 use seatrial_core::identification::predictor::validate_on_run;
 
 /// Filters of the model list.
@@ -271,30 +271,19 @@ pub async fn compare_models(
         "vessel",
         &campaign.vessel_id,
     )?;
-    let meta = RunMeta::of_stored(run.summary.as_ref());
-    let files: Vec<_> = run
-        .files
-        .iter()
-        .map(|f| (f.role.clone(), s.blobs.path(&f.sha256)))
-        .collect();
+    let stored_run = StoredRun::of(&s.job_context(), run.clone());
     let k = q.k.unwrap_or(10).max(1);
     let docs: Vec<ModelDocument> = stored
         .iter()
         .map(|m| view(m.clone()).map(|v| v.document))
         .collect::<Result<_, _>>()?;
     let profile = vessel.profile.clone();
-    let (run_id, run_name) = (run.id.clone(), run.name.clone());
     let reports = blocking(move || -> Result<Vec<serde_json::Value>, ApiError> {
         let mut summary = RunSummary::default();
-        let record = processing::load_record(&profile, &files, &meta, &mut summary)
-            .map_err(|e| ApiError::invalid("run_id", e.message))?;
-        let input = RunInput {
-            run_id: run_id.clone(),
-            name: run_name.clone(),
-            family: None,
-            grid_speed_mps: None,
-            record,
-        };
+        let record =
+            processing::load_record(&profile, &stored_run.files, &stored_run.meta, &mut summary)
+                .map_err(|e| ApiError::invalid("run_id", e.message))?;
+        let input = stored_run.input(record);
         let forces = processing::generalized_force_columns(&profile);
         docs.iter()
             .zip(["a", "b"])

@@ -112,7 +112,7 @@ impl JobHandler for Discover {
                 })?;
                 chosen.push(run);
             }
-            let stored = run_inputs::describe(cx, &cid, chosen).await?;
+            let stored = run_inputs::describe(cx, chosen);
             let settings = req.settings.clone();
             let profile = vessel.profile.clone();
             let base = model.summary.clone();

@@ -156,7 +156,7 @@ impl JobHandler for Identify {
                 }
                 v
             };
-            let stored = run_inputs::describe(cx, &cid, chosen).await?;
+            let stored = run_inputs::describe(cx, chosen);
             let method = req
                 .method
                 .clone()

@@ -1,16 +1,18 @@
 //! Runs as jobs read them: the stored rows (async, in `load`) become owned
 //! descriptions, and those become the core's [`RunInput`]s on the worker
-//! thread, where parsing the logs belongs.
+//! thread, where parsing the logs belongs. What a run is (its family, grid
+//! speed, excited DOFs) is its effective description: the supervisor's
+//! word, else the matched planned experiment, else what was inferred from
+//! its data on upload.
 
 use std::path::PathBuf;
 
 use seatrial_core::identification::RunInput;
-use seatrial_core::planning::VesselProfile;
 use seatrial_core::planning::campaign::ExperimentFamily;
+use seatrial_core::planning::{Dof, VesselProfile};
 
 use super::handler::{JobContext, JobFailure};
 use crate::processing::{self, RunMeta, RunSummary};
-use crate::storage::plans;
 use crate::storage::runs::Run;
 
 /// A run as stored, ready to be re-read on the worker.
@@ -23,40 +25,53 @@ pub struct StoredRun {
     pub files: Vec<(String, PathBuf)>,
     /// How it was uploaded (rate, shared channel).
     pub meta: RunMeta,
-    /// The planned experiment's family.
+    /// The family it counts as (from its role).
     pub family: Option<ExperimentFamily>,
-    /// The planned experiment's grid speed (m/s).
+    /// Its grid speed (m/s).
     pub grid_speed_mps: Option<f64>,
+    /// The DOFs it excites.
+    pub excited_dofs: Vec<Dof>,
 }
 
-/// Describes `runs` of campaign `campaign_id` with what their plan says.
-pub async fn describe(
-    cx: &JobContext,
-    campaign_id: &str,
-    runs: Vec<Run>,
-) -> Result<Vec<StoredRun>, JobFailure> {
-    let mut stored = Vec::new();
-    for r in runs {
-        let planned = match &r.experiment_id {
-            Some(eid) => plans::experiment(&cx.db, campaign_id, eid)
-                .await?
-                .map(|(e, _)| e.experiment),
-            None => None,
-        };
-        stored.push(StoredRun {
+impl StoredRun {
+    /// What `run`'s description says it is, with its files under `cx`'s blobs.
+    pub fn of(cx: &JobContext, r: Run) -> StoredRun {
+        let d = &r.description;
+        StoredRun {
             meta: RunMeta::of_stored(r.summary.as_ref()),
             files: r
                 .files
                 .iter()
                 .map(|f| (f.role.clone(), cx.blobs.path(&f.sha256)))
                 .collect(),
-            family: planned.as_ref().map(|e| e.family),
-            grid_speed_mps: planned.as_ref().and_then(|e| e.grid_speed_mps),
+            family: d.family,
+            grid_speed_mps: d.grid_speed_mps.as_ref().map(|g| g.value),
+            excited_dofs: d
+                .excited_dofs
+                .as_ref()
+                .map(|x| x.value.clone())
+                .unwrap_or_default(),
             id: r.id,
             name: r.name,
-        });
+        }
     }
-    Ok(stored)
+
+    /// The core's run input over `record`.
+    pub fn input(&self, record: seatrial_core::timeseries::UniformRecord) -> RunInput {
+        RunInput {
+            run_id: self.id.clone(),
+            name: self.name.clone(),
+            family: self.family,
+            grid_speed_mps: self.grid_speed_mps,
+            excited_dofs: self.excited_dofs.clone(),
+            record,
+        }
+    }
+}
+
+/// Describes `runs` by their effective descriptions.
+pub fn describe(cx: &JobContext, runs: Vec<Run>) -> Vec<StoredRun> {
+    runs.into_iter().map(|r| StoredRun::of(cx, r)).collect()
 }
 
 /// Reads and resamples the logs (on the worker thread); an unreadable run
@@ -68,13 +83,7 @@ pub fn read(profile: &VesselProfile, stored: &[StoredRun]) -> Result<Vec<RunInpu
             let mut summary = RunSummary::default();
             let record = processing::load_record(profile, &s.files, &s.meta, &mut summary)
                 .map_err(|e| JobFailure::field(format!("runs[{}]", s.id), e.message))?;
-            Ok(RunInput {
-                run_id: s.id.clone(),
-                name: s.name.clone(),
-                family: s.family,
-                grid_speed_mps: s.grid_speed_mps,
-                record,
-            })
+            Ok(s.input(record))
         })
         .collect()
 }

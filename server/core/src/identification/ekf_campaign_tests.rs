@@ -42,6 +42,7 @@ fn runs_of(profile: &VesselProfile, plan: &crate::planning::Plan, seed: u64) -> 
                 name: f.code.clone(),
                 family: Some(f.family),
                 grid_speed_mps: Some(0.0),
+                excited_dofs: vec![],
                 record,
             }
         })

@@ -6,6 +6,9 @@
 //!   per grid speed, and the augmented model as its next version.
 //! - [`augmented`]: an LPV model with discovered terms as a predictor.
 //! - [`dataset`]: runs → segments (one per valid block, never concatenated).
+//! - [`describe`]: what a run is (role, grid speed, excited DOFs, signal),
+//!   inferred from its data; [`description`]: that, the plan and the
+//!   supervisor's word merged, each value with its source.
 //! - [`roles`]: static, estimation and held-out validation runs.
 //! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method.
 //! - [`n4sid_campaign`]: black-box LTI comparison model by N4SID.
@@ -19,6 +22,8 @@
 pub mod augmented;
 pub mod bis;
 pub mod dataset;
+pub mod describe;
+pub mod description;
 pub mod discover_campaign;
 pub mod discrete;
 pub mod document;
@@ -37,6 +42,10 @@ pub mod predictor;
 pub mod roles;
 
 pub use dataset::{DatasetError, RunInput, Segment, segments};
+pub use describe::{DescribeError, DofActivity, InferredDescription, infer_description};
+pub use description::{
+    PlanDescription, RunDescription, RunRole, RunSignal, Source, UserDescription, describe_run,
+};
 pub use discover_campaign::{CampaignDiscovery, DiscoverCampaignSettings, discover_campaign};
 pub use document::{Method, ModelDocument, ModelKind, ParameterRow};
 pub use ekf_campaign::{EkfCampaignSettings, identify_ekf_campaign};
