@@ -17,6 +17,8 @@
 //! - [`discrete`]: ZOH matrices at a chosen h.
 //! - [`export`]: parameter CSV and the Fossen-form parameter set.
 //! - [`predictor`]: a stored model back as a predictor; validation on any run.
+//! - [`state_space`]: an N4SID model's restarted free runs from its Kalman
+//!   predictor state.
 //! - [`outcome`], [`error`]: what an identification returns.
 
 pub mod augmented;
@@ -40,6 +42,7 @@ pub mod n4sid_campaign;
 pub mod outcome;
 pub mod predictor;
 pub mod roles;
+pub mod state_space;
 
 pub use dataset::{DatasetError, RunInput, Segment, segments};
 pub use describe::{DescribeError, DofActivity, InferredDescription, infer_description};

@@ -9,6 +9,7 @@ use super::bis::{BisScale, SiDpShip, unwrap_heading};
 use super::dataset::{RunInput, segments};
 use super::document::{ModelDocument, ModelKind, from_rows};
 use super::error::IdentifyError;
+use super::state_space::StateSpacePredictor;
 use crate::estimation::ekf::IdentifiedDpShip;
 use crate::estimation::n4sid::{N4sidModel, NoiseCovariances, Weighting};
 use crate::logs::schema::pose_column;
@@ -56,7 +57,7 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                 .ok_or_else(|| IdentifyError::invalid("document.state_space", "missing"))?;
             let (a, c) = (matrix(&s.phi, "Φ")?, matrix(&s.c, "C")?);
             let (n, l) = (a.nrows(), c.nrows());
-            Ok(Box::new(N4sidModel {
+            Ok(Box::new(StateSpacePredictor(N4sidModel {
                 a,
                 b: matrix(&s.gamma, "Γ")?,
                 c,
@@ -76,7 +77,7 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                 state_covariance: DMatrix::zeros(n, n),
                 hankel_columns: 0,
                 output_names: doc.outputs.clone(),
-            }))
+            })))
         }
         ModelKind::DpShip => Ok(Box::new(dp_ship(doc)?)),
     }

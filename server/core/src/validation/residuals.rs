@@ -163,8 +163,9 @@ pub struct Normality {
     pub jarque_bera: f64,
     /// P(χ²(2) > JB).
     pub p_value: f64,
-    /// Correlation of the probability plot (1 for a perfect line).
-    pub plot_correlation: f64,
+    /// Correlation of the probability plot (1 for a perfect line); `None`
+    /// for a constant residual, whose plot is a flat line.
+    pub plot_correlation: Option<f64>,
     /// The normal-probability plot, thinned for display.
     pub plot: ProbabilityPlot,
 }
@@ -426,7 +427,7 @@ pub fn normality(e: &[f64], autocorrelation: Option<&[f64]>, plot_points: usize)
     let q: Vec<f64> = (0..n)
         .map(|i| normal_quantile((i as f64 + 1.0 - 0.375) / (nf + 0.25)))
         .collect();
-    let plot_correlation = pearson(&q, &sorted).unwrap_or(f64::NAN);
+    let plot_correlation = pearson(&q, &sorted);
     let keep = thin_indices(n, plot_points);
     Normality {
         skewness,
@@ -662,7 +663,7 @@ mod tests {
         let mut rng = SplitMix64::new(9);
         let g: Vec<f64> = (0..4000).map(|_| 2.0 + 3.0 * rng.normal()).collect();
         let nm = normality(&g, None, 100);
-        assert!(nm.p_value > 0.01 && nm.plot_correlation > 0.998);
+        assert!(nm.p_value > 0.01 && nm.plot_correlation.unwrap() > 0.998);
         assert!(nm.plot.theoretical_quantiles.len() == 100);
         // The probability plot of N(2, 3²) is the line 2 + 3q.
         let (q, y) = (&nm.plot.theoretical_quantiles, &nm.plot.sorted_residuals);
@@ -673,7 +674,7 @@ mod tests {
         let u: Vec<f64> = (0..4000).map(|_| rng.uniform()).collect();
         let nu = normality(&u, None, 100);
         assert!((nu.excess_kurtosis + 1.2).abs() < 0.1);
-        assert!(nu.p_value < 1e-20 && nu.plot_correlation < 0.99);
+        assert!(nu.p_value < 1e-20 && nu.plot_correlation.unwrap() < 0.99);
     }
 
     #[test]
