@@ -16,25 +16,39 @@ use std::collections::HashSet;
 use serde::Serialize;
 
 use super::AlignError;
+use super::decide::{OffsetPriors, OffsetSource, PooledValue, choose_offset};
 use super::drift::check_drift;
 use super::grid::grid_len;
-use super::offset::{Confidence, Labels, OffsetEstimate, OffsetOptions, estimate_labeled};
+use super::offset::{Labels, OffsetEstimate, OffsetOptions, estimate_labeled};
 use super::resample::{GAP_FACTOR, cell_average, gaps, valid_blocks, zero_order_hold};
 use super::validate::{SeriesLabels, check_finite, check_positive, check_time};
+use super::warnings::{
+    Context, fmt_num, offset_warnings, overlap_warnings, rate_warnings, source_words,
+};
 use crate::timeseries::{LogTable, UniformRecord, interp_linear, median_dt};
 
 /// Largest merged record, in values over all channels (256 MB of f64).
 const MAX_MERGED_VALUES: usize = 1 << 25;
-/// `residual_relative` above which the report warns.
-const RESIDUAL_WARNING: f64 = 0.2;
 
 /// How two logs were aligned and merged, for the analyst.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub struct AlignmentReport {
-    /// The clock offset (added to navigation stamps) and its quality.
-    pub offset: OffsetEstimate,
+    /// The run's own estimate of the clock offset (added to navigation
+    /// stamps) from the shared channel, and its quality; `null` when the
+    /// channel did not vary and another offset was available.
+    pub offset: Option<OffsetEstimate>,
+    /// The offset the logs were merged with (s): see `offset_source`.
+    pub offset_used_s: f64,
+    /// Its standard deviation (s); `null` for an offset set by hand.
+    pub offset_used_std_s: Option<f64>,
+    /// Where `offset_used_s` came from: set by hand for the run or the
+    /// campaign, the run's own informative estimate, the campaign's pooled
+    /// offset, or the run's own estimate although it is weak.
+    pub offset_source: OffsetSource,
+    /// The campaign's pooled offset known when the run was merged, if any.
+    pub pooled: Option<PooledValue>,
     /// The channel both logs recorded, used to align them.
     pub shared_channel: String,
     /// Rate of the merged record (Hz).
@@ -87,6 +101,36 @@ pub fn align_logs(
     rate_hz: Option<f64>,
     opts: &OffsetOptions,
 ) -> Result<(UniformRecord, AlignmentReport), AlignError> {
+    align_logs_with(
+        control,
+        nav,
+        shared,
+        rate_hz,
+        opts,
+        &OffsetPriors::default(),
+    )
+}
+
+/// [`align_logs`] with offsets known apart from the run's own estimate: set
+/// by hand for the run or the campaign, or the campaign's pooled offset.
+/// The own estimate is always made and reported; the logs are merged with
+/// the offset chosen by [`super::choose_offset`] (precedence: by hand for
+/// the run, by hand for the campaign, own if informative, pooled, own
+/// although weak). A shared channel that does not vary is no error when a
+/// prior offset exists: the run is merged with it.
+///
+/// # Errors
+/// Those of [`align_logs`]; `priors.user_run_s`, `priors.user_campaign_s`
+/// or `priors.pooled` for a prior that is not finite, beyond a day (by
+/// hand) or leaves the logs without overlap.
+pub fn align_logs_with(
+    control: &LogTable,
+    nav: &LogTable,
+    shared: &str,
+    rate_hz: Option<f64>,
+    opts: &OffsetOptions,
+    priors: &OffsetPriors,
+) -> Result<(UniformRecord, AlignmentReport), AlignError> {
     check_positive("rate_hz", rate_hz)?;
     check_table(control, "control", "control log")?;
     check_table(nav, "nav", "navigation log")?;
@@ -114,8 +158,28 @@ pub fn align_logs(
         max_offset: "opts.max_offset_s",
         rate: "opts.rate_hz",
     };
-    let (offset, pairing) = estimate_labeled(&control.t, control_x, &nav.t, nav_x, opts, &labels)?;
-    let d = offset.offset_s;
+    let has_prior =
+        priors.user_run_s.is_some() || priors.user_campaign_s.is_some() || priors.pooled.is_some();
+    let mut no_estimate = None;
+    let (own, pairing) = match estimate_labeled(&control.t, control_x, &nav.t, nav_x, opts, &labels)
+    {
+        Ok((e, p)) => (Some(e), Some(p)),
+        Err(e @ AlignError::FlatSignal { .. }) if has_prior => {
+            no_estimate = Some(e.message().to_owned());
+            (None, None)
+        }
+        Err(e) => return Err(e),
+    };
+    let chosen = choose_offset(own.as_ref(), priors)?.ok_or_else(|| {
+        AlignError::flat("shared", "no offset: the shared channel gave no estimate")
+    })?;
+    let d = chosen.offset_s;
+    let source_field = match chosen.source {
+        OffsetSource::UserRun => "priors.user_run_s",
+        OffsetSource::UserCampaign => "priors.user_campaign_s",
+        OffsetSource::Pooled => "priors.pooled",
+        OffsetSource::Own | OffsetSource::WeakOwn => "shared",
+    };
 
     // Validated above: at least 16 strictly increasing stamps each.
     let dt_c = median_dt(&control.t).unwrap_or(1.0);
@@ -128,8 +192,13 @@ pub fn align_logs(
     let (start, end) = (tc0.max(tn0), tc1.min(tn1));
     if end <= start {
         return Err(AlignError::overlap(
-            "shared",
-            "after alignment the logs do not overlap",
+            source_field,
+            format!(
+                "with the {} offset {d:.3} s the logs do not overlap (control {tc0:.3}–{tc1:.3} s, navigation {:.3}–{:.3} s + offset)",
+                source_words(chosen.source),
+                nav.t[0],
+                nav.t[nav.t.len() - 1]
+            ),
         ));
     }
     let n = grid_len(start, end, h);
@@ -193,7 +262,9 @@ pub fn align_logs(
 
     let ctx = Context {
         shared,
-        offset: &offset,
+        own: own.as_ref(),
+        chosen,
+        pooled: priors.pooled,
         fs,
         control_rate_hz,
         nav_rate_hz,
@@ -203,7 +274,11 @@ pub fn align_logs(
         nav_span: tn1 - tn0,
     };
     warnings.splice(0..0, rate_warnings(&ctx));
-    warnings.extend(quality_warnings(&ctx));
+    if let Some(why) = no_estimate {
+        warnings.push(format!("no own estimate of the clock offset: {why}"));
+    }
+    warnings.extend(offset_warnings(&ctx));
+    warnings.extend(overlap_warnings(&ctx));
     for (log, list) in [
         ("control log", &all_gaps[..control_gaps]),
         ("navigation log", &nav_gaps[..]),
@@ -216,7 +291,10 @@ pub fn align_logs(
             ));
         }
     }
-    if let Some(drift) = check_drift(&pairing, d, dt_c.max(dt_n))
+    // Drift is measured about an offset the run itself determines well.
+    if chosen.source == OffsetSource::Own
+        && let Some(pairing) = &pairing
+        && let Some(drift) = check_drift(pairing, d, dt_c.max(dt_n))
         && drift.significant
     {
         warnings.push(format!(
@@ -233,7 +311,11 @@ pub fn align_logs(
         valid,
     };
     let report = AlignmentReport {
-        offset,
+        offset: own,
+        offset_used_s: d,
+        offset_used_std_s: chosen.std_s,
+        offset_source: chosen.source,
+        pooled: priors.pooled,
         shared_channel: shared.to_owned(),
         rate_hz: fs,
         control_rate_hz,
@@ -280,95 +362,4 @@ fn check_table(table: &LogTable, prefix: &str, log: &str) -> Result<(), AlignErr
         check_finite(&field, col)?;
     }
     Ok(())
-}
-
-/// What the warnings are about.
-struct Context<'a> {
-    shared: &'a str,
-    offset: &'a OffsetEstimate,
-    fs: f64,
-    control_rate_hz: f64,
-    nav_rate_hz: f64,
-    hold: bool,
-    overlap: f64,
-    control_span: f64,
-    nav_span: f64,
-}
-
-/// A number without trailing zeros: 10 → "10", 12.5 → "12.5".
-fn fmt_num(v: f64) -> String {
-    let s = format!("{v:.3}");
-    s.trim_end_matches('0').trim_end_matches('.').to_owned()
-}
-
-fn rate_warnings(c: &Context) -> Vec<String> {
-    let mut w = Vec::new();
-    if c.control_rate_hz < c.nav_rate_hz * 0.99 {
-        w.push(format!(
-            "the control log ({} Hz) is slower than the navigation log ({} Hz): the inputs are known only every {} s",
-            fmt_num(c.control_rate_hz),
-            fmt_num(c.nav_rate_hz),
-            fmt_num(1.0 / c.control_rate_hz)
-        ));
-    }
-    if c.fs > c.control_rate_hz * 1.01 {
-        w.push(format!(
-            "the inputs are held (zero-order hold) from {} Hz up to {} Hz: the extra samples repeat the last command, they are not new information",
-            fmt_num(c.control_rate_hz),
-            fmt_num(c.fs)
-        ));
-    } else if !c.hold {
-        w.push(format!(
-            "the inputs are averaged over {} s to go from {} Hz down to {} Hz",
-            fmt_num(1.0 / c.fs),
-            fmt_num(c.control_rate_hz),
-            fmt_num(c.fs)
-        ));
-    }
-    if c.fs > c.nav_rate_hz * 1.01 {
-        w.push(format!(
-            "the navigation log ({} Hz) is interpolated linearly up to {} Hz: the samples in between are not measured",
-            fmt_num(c.nav_rate_hz),
-            fmt_num(c.fs)
-        ));
-    }
-    w
-}
-
-fn quality_warnings(c: &Context) -> Vec<String> {
-    let mut w = Vec::new();
-    let o = c.offset;
-    let plot = format!("check it by plotting {0} and {0}_control", c.shared);
-    match o.confidence {
-        Confidence::High => {}
-        Confidence::Medium => w.push(format!(
-            "the clock offset is only moderately certain (correlation {:.2}, peak ratio {:.2}, standard error {:.3} s); {plot}",
-            o.correlation, o.peak_ratio, o.std_error_s
-        )),
-        Confidence::Low => w.push(format!(
-            "the clock offset is uncertain (correlation {:.2}, peak ratio {:.2}, standard error {:.3} s): another offset may fit as well (e.g. a periodic {}), or the channel varies too little; {plot}",
-            o.correlation, o.peak_ratio, o.std_error_s, c.shared
-        )),
-    }
-    if o.residual_relative > RESIDUAL_WARNING {
-        w.push(format!(
-            "after alignment {} still differs between the logs by {:.0} % of its variation: the logs may not record the same quantity (sensor, units, sign), or a clock drifts",
-            c.shared,
-            100.0 * o.residual_relative
-        ));
-    }
-    for (log, span) in [
-        ("control log", c.control_span),
-        ("navigation log", c.nav_span),
-    ] {
-        if span > 0.0 && c.overlap < 0.8 * span {
-            w.push(format!(
-                "only {:.0} % of the {log} ({:.1} s of {:.1} s) overlaps the other log; the rest is dropped",
-                100.0 * c.overlap / span,
-                c.overlap,
-                span
-            ));
-        }
-    }
-    w
 }

@@ -34,8 +34,11 @@
 //! error), `resample` (merging rules: zero-order hold, cell averages,
 //! linear; gaps), `drift` (clock-drift check), `error` ([`AlignError`]).
 
+mod ambiguity;
 mod bandwidth;
 mod brent;
+mod calibrate;
+mod decide;
 mod drift;
 mod error;
 mod grid;
@@ -43,9 +46,11 @@ mod hermite;
 mod kernel;
 mod merge;
 mod offset;
+mod pool;
 mod refine;
 mod resample;
 mod validate;
+mod warnings;
 mod xcorr;
 
 #[cfg(test)]
@@ -53,6 +58,11 @@ mod test_support;
 #[cfg(test)]
 mod tests;
 
+pub use decide::{
+    Chosen, MAX_USER_OFFSET_S, OffsetPriors, OffsetSource, PooledValue, check_user_offset,
+    choose_offset,
+};
 pub use error::AlignError;
-pub use merge::{AlignmentReport, align_logs};
+pub use merge::{AlignmentReport, align_logs, align_logs_with};
 pub use offset::{Confidence, OffsetEstimate, OffsetOptions, estimate_offset};
+pub use pool::{OUTLIER_Z, PooledOffset, RejectedRun, RunOffset, pool_offsets};

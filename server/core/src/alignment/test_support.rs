@@ -91,6 +91,40 @@ impl Depth {
         Self::random(rng, duration, 1.0, 0.1)
     }
 
+    /// A slow wander without ramps (a depth hold drifting, a sensor's own
+    /// drift): 40 random sinusoids in 0.0005–`max_hz` Hz with a flat
+    /// spectrum, scaled to `rms` m, around `base` m.
+    pub fn drift(rng: &mut Rng, rms: f64, max_hz: f64, base: f64) -> Self {
+        let mut waves: Vec<(f64, f64, f64)> = (0..40)
+            .map(|_| {
+                let f = rng.range(0.0005, max_hz);
+                (1.0, 2.0 * PI * f, rng.range(0.0, 2.0 * PI))
+            })
+            .collect();
+        let total = (waves.iter().map(|w| 0.5 * w.0 * w.0).sum::<f64>()).sqrt();
+        waves.iter_mut().for_each(|w| w.0 *= rms / total);
+        Depth {
+            waves,
+            ramps: Vec::new(),
+            base,
+        }
+    }
+
+    /// Heave at one period (s) and amplitude (m), slowly modulated by
+    /// `modulation` (0: a pure sinusoid).
+    pub fn heave(rng: &mut Rng, period: f64, amplitude: f64, modulation: f64) -> Self {
+        let w = 2.0 * PI / period;
+        let dw = w * modulation * rng.range(0.5, 1.0);
+        Depth {
+            waves: vec![
+                (amplitude, w, rng.range(0.0, 2.0 * PI)),
+                (amplitude * modulation, w + dw, rng.range(0.0, 2.0 * PI)),
+            ],
+            ramps: Vec::new(),
+            base: 20.0,
+        }
+    }
+
     /// A pure sinusoid of the given period (s) around 20 m.
     pub fn sinusoid(period: f64) -> Self {
         Depth {
@@ -212,6 +246,92 @@ pub(crate) fn make_case(
         control: c,
         nav: n,
         dt_slow: 1.0 / control_hz.min(nav_hz),
+    }
+}
+
+/// The kinds of run of the calibration sweeps, strong to hopeless.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum RunKind {
+    /// 10 min of lively depth at 30 dB (an excitation run).
+    Lively,
+    /// 3 min of lively depth at 15 dB.
+    ShortNoisy,
+    /// 5 min of a ramp-dominated dive at 25 dB.
+    SlowDive,
+    /// A static run holding depth: a slow drift of 2–10 cm and 1–3 cm of
+    /// white noise on each log, 5–10 min.
+    StaticHold,
+    /// The same, each depth sensor also wandering on its own.
+    StaticWander,
+    /// Heave at one period (6–30 s), 5 min: every period fits.
+    Heave,
+}
+
+impl RunKind {
+    pub const ALL: [RunKind; 6] = [
+        RunKind::Lively,
+        RunKind::ShortNoisy,
+        RunKind::SlowDive,
+        RunKind::StaticHold,
+        RunKind::StaticWander,
+        RunKind::Heave,
+    ];
+}
+
+/// One seeded run of `kind` with clock offset `offset` (s): control 10 Hz
+/// over true [0, duration], nav at 20 Hz over a random sub-window.
+pub(crate) fn make_run(kind: RunKind, seed: u64, offset: f64) -> Case {
+    match kind {
+        RunKind::Lively => return make_case(seed, (10.0, 20.0), offset, 600.0, 30.0, false),
+        RunKind::ShortNoisy => return make_case(seed, (10.0, 20.0), offset, 180.0, 15.0, false),
+        RunKind::SlowDive => return make_case(seed, (10.0, 20.0), offset, 300.0, 25.0, true),
+        _ => {}
+    }
+    let mut rng = Rng::new(seed);
+    let (duration, depth, noise, wander) = match kind {
+        RunKind::Heave => {
+            let (period, amp) = (rng.range(6.0, 30.0), rng.range(0.1, 0.5));
+            let modulation = rng.range(0.0, 0.05);
+            let depth = Depth::heave(&mut rng, period, amp, modulation);
+            (300.0, depth, rng.range(0.01, 0.05), 0.0)
+        }
+        _ => {
+            let duration = rng.range(300.0, 600.0);
+            let (rms, max_hz) = (rng.range(0.02, 0.1), rng.range(0.002, 0.01));
+            let depth = Depth::drift(&mut rng, rms, max_hz, 20.0);
+            let wander = if kind == RunKind::StaticWander {
+                0.5 * rms
+            } else {
+                0.0
+            };
+            (duration, depth, rng.range(0.01, 0.03), wander)
+        }
+    };
+    let own = |rng: &mut Rng| Depth::drift(rng, wander, 0.01, 0.0);
+    let (wander_c, wander_n) = (own(&mut rng), own(&mut rng));
+    let control = LogSpec {
+        rate_hz: 10.0,
+        start: 0.0,
+        end: duration,
+        clock: 100.0,
+        jitter: 0.01,
+        noise,
+    };
+    let nav = LogSpec {
+        rate_hz: 20.0,
+        start: rng.range(0.0, 0.1 * duration),
+        end: duration - rng.range(0.0, 0.1 * duration),
+        clock: 100.0 - offset,
+        jitter: 0.01,
+        noise,
+    };
+    let c = control.sample(|t| depth.eval(t) + wander_c.eval(t), &mut rng);
+    let n = nav.sample(|t| depth.eval(t) + wander_n.eval(t), &mut rng);
+    Case {
+        offset,
+        control: c,
+        nav: n,
+        dt_slow: 0.1,
     }
 }
 

@@ -32,14 +32,14 @@ pub(crate) struct Correlation {
     pub z: Vec<f64>,
 }
 
-struct Prefix {
+pub(crate) struct Prefix {
     s0: Vec<f64>,
     s1: Vec<f64>,
     sq: Vec<f64>,
 }
 
 impl Prefix {
-    fn new(x: &[f64]) -> Self {
+    pub(crate) fn new(x: &[f64]) -> Self {
         let n = x.len() + 1;
         let (mut s0, mut s1, mut sq) = (
             Vec::with_capacity(n),
@@ -63,7 +63,7 @@ impl Prefix {
 
     /// (Σx, Σ(i − (n−1)/2)·x, Σx²) over `x[start..start + n]`, `i` the
     /// index within the slice.
-    fn window(&self, start: usize, n: usize) -> (f64, f64, f64) {
+    pub(crate) fn window(&self, start: usize, n: usize) -> (f64, f64, f64) {
         let end = start + n;
         let s0 = self.s0[end] - self.s0[start];
         let s1 = self.s1[end] - self.s1[start] - start as f64 * s0;
@@ -117,7 +117,7 @@ pub(crate) fn normalized_xcorr(a: &[f64], b: &[f64], lo: i64, hi: i64) -> Correl
 
 /// `r[m mod N] = Σ_k a[k]·b[k − m]` for every lag, by one zero-padded real
 /// FFT pair (`N` a power of two ≥ `na + nb − 1`, so nothing wraps).
-fn raw_xcorr(a: &[f64], b: &[f64]) -> Vec<f64> {
+pub(crate) fn raw_xcorr(a: &[f64], b: &[f64]) -> Vec<f64> {
     let n_fft = (a.len() + b.len() - 1).next_power_of_two().max(2);
     let mut planner = RealFftPlanner::<f64>::new();
     let fwd = planner.plan_fft_forward(n_fft);
