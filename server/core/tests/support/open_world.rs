@@ -101,6 +101,7 @@ pub fn to_input(profile: &VesselProfile, run: &Run, described: bool) -> RunInput
         name: run.meta.name.clone(),
         family: described.then(|| family(run.meta.role)),
         grid_speed_mps: if described { run.meta.grid_speed } else { None },
+        excited_dofs: Vec::new(),
         record,
     }
 }
