@@ -364,3 +364,53 @@ async fn identification_uses_the_inferred_roles_of_unplanned_runs() {
     let points = m.json["document"]["lpv"]["points"].as_array().unwrap();
     assert_eq!(points.len(), 2, "{}", m.json["document"]["notes"]);
 }
+
+/// The supply vessel's SI1–SI3 manoeuvres and validation runs uploaded
+/// without experiment ids: the manoeuvre is inferred from the thrusters each
+/// run drives, and the parallel EKF stages the runs by it.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_dp_campaign_without_a_plan_is_staged_by_the_thrusters_it_drives() {
+    use seatrial_core::planning::examples::{supply_vessel, supply_vessel_trial_campaign};
+    use seatrial_core::simulation::dp_ship::{DpFlightSettings, DpShip, fly_dp_campaign};
+    let app = TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await;
+    let spec = supply_vessel_trial_campaign(1995);
+    let (cid, _) = common::flights::planned_campaign(
+        &app,
+        common::dp_profile(),
+        serde_json::to_value(&spec).unwrap(),
+    )
+    .await;
+    let profile = supply_vessel();
+    let plan = seatrial_core::planning::generate_plan(&profile, &spec).unwrap();
+    let flown = fly_dp_campaign(
+        &profile,
+        &DpShip::supply_vessel(),
+        &plan,
+        &DpFlightSettings::supply_vessel(2024),
+        |_| true,
+    )
+    .unwrap();
+    for f in &flown {
+        let run = upload(&app, &cid, &f.code, &f.csv, None).await;
+        let d = &run["description"];
+        assert_eq!(d["role"]["source"], "inferred");
+        assert_eq!(
+            d["family"],
+            f.family.name(),
+            "{}: {}",
+            f.code,
+            d["role"]["reason"]
+        );
+    }
+    let r = app
+        .call(
+            "POST",
+            "/api/jobs",
+            &[],
+            Some(json!({ "kind": "identify", "campaign_id": cid, "method": "parallel_ekf" })),
+        )
+        .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let job = wait_for_job(&app, r.json["id"].as_str().unwrap(), 120).await;
+    assert_eq!(job["state"], "succeeded", "{job}");
+}

@@ -176,6 +176,16 @@ macro_rules! described {
             #[serde(default, skip_serializing_if = "Option::is_none")]
             pub reason: Option<String>,
         }
+
+        impl From<($t, Source, Option<String>)> for $name {
+            fn from((value, source, reason): ($t, Source, Option<String>)) -> Self {
+                $name {
+                    value,
+                    source,
+                    reason,
+                }
+            }
+        }
     };
 }
 
@@ -293,85 +303,58 @@ pub fn dof_words(dofs: &[Dof]) -> String {
     dofs.iter().map(|d| d.name()).collect::<Vec<_>>().join(", ")
 }
 
+/// The first of the supervisor's, the plan's and the inferred value, with
+/// its source and reason. A matched plan wins over the data even where it
+/// says nothing (the validation run's grid speed).
+fn first<T>(
+    user: Option<T>,
+    plan: Option<(Option<T>, &PlanDescription)>,
+    inferred: Option<(Option<T>, &str)>,
+) -> Option<(T, Source, Option<String>)> {
+    match (user, plan, inferred) {
+        (Some(v), ..) => Some((v, Source::User, None)),
+        (None, Some((v, p)), _) => v.map(|v| {
+            (
+                v,
+                Source::Plan,
+                Some(format!("planned experiment {}", p.code)),
+            )
+        }),
+        (None, None, Some((v, why))) => v.map(|v| (v, Source::Inferred, Some(why.to_string()))),
+        _ => None,
+    }
+}
+
 /// Merges the three sources of a run's description.
 pub fn describe_run(
     user: &UserDescription,
     plan: Option<&PlanDescription>,
     inferred: Option<&InferredDescription>,
 ) -> RunDescription {
-    let from_plan = |p: &PlanDescription| Some(format!("planned experiment {}", p.code));
-    let role = match (user.role, plan, inferred) {
-        (Some(r), ..) => Some(DescribedRole {
-            value: r,
-            source: Source::User,
-            reason: None,
-        }),
-        (None, Some(p), _) => Some(DescribedRole {
-            value: RunRole::of_family(p.family),
-            source: Source::Plan,
-            reason: from_plan(p),
-        }),
-        (None, None, Some(i)) => Some(DescribedRole {
-            value: i.role,
-            source: Source::Inferred,
-            reason: Some(i.role_reason.clone()),
-        }),
-        _ => None,
-    };
-    let grid_speed_mps = match (user.grid_speed_mps, plan, inferred) {
-        (Some(v), ..) => Some(DescribedSpeed {
-            value: v,
-            source: Source::User,
-            reason: None,
-        }),
-        (None, Some(p), _) => p.grid_speed_mps.map(|v| DescribedSpeed {
-            value: v,
-            source: Source::Plan,
-            reason: from_plan(p),
-        }),
-        (None, None, Some(i)) => i.grid_speed_mps.map(|v| DescribedSpeed {
-            value: v,
-            source: Source::Inferred,
-            reason: Some(i.grid_speed_reason.clone()),
-        }),
-        _ => None,
-    };
-    let excited_dofs = match (&user.excited_dofs, plan, inferred) {
-        (Some(v), ..) => Some(DescribedDofs {
-            value: v.clone(),
-            source: Source::User,
-            reason: None,
-        }),
-        (None, Some(p), _) => Some(DescribedDofs {
-            value: p.excited_dofs.clone(),
-            source: Source::Plan,
-            reason: from_plan(p),
-        }),
-        (None, None, Some(i)) => Some(DescribedDofs {
-            value: i.excited_dofs.clone(),
-            source: Source::Inferred,
-            reason: Some(i.excited_dofs_reason.clone()),
-        }),
-        _ => None,
-    };
-    let signal = match (user.signal, plan, inferred) {
-        (Some(v), ..) => Some(DescribedSignal {
-            value: v,
-            source: Source::User,
-            reason: None,
-        }),
-        (None, Some(p), _) => Some(DescribedSignal {
-            value: p.signal,
-            source: Source::Plan,
-            reason: from_plan(p),
-        }),
-        (None, None, Some(i)) => Some(DescribedSignal {
-            value: i.signal,
-            source: Source::Inferred,
-            reason: Some(i.signal_reason.clone()),
-        }),
-        _ => None,
-    };
+    let role = first(
+        user.role,
+        plan.map(|p| (Some(RunRole::of_family(p.family)), p)),
+        inferred.map(|i| (Some(i.role), i.role_reason.as_str())),
+    )
+    .map(DescribedRole::from);
+    let grid_speed_mps = first(
+        user.grid_speed_mps,
+        plan.map(|p| (p.grid_speed_mps, p)),
+        inferred.map(|i| (i.grid_speed_mps, i.grid_speed_reason.as_str())),
+    )
+    .map(DescribedSpeed::from);
+    let excited_dofs = first(
+        user.excited_dofs.clone(),
+        plan.map(|p| (Some(p.excited_dofs.clone()), p)),
+        inferred.map(|i| (Some(i.excited_dofs.clone()), i.excited_dofs_reason.as_str())),
+    )
+    .map(DescribedDofs::from);
+    let signal = first(
+        user.signal,
+        plan.map(|p| (Some(p.signal), p)),
+        inferred.map(|i| (Some(i.signal), i.signal_reason.as_str())),
+    )
+    .map(DescribedSignal::from);
     let family = role.as_ref().map(|r| {
         let role = r.value;
         match (plan, inferred) {
@@ -385,11 +368,7 @@ pub fn describe_run(
         grid_speed_mps,
         excited_dofs,
         signal,
-        notes: user.notes.clone().map(|n| DescribedNotes {
-            value: n,
-            source: Source::User,
-            reason: None,
-        }),
+        notes: first(user.notes.clone(), None, None).map(DescribedNotes::from),
         family,
         inferred: inferred.cloned(),
     }

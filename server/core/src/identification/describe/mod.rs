@@ -18,8 +18,9 @@
 //!   how far the mean was from it.
 //! - **Role.** Forward speed (moving average over [`SPEED_WINDOW_TIME_CONSTANTS`]
 //!   surge time constants, ≥ 30 s) spending ≥ [`MIN_BIN_SHARE`] of the run in
-//!   each of two grid bins → validation (the thesis's validation run steps
-//!   through the grid); no DOF excited dynamically → static; on a DP vessel,
+//!   each of two grid bins of a grid of ≥ 2 speeds → validation (the
+//!   thesis's validation run steps through the grid); no DOF excited
+//!   dynamically → static; on a DP vessel,
 //!   more than one kind of thruster (main, tunnel, azimuth) driven →
 //!   validation, else the manoeuvre of the one kind driven (SI1 / SI2 / SI3);
 //!   on a ROV, ≥ [`RECURSIVE_MIN_DOFS`] DOFs excited at once → recursive,

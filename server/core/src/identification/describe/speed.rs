@@ -17,8 +17,9 @@ pub const SPEED_WINDOW_TIME_CONSTANTS: f64 = 10.0;
 /// bin for the speed to count as wandering across the grid.
 pub const MIN_BIN_SHARE: f64 = 0.15;
 
-/// Bin width of a one-point grid (m/s): the thesis's grid spacing 0.5 kn.
-const SINGLE_POINT_BIN_MPS: f64 = 0.5 * KNOT;
+/// Spacing assumed about a one-point grid (m/s), to call a mean speed off
+/// the grid: the thesis's grid spacing 0.5 kn.
+const SINGLE_POINT_SPACING_MPS: f64 = 0.5 * KNOT;
 
 /// Forward speed: mean, and the shares of the run the smoothed speed spends
 /// in each grid bin (grid index → share), largest first.
@@ -29,15 +30,6 @@ fn speed_bins(
     window_s: f64,
 ) -> (f64, Vec<(usize, f64)>) {
     let (mean, _) = mean_std(rec, u);
-    let bin = |v: f64| -> usize {
-        if grid.len() == 1 {
-            // Pseudo-bins of 0.5 kn about the one grid point.
-            let k = ((v - grid[0]) / SINGLE_POINT_BIN_MPS).round();
-            (k + 1000.0).clamp(0.0, 2000.0) as usize
-        } else {
-            nearest_grid_index(grid, v)
-        }
-    };
     let w = ((window_s * rec.sample_rate_hz).round() as usize).max(1);
     let mut counts = std::collections::BTreeMap::<usize, usize>::new();
     let mut total = 0usize;
@@ -51,7 +43,7 @@ fn speed_bins(
             let lo = k.saturating_sub(half);
             let hi = (k + half + 1).min(b.len());
             let avg = (prefix[hi] - prefix[lo]) / (hi - lo) as f64;
-            *counts.entry(bin(avg)).or_default() += 1;
+            *counts.entry(nearest_grid_index(grid, avg)).or_default() += 1;
             total += 1;
         }
     }
@@ -83,9 +75,11 @@ pub(super) fn grid_speed(
     }
     let window =
         (SPEED_WINDOW_TIME_CONSTANTS * profile.limit(Dof::Surge).time_constant_s).max(30.0);
+    // With one grid point (a DP campaign at rest) there is no grid to move
+    // across: a surge manoeuvre's speed changes are its excitation.
     let (mean, shares) = speed_bins(rec, u, grid, window);
     let visited: Vec<&(usize, f64)> = shares.iter().filter(|s| s.1 >= MIN_BIN_SHARE).collect();
-    if visited.len() >= 2 && grid.len() > 1 {
+    if visited.len() >= 2 {
         let mut v: Vec<&(usize, f64)> = visited.clone();
         v.sort_by_key(|s| s.0);
         let list = v
@@ -103,12 +97,6 @@ pub(super) fn grid_speed(
             Some(why),
         );
     }
-    if visited.len() >= 2 {
-        let why = format!(
-            "the forward speed ({window:.0} s moving average) moves by more than 0.5 kn about the one grid speed"
-        );
-        return (None, why.clone(), Some(mean), Some(why));
-    }
     let i = nearest_grid_index(grid, mean);
     let g = grid[i];
     let spacing = if grid.len() > 1 {
@@ -116,7 +104,7 @@ pub(super) fn grid_speed(
             .map(|w| (w[1] - w[0]).abs())
             .fold(f64::INFINITY, f64::min)
     } else {
-        SINGLE_POINT_BIN_MPS
+        SINGLE_POINT_SPACING_MPS
     };
     let off = mean - g;
     let mut reason = format!(
