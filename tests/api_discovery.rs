@@ -9,21 +9,13 @@ mod common;
 
 use common::TestApp;
 use common::flights::flown_campaign;
-use common::wait_for_job;
+use common::{run_job, wait_for_job};
 use seatrial::jobs::{JobRegistry, JobsConfig};
 use seatrial_core::simulation::rov::RovTruth;
 use serde_json::{Value, json};
 
 async fn app() -> TestApp {
     TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await
-}
-
-async fn run_job(app: &TestApp, body: Value) -> Value {
-    let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
-    assert_eq!(r.status, 202, "{}", r.text);
-    let job = wait_for_job(app, r.json["id"].as_str().unwrap(), 60).await;
-    assert_eq!(job["state"], "succeeded", "{job}");
-    job
 }
 
 /// Identifies campaign `cid` by `method`; the stored model's id. A λ model

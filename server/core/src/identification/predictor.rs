@@ -198,19 +198,34 @@ pub fn validation_data(
     }
 }
 
-/// Validates a stored model on one run.
+/// Validates a stored model on one run with horizon `k` (other settings
+/// default).
 pub fn validate_on_run(
     doc: &ModelDocument,
     run: &RunInput,
     inputs: &[String],
     k: usize,
 ) -> Result<ValidationReport, IdentifyError> {
+    let settings = ValidationSettings {
+        k,
+        ..ValidationSettings::default()
+    };
+    validate_on_run_with(doc, run, inputs, settings)
+}
+
+/// Validates a stored model on one run with `settings` (the input names
+/// are the model's own).
+pub fn validate_on_run_with(
+    doc: &ModelDocument,
+    run: &RunInput,
+    inputs: &[String],
+    settings: ValidationSettings,
+) -> Result<ValidationReport, IdentifyError> {
     let model = predictor(doc)?;
     let (h, u, y) = validation_data(doc, run, inputs)?;
     let settings = ValidationSettings {
-        k,
         input_names: doc.inputs.clone(),
-        ..ValidationSettings::default()
+        ..settings
     };
     validate(
         model.as_ref(),

@@ -40,33 +40,41 @@ pub(crate) fn check_k_step(
     } else {
         format!("{k}-step prediction")
     };
-    Ok(match ch.first_outside(yhat, start..yhat.len()) {
-        None => Checked {
-            series: yhat.to_vec(),
-            fit: nrmse_fit(ch.y, yhat),
-            divergence: None,
-        },
-        Some(t) => Checked {
-            series: cut(yhat, t, yhat.len()),
-            fit: None,
-            divergence: Some(ch.divergence(&what, yhat[t], t, Some(t.saturating_sub(k)))),
-        },
-    })
+    Ok(cut_at_divergence(ch, yhat, start, |t| {
+        ch.divergence(&what, yhat[t], t, Some(t.saturating_sub(k)))
+    }))
 }
 
 /// The whole-record free run, from row 0.
 pub(crate) fn check_free_run(ch: &Channel<'_>, yhat: &[f64]) -> Checked {
-    match ch.first_outside(yhat, 0..yhat.len()) {
+    cut_at_divergence(ch, yhat, 0, |t| {
+        ch.divergence("free-run simulation", yhat[t], t, None)
+    })
+}
+
+/// `yhat` checked from row `start`: whole with its fit, or cut at its first
+/// implausible row (the divergence `at` that row) without a fit.
+fn cut_at_divergence(
+    ch: &Channel<'_>,
+    yhat: &[f64],
+    start: usize,
+    at: impl FnOnce(usize) -> Divergence,
+) -> Checked {
+    match ch.first_outside(yhat, start..yhat.len()) {
         None => Checked {
             series: yhat.to_vec(),
             fit: nrmse_fit(ch.y, yhat),
             divergence: None,
         },
-        Some(t) => Checked {
-            series: cut(yhat, t, yhat.len()),
-            fit: None,
-            divergence: Some(ch.divergence("free-run simulation", yhat[t], t, None)),
-        },
+        Some(t) => {
+            let mut series = yhat.to_vec();
+            series[t..].fill(f64::NAN);
+            Checked {
+                series,
+                fit: None,
+                divergence: Some(at(t)),
+            }
+        }
     }
 }
 
@@ -120,12 +128,6 @@ pub(crate) fn residual(y: &[f64], p: &Checked) -> Option<(usize, Vec<f64>)> {
             .map(|(a, b)| a - b)
             .collect(),
     ))
-}
-
-fn cut(yhat: &[f64], from: usize, to: usize) -> Vec<f64> {
-    let mut s = yhat.to_vec();
-    s[from..to].fill(f64::NAN);
-    s
 }
 
 #[cfg(test)]

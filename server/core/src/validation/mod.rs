@@ -25,6 +25,8 @@ pub mod residuals;
 mod verdict;
 
 #[cfg(test)]
+mod residual_tests;
+#[cfg(test)]
 mod tests;
 #[cfg(test)]
 mod unstable_tests;
