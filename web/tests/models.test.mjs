@@ -120,8 +120,9 @@ test('identify from the campaign page, follow the job, read the model page', asy
     assert.ok(nParams >= 12, `${nParams} parameter rows`);
     const stds = await page.locator(tid('param-std')).allTextContents();
     assert.ok(stds.some((s) => /^± \S+/.test(s)), `± std shown: ${stds.slice(0, 5)}`);
-    // Grouped by grid speed (two grid points), and sortable.
-    assert.equal(await page.locator(tid('param-group-head')).count(), 2);
+    // Grouped by grid speed (two grid points, and the campaign-wide g(η)),
+    // and sortable.
+    assert.equal(await page.locator(tid('param-group-head')).count(), 3);
     await page.getByRole('button', { name: /^Value/ }).click();
     await page.getByLabel('group by grid speed').uncheck();
     const values = await page.locator(`${tid('param-row')} td:nth-child(4)`).evaluateAll((tds) => tds.map((t) => Number(t.title)));
