@@ -79,25 +79,12 @@ pub(crate) fn choose_structure(
             let proposal = propose_coupling(all, settings.coupling_threshold).map_err(|e| {
                 IdentifyError::invalid(format!("settings.{}", e.field()), e.to_string())
             })?;
-            let pairs: Vec<String> = proposal
-                .evidence
-                .iter()
-                .filter(|p| proposal.mask.a[(p.output, p.input)])
-                .map(|p| {
-                    format!(
-                        "{}←{} (partial coherence {:.2})",
-                        dofs[p.output].name(),
-                        dofs[p.input].name(),
-                        p.median_partial_coherence
-                    )
-                })
-                .collect();
-            if has_symmetric_form(dofs) {
-                let base = symmetric_pattern(dofs);
-                let extra: Vec<String> = proposal
+            // The proposed pairs outside `skip`, in words.
+            let described = |skip: &dyn Fn(usize, usize) -> bool| -> Vec<String> {
+                proposal
                     .evidence
                     .iter()
-                    .filter(|p| proposal.mask.a[(p.output, p.input)] && !base[(p.output, p.input)])
+                    .filter(|p| proposal.mask.a[(p.output, p.input)] && !skip(p.output, p.input))
                     .map(|p| {
                         format!(
                             "{}←{} (partial coherence {:.2})",
@@ -106,7 +93,11 @@ pub(crate) fn choose_structure(
                             p.median_partial_coherence
                         )
                     })
-                    .collect();
+                    .collect()
+            };
+            if has_symmetric_form(dofs) {
+                let base = symmetric_pattern(dofs);
+                let extra = described(&|i, j| base[(i, j)]);
                 notes.push(if extra.is_empty() {
                     "structure: port–starboard symmetry (surge–heave–pitch and sway–roll–yaw coupled); the data propose no coupling across the two".into()
                 } else {
@@ -119,6 +110,7 @@ pub(crate) fn choose_structure(
                     DMatrix::from_fn(n, n, |i, j| base[(i, j)] || proposal.mask.a[(i, j)]);
                 return Ok(coupled(CouplingMask::from_pattern(&pattern)));
             }
+            let pairs = described(&|_, _| false);
             notes.push(if pairs.is_empty() {
                 "coupling proposal: no DOF pair is coupled above the threshold; diagonal model"
                     .into()
