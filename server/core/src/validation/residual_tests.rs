@@ -1,6 +1,8 @@
 //! The residual tests of [`super::residuals`] against their white-noise
 //! laws and closed-form cases.
 
+use super::ValidationError;
+use super::correlation::autocorrelation;
 use super::residuals::*;
 use crate::rng::SplitMix64;
 use crate::validation::ValidationError;
