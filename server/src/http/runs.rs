@@ -100,6 +100,11 @@ pub async fn upload_run(
     multipart: Result<Multipart, MultipartRejection>,
 ) -> ApiResult<(StatusCode, Json<Run>)> {
     let campaign = found(campaigns::get(&s.db, &id).await?, "campaign", &id)?;
+    let vessel = found(
+        vessels::get(&s.db, &campaign.vessel_id).await?,
+        "vessel",
+        &campaign.vessel_id,
+    )?;
     if let Some(len) = headers
         .get(header::CONTENT_LENGTH)
         .and_then(|v| v.to_str().ok())
@@ -114,6 +119,7 @@ pub async fn upload_run(
         ))
     })?;
     let mut meta = RunMeta::default();
+    let mut user = Default::default();
     let mut files: Vec<NewFile> = Vec::new();
     let mut total = 0u64;
     loop {
@@ -142,6 +148,9 @@ pub async fn upload_run(
                 other => other,
             })?;
             meta = from_value(v, "meta.")?;
+            // Checked at once: a `meta` sent before the files refuses the
+            // upload before any byte is stored.
+            DescriptionChange::of_meta(&meta).apply(&mut user, &vessel.profile, "meta.")?;
             continue;
         }
         if !FILE_ROLES.contains(&name.as_str()) {
@@ -217,13 +226,6 @@ pub async fn upload_run(
         .clone()
         .or_else(|| planned.as_ref().map(|(e, _)| e.experiment.code.clone()))
         .unwrap_or_else(|| files[0].filename.clone());
-    let vessel = found(
-        vessels::get(&s.db, &campaign.vessel_id).await?,
-        "vessel",
-        &campaign.vessel_id,
-    )?;
-    let mut user = Default::default();
-    DescriptionChange::of_meta(&meta).apply(&mut user, &vessel.profile, "meta.")?;
     let run = runs::insert(
         &s.db,
         &campaign.id,
