@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::flights::upload_planned;
+use common::flights::{planned_campaign, upload_planned};
 use common::{TestApp, dp_profile, rov_profile};
 use seatrial::jobs::{JobRegistry, JobsConfig};
 use seatrial_core::planning::examples::{supply_vessel, supply_vessel_trial_campaign};
@@ -21,21 +21,9 @@ async fn app() -> TestApp {
 /// Creates the supply vessel and its trial campaign, flies every planned
 /// experiment through the DP truth and uploads the logs.
 async fn flown_dp_campaign(app: &TestApp) -> String {
-    let r = app
-        .call("POST", "/api/vessels", &[], Some(dp_profile()))
-        .await;
-    assert_eq!(r.status, 201, "{}", r.text);
-    let vid = r.json["id"].as_str().unwrap().to_string();
     let spec = supply_vessel_trial_campaign(1995);
-    let mut body = serde_json::to_value(&spec).unwrap();
-    body["vessel_id"] = json!(vid);
-    let r = app.call("POST", "/api/campaigns", &[], Some(body)).await;
-    assert_eq!(r.status, 201, "{}", r.text);
-    let cid = r.json["id"].as_str().unwrap().to_string();
-    let plan = app
-        .call("POST", "/api/campaigns/{id}/plan", &[&cid], None)
-        .await;
-    assert_eq!(plan.status, 201, "{}", plan.text);
+    let (cid, plan) =
+        planned_campaign(app, dp_profile(), serde_json::to_value(&spec).unwrap()).await;
     let profile = supply_vessel();
     let core_plan = generate_plan(&profile, &spec).unwrap();
     let flown = fly_dp_campaign(
@@ -48,7 +36,7 @@ async fn flown_dp_campaign(app: &TestApp) -> String {
     .unwrap();
     assert_eq!(flown.len(), 8);
     for run in flown {
-        upload_planned(app, &cid, &plan.json, &run.code, &run.csv).await;
+        upload_planned(app, &cid, &plan, &run.code, &run.csv).await;
     }
     cid
 }

@@ -53,6 +53,16 @@ async fn identify_job_stores_a_validated_versioned_lpv_model() {
         let fit = ch["fit_one_step"].as_f64().unwrap();
         assert!(fit > 0.5, "{}: 1-step fit {fit}", ch["output"]);
         assert!(ch["fit_simulation"].is_number() || ch["fit_simulation"].is_null());
+        // The model of a linear truth never diverges; restarted every 10 s
+        // from the measured ν it stays on the recording.
+        assert_eq!(ch["restarted"]["diverged"], 0, "{}", ch["verdict"]);
+        assert!(ch["diverged"]["simulation"].is_null(), "{}", ch["verdict"]);
+        let restarted = ch["fit_restarted"].as_f64().unwrap();
+        assert!(
+            restarted > 0.5,
+            "{}: restarted fit {restarted}",
+            ch["output"]
+        );
     }
 
     // ZOH matrices at the controller's h.
@@ -132,6 +142,41 @@ async fn identify_job_stores_a_validated_versioned_lpv_model() {
         .as_f64()
         .unwrap();
     assert!((fit(fa) - stored).abs() < 1e-9, "{} vs {stored}", fit(fa));
+    // Restarted every 5 s instead of 10: twice the windows; a period that is
+    // not a positive number of seconds is refused.
+    let c5 = app
+        .call(
+            "GET",
+            "/api/models/compare?a={a}&b={b}&run_id={r}&restart_s=5",
+            &[&mid, &mid2, &val],
+            None,
+        )
+        .await;
+    assert_eq!(c5.status, 200, "{}", c5.text);
+    let (r10, r5) = (&fa["report"], &c5.json["models"][0]["report"]);
+    assert_eq!(
+        (r10["restart_s"].as_f64(), r5["restart_s"].as_f64()),
+        (Some(10.0), Some(5.0))
+    );
+    let windows = |r: &Value| r["channels"][0]["restarted"]["windows"].as_u64().unwrap();
+    assert!(
+        windows(r5) >= 2 * windows(r10) - 1,
+        "{} vs {}",
+        windows(r5),
+        windows(r10)
+    );
+    let r = app
+        .call(
+            "GET",
+            "/api/models/compare?a={a}&b={b}&run_id={r}&restart_s=0",
+            &[&mid, &mid2, &val],
+            None,
+        )
+        .await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["field"].as_str()),
+        (422, Some("restart_s"))
+    );
     let r = app
         .call(
             "GET",

@@ -42,6 +42,8 @@ async fn stored_model(app: &TestApp, cid: &str, vid: &str) -> String {
             structure: "diagonal".into(),
             coupling: vec![vec![true]],
             points: vec![LpvPoint {
+                load: None,
+                load_std: None,
                 speed_mps: 0.5,
                 m: vec![vec![5800.0]],
                 m_std: vec![vec![50.0]],
@@ -252,6 +254,15 @@ async fn every_documented_operation_is_exercised_and_answers() {
                         template,
                         &args,
                         Some(json!({ "clock_offset_s": 4.0 })),
+                    )
+                    .await
+                }
+                ("patch", "/api/runs/{id}") => {
+                    app.call(
+                        "PATCH",
+                        template,
+                        &args,
+                        Some(json!({ "role": "dynamic", "grid_speed_kn": 1.0, "notes": "walked" })),
                     )
                     .await
                 }

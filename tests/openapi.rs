@@ -48,6 +48,8 @@ fn every_fixed_route_of_the_contract_is_documented() {
         ("put", "/api/campaigns/{id}/clock-offset"),
         ("get", "/api/runs/{id}/clock-offset"),
         ("put", "/api/runs/{id}/clock-offset"),
+        ("get", "/api/runs/{id}"),
+        ("patch", "/api/runs/{id}"),
     ] {
         assert!(
             spec["paths"][path][method].is_object(),

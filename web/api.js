@@ -68,6 +68,8 @@ export const api = {
   experiment: (id, eid) => request('GET', urls.experimentJson(id, eid)),
   runs: (id) => request('GET', `/api/campaigns/${enc(id)}/runs`),
   run: (rid) => request('GET', `/api/runs/${enc(rid)}`),
+  // What a run is: fields absent are kept, null clears a user value.
+  describeRun: (rid, body) => request('PATCH', `/api/runs/${enc(rid)}`, body),
   quality: (rid) => request('GET', urls.quality(rid)),
   coverage: (id) => request('GET', `/api/campaigns/${enc(id)}/coverage`),
   // Clock offsets of two-file runs (s; null clears the one set by hand).

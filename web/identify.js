@@ -6,6 +6,7 @@
 import { api, urls } from './api.js';
 import { FAMILY_LABEL, fmtDate, fmtKn } from './format.js';
 import { h, fill, labelled, clearErrors, showFieldError } from './forms.js';
+import { runFamily, runRole, sourceBadge } from './rundescribe.js';
 
 export const METHOD_LABEL = {
   lambda_kf: 'λ-filter Kalman (LPV)',
@@ -96,19 +97,22 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
   }
 
   /** "estimation", with the EKF stage of a DP manoeuvre. */
-  const estimationRole = (e) => (m.method === 'parallel_ekf' && e && DP_STAGE[e.family] ? `estimation (${DP_STAGE[e.family]})` : 'estimation');
+  const estimationRole = (r) => (m.method === 'parallel_ekf' && DP_STAGE[runFamily(r)] ? `estimation (${DP_STAGE[runFamily(r)]})` : 'estimation');
   const expOf = (r) => (plan && r.experiment_id ? plan.experiments.find((e) => e.id === r.experiment_id) : null);
   const accepted = () => runs.filter((r) => r.status === 'accepted');
 
-  /** Role of each used run, as the server assigns it (roles.rs). */
+  /**
+   * Role of each used run, as the server assigns it (roles.rs): by the
+   * run's description — the supervisor's word, else its planned
+   * experiment, else inferred from its data.
+   */
   function roles() {
     const used = accepted().filter((r) => m.use.get(r.id) !== false);
     const explicit = used.some((r) => m.holdOut.has(r.id));
     const role = new Map();
     for (const r of used) {
-      const e = expOf(r);
-      const held = explicit ? m.holdOut.has(r.id) : e && e.family === 'validation';
-      role.set(r.id, held ? 'validation' : e && e.family === 'static' ? 'static' : 'estimation');
+      const held = explicit ? m.holdOut.has(r.id) : runRole(r) === 'validation';
+      role.set(r.id, held ? 'validation' : runRole(r) === 'static' ? 'static' : 'estimation');
     }
     return { used, explicit, role };
   }
@@ -135,24 +139,26 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
         onChange: (ev) => { if (ev.target.checked) m.holdOut.add(r.id); else m.holdOut.delete(r.id); renderRunsTable(); },
       });
       const rl = role.get(r.id);
+      const d = r.description || {};
+      const fam = runFamily(r);
       return h('tr', { 'data-testid': 'identify-run', 'data-run-id': r.id, 'data-role': rl || 'unused', class: rl ? `role-${rl}` : 'unused' },
         h('td', null, useBox),
         h('td', null, h('a', { href: urls.run(r.id) }, r.name)),
         h('td', { class: 'mono nowrap' }, e ? e.code : h('span', { class: 'muted' }, '–')),
-        h('td', null, e ? h('span', { class: `fam-tag ${e.family}` }, FAMILY_LABEL[e.family] || e.family) : h('span', { class: 'muted' }, 'not planned')),
-        h('td', { class: 'num' }, e && e.grid_speed_mps != null ? `${fmtKn(e.grid_speed_mps)} kn` : '–'),
-        h('td', { class: 'nowrap', 'data-testid': 'identify-role' }, rl ? (rl === 'validation' ? (explicit ? 'validation (held out)' : 'validation (plan)') : rl === 'static' ? 'static (restoring)' : estimationRole(e)) : h('span', { class: 'muted' }, 'not used')),
+        h('td', { class: 'nowrap' }, fam ? [h('span', { class: `fam-tag ${fam}` }, FAMILY_LABEL[fam] || fam), ' ', sourceBadge(d.role)] : h('span', { class: 'muted' }, 'not known')),
+        h('td', { class: 'num' }, d.grid_speed_mps ? `${fmtKn(d.grid_speed_mps.value)} kn` : '–'),
+        h('td', { class: 'nowrap', 'data-testid': 'identify-role' }, rl ? (rl === 'validation' ? (explicit ? 'validation (held out)' : `validation (${d.role ? d.role.source : 'plan'})`) : rl === 'static' ? 'static (restoring)' : estimationRole(r)) : h('span', { class: 'muted' }, 'not used')),
         h('td', null, h('label', { class: 'check' }, holdBox, ' hold out')));
     });
     fill(runsBox, h('div', { class: 'table-x' }, h('table', { class: 'grid-table compact', 'data-testid': 'identify-runs' },
-      h('thead', null, h('tr', null, h('th', null, 'Use'), h('th', null, 'Run'), h('th', null, 'Experiment'), h('th', null, 'Family'),
+      h('thead', null, h('tr', null, h('th', null, 'Use'), h('th', null, 'Run'), h('th', null, 'Experiment'), h('th', { title: 'the run’s role: said by the supervisor, planned, or inferred from its data (edit it on the run page)' }, 'Family'),
         h('th', { class: 'num' }, 'Speed'), h('th', null, 'Role'), h('th', { title: 'hold these runs out for validation instead of the plan’s validation runs' }, 'Validation'))),
       h('tbody', null, rows))));
     const nVal = [...role.values()].filter((x) => x === 'validation').length;
     const nEst = [...role.values()].filter((x) => x === 'estimation').length;
     rolesNote.textContent = `${used.length} of ${acc.length} accepted runs: ${nEst} to estimate from, ${nVal} held out for validation`
-      + `${explicit ? ' (ticked)' : ' (the plan’s validation runs)'}.`
-      + (nVal === 0 ? ' No validation run: fly the plan’s validation experiment, or tick “hold out” on a run.' : '');
+      + `${explicit ? ' (ticked)' : ' (the runs whose role is validation)'}.`
+      + (nVal === 0 ? ' No validation run: fly the plan’s validation experiment, set a run’s role to validation on its run page, or tick “hold out” on a run.' : '');
     rolesNote.classList.toggle('error-text', nVal === 0);
   }
 

@@ -21,10 +21,34 @@ function outUnit(name) {
   return '';
 }
 
-/** NRMSE fit (1 perfect, 0 no better than the mean) as a percentage. */
+/**
+ * NRMSE fit (1 perfect, 0 no better than the mean) as a percentage with one
+ * decimal, the core's format: "87.3 %", "−41.0 %", "< −1000 %" below −10,
+ * "—" when there is none (the prediction diverged, or the output is constant).
+ */
 export function fitText(v) {
-  if (v == null || !Number.isFinite(v)) return '–';
-  return `${fmt(v * 100, 1)} %`;
+  if (v == null || !Number.isFinite(v)) return '—';
+  if (v < -10) return '< −1000 %';
+  const p = (v * 100).toFixed(1);
+  return `${p === '-0.0' ? '0.0' : p.replace('-', '−')} %`;
+}
+
+/** The restart period of a report, e.g. "10 s". */
+function restartText(rep) {
+  return rep.restart_s != null ? `${Number(rep.restart_s.toFixed(1))} s` : '10 s';
+}
+
+/** Tooltip of a restarted fit: how many windows diverged. */
+function restartedTitle(c) {
+  const w = c.restarted;
+  if (!w) return '';
+  return w.diverged ? `${w.diverged} of ${w.windows} windows diverged and are left out` : `${w.windows} windows, none diverged`;
+}
+
+/** Where a channel's predictions diverged, in the order of the fit columns. */
+function divergences(c) {
+  const d = c.diverged || {};
+  return ['one_step', 'k_step', 'restarted', 'simulation'].map((k) => d[k]).filter(Boolean);
 }
 const fitClass = (v) => (v == null ? '' : v >= 0.8 ? 'fit-good' : v >= 0.5 ? 'fit-weak' : 'fit-bad');
 
@@ -175,15 +199,21 @@ export async function modelPage(view, id) {
       h('td', { class: 'mono' }, c.output),
       h('td', { class: `num ${fitClass(c.fit_one_step)}`, 'data-testid': 'fit-one-step' }, fitText(c.fit_one_step)),
       h('td', { class: `num ${fitClass(c.fit_k_step)}`, 'data-testid': 'fit-k-step' }, fitText(c.fit_k_step)),
+      h('td', { class: `num ${fitClass(c.fit_restarted)}`, 'data-testid': 'fit-restarted', title: restartedTitle(c) }, fitText(c.fit_restarted)),
       h('td', { class: `num ${fitClass(c.fit_simulation)}`, 'data-testid': 'fit-simulation' }, fitText(c.fit_simulation)),
       h('td', null, c.residuals_white ? h('span', { class: 'badge good' }, 'white') : h('span', { class: 'badge weak' }, 'correlated')),
       h('td', { class: 'verdict-text', 'data-testid': 'channel-verdict' }, c.verdict)));
+    const diverged = chans.flatMap(divergences);
+    const divergenceNote = diverged.length
+      ? h('ul', { class: 'warnings', 'data-testid': 'divergences', role: 'note', 'aria-label': 'Divergences' },
+        diverged.map((d) => h('li', { 'data-testid': 'divergence', 'data-channel': d.output }, '⚠ ', d.text, ': no fit over what follows')))
+      : null;
     const chanBlocks = chans.map((c, ci) => {
       const pvm = h('div', { class: 'plot', 'data-testid': 'pvm-plot', 'data-channel': c.output });
       const acf = h('div', { class: 'plot', 'data-testid': 'acf-plot', 'data-channel': c.output });
       const ac = c.one_step && c.one_step.autocorrelation;
       plotJobs.push(() => {
-        if (c.plot && c.plot.time_s && c.plot.time_s.length) predictionPlot(`pvm:${ri}:${ci}`, pvm, c.plot, { k: rep.k, unit: `${c.output} [${outUnit(c.output)}]`, sync, group });
+        if (c.plot && c.plot.time_s && c.plot.time_s.length) predictionPlot(`pvm:${ri}:${ci}`, pvm, c.plot, { k: rep.k, restart: rep.restart_s, unit: `${c.output} [${outUnit(c.output)}]`, sync, group });
         else fill(pvm, h('p', { class: 'empty' }, 'No plot series in the report.'));
         if (ac && ac.lags && ac.lags.length) autocorrelationPlot(`acf:${ri}:${ci}`, acf, ac);
         else fill(acf, h('p', { class: 'empty' }, 'No autocorrelation in the report.'));
@@ -194,7 +224,7 @@ export async function modelPage(view, id) {
           h('span', { class: 'verdict-line', 'data-testid': 'channel-verdict-line' }, c.verdict)),
         (c.findings || []).length ? h('ul', { class: 'findings', 'data-testid': 'channel-findings' }, c.findings.map((f) => h('li', null, f))) : null,
         h('div', { class: 'plot-grid pvm-grid' },
-          h('div', { class: 'plot-card' }, h('h3', null, 'Predicted vs measured ', h('span', { class: 'hint' }, `fit 1-step ${fitText(c.fit_one_step)} · ${rep.k}-step ${fitText(c.fit_k_step)} · simulation ${fitText(c.fit_simulation)}`)), pvm),
+          h('div', { class: 'plot-card' }, h('h3', null, 'Predicted vs measured ', h('span', { class: 'hint' }, `fit 1-step ${fitText(c.fit_one_step)} · ${rep.k}-step ${fitText(c.fit_k_step)} · restarted ${fitText(c.fit_restarted)} · simulation ${fitText(c.fit_simulation)}`)), pvm),
           h('div', { class: 'plot-card' }, h('h3', null, 'Residual autocorrelation ', h('span', { class: 'hint' },
             ac ? `1-step errors; ${ac.lags_outside.length} lag${ac.lags_outside.length === 1 ? '' : 's'} outside the ${Math.round(ac.confidence * 100)} % band (${fmt(ac.fraction_outside * 100, 1)} %, expected ${fmt(ac.expected_fraction * 100, 1)} %)${zc ? ` · ${zc.count} zero crossings (expected ${fmt(zc.expected, 0)})` : ''}` : '')), acf)));
     });
@@ -203,9 +233,12 @@ export async function modelPage(view, id) {
         h('span', { class: 'hint' }, ` · ${rep.n_samples} samples at ${exact(rep.sample_time_s)} s · k = ${rep.k} · drag to zoom (all channels follow), double-click to reset`)),
       h('div', { class: 'table-x' }, h('table', { class: 'grid-table compact fit-table', 'data-testid': 'fit-table' },
         h('thead', null, h('tr', null, h('th', null, 'Channel'), h('th', { class: 'num', title: 'NRMSE fit of ŷ(t|t−1): 100 % perfect, 0 % no better than the mean' }, '1-step fit'),
-          h('th', { class: 'num', title: `NRMSE fit of ŷ(t|t−${rep.k})` }, `${rep.k}-step fit`), h('th', { class: 'num', title: 'NRMSE fit of the free-run simulation' }, 'Simulation fit'),
+          h('th', { class: 'num', title: `NRMSE fit of ŷ(t|t−${rep.k})` }, `${rep.k}-step fit`),
+          h('th', { class: 'num', title: `NRMSE fit of free runs restarted from the measured state every ${restartText(rep)}, over the windows that did not diverge` }, `Restarted ${restartText(rep)} fit`),
+          h('th', { class: 'num', title: 'NRMSE fit of the free-run simulation over the whole run' }, 'Simulation fit'),
           h('th', null, 'Residuals'), h('th', null, 'Verdict'))),
         h('tbody', null, fitRows))),
+      divergenceNote,
       chanBlocks);
   });
 

@@ -1,14 +1,16 @@
 // uPlot charts of a model's validation: predicted versus measured output over
-// time (measured, 1-step, k-step, free-run simulation) and the residual
-// autocorrelation with its confidence band. The series come decimated from
-// the server. Plots of one validation run share the cursor and the zoom.
+// time (measured, 1-step, k-step, free runs restarted every 10 s, free-run
+// simulation) and the residual autocorrelation with its confidence band. A
+// prediction that diverged stops where it left the plausible range (null from
+// there on). The series come decimated from the server. Plots of one
+// validation run share the cursor and the zoom.
 // Live charts: window.__plots['pvm:<run>:<channel>'], ['acf:<run>:<channel>'].
 
 import uPlot from '/node_modules/uplot/dist/uPlot.esm.js';
 import { axisBase, autoSize, register, tick } from './plots.js';
 import { exact } from './runplots.js';
 
-const COLORS = { measured: '#1c2430', one: '#1f6fb5', k: '#e08a1e', sim: '#2e9e5b', bound: '#b3261e' };
+const COLORS = { measured: '#1c2430', one: '#1f6fb5', k: '#e08a1e', restarted: '#8e44ad', sim: '#2e9e5b', bound: '#b3261e' };
 
 const clean = (xs) => xs.map((v) => (v != null && Number.isFinite(v) ? v : null));
 
@@ -32,16 +34,18 @@ export function zoomGroup() {
 
 /**
  * Measured vs predicted for one channel.
- *   plot  {time_s, measured, one_step, k_step, simulated}
+ *   plot  {time_s, measured, one_step, k_step, restarted, simulated}
  *   k     the k-step horizon (legend)
+ *   restart  the restart period (s) of the restarted free runs (legend)
  *   sync  cursor sync key shared by the channels of one run
  */
-export function predictionPlot(name, host, plot, { k, unit = '', sync, group, height = 220 } = {}) {
+export function predictionPlot(name, host, plot, { k, restart, unit = '', sync, group, height = 220 } = {}) {
   const series = [
     { label: 't', value: (u, v) => (v == null ? '–' : `${exact(v)} s`) },
     { label: 'measured', stroke: COLORS.measured, width: 1.4 },
     { label: '1-step', stroke: COLORS.one, width: 1 },
     { label: `${k || 'k'}-step`, stroke: COLORS.k, width: 1, dash: [6, 3] },
+    { label: `restarted ${restart != null ? `${Number(restart.toFixed(1))} s` : ''}`.trim(), stroke: COLORS.restarted, width: 1, dash: [2, 2] },
     { label: 'simulated', stroke: COLORS.sim, width: 1.2 },
   ].map((s, i) => (i === 0 ? s : { ...s, points: { show: false }, spanGaps: false, value: (u, v) => exact(v) }));
   const opts = {
@@ -60,7 +64,8 @@ export function predictionPlot(name, host, plot, { k, unit = '', sync, group, he
     legend: { live: true },
     hooks: { setScale: group ? [group.hook] : [] },
   };
-  const data = [plot.time_s, clean(plot.measured), clean(plot.one_step), clean(plot.k_step), clean(plot.simulated)];
+  const none = plot.time_s.map(() => null);
+  const data = [plot.time_s, clean(plot.measured), clean(plot.one_step), clean(plot.k_step), clean(plot.restarted || none), clean(plot.simulated)];
   host.replaceChildren();
   const u = new uPlot(opts, data, host);
   if (group) group.add(u);

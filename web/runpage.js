@@ -1,6 +1,8 @@
-// Run page (#/runs/{id}): what was uploaded (files, SHA-256, raw bytes), how it
-// was read (rate, duration, gaps, warnings, clock alignment of two-file
-// runs), the verdict per DOF with its reason, and the quality report's plots:
+// Run page (#/runs/{id}): what was uploaded (files, SHA-256, raw bytes), what
+// the run is (role, grid speed, excited DOFs, signal: the supervisor's, the
+// plan's or inferred, editable), how it was read (rate, duration, gaps,
+// warnings, clock alignment of two-file runs), the verdict per DOF with its
+// reason, and the quality report's plots:
 // PSDs, coherence, H1 magnitude and phase, regressor singular values, plan
 // adherence.
 
@@ -11,6 +13,7 @@ import { PALETTE, psdUnit } from './plots.js';
 import { spectrumPlot, singularValuePlot, syncX, exact } from './runplots.js';
 import { verdictBadge, statusBadge, coverageBadge, errorWhere, errorText, rawLinks } from './runs.js';
 import { runOffsetPanel } from './offsetpanel.js';
+import { descriptionSection } from './rundescribe.js';
 
 const GOOD_COHERENCE = 0.8; // server: quality::verdict::GOOD_COHERENCE (the reasons quote it)
 
@@ -39,13 +42,18 @@ function evidenceLine(v) {
   return bits.join(' · ');
 }
 
-function verdictCards(verdicts) {
-  return h('div', { class: 'verdict-cards', 'data-testid': 'run-verdicts' }, verdicts.map((v) => h('div', {
-    class: `verdict-card ${v.verdict}`, 'data-testid': 'verdict', 'data-dof': v.dof, 'data-verdict': v.verdict,
-  },
-  h('div', { class: 'vc-head' }, verdictBadge(v, { text: `${v.dof}: ${v.verdict}` }), h('span', { class: 'mono muted' }, `${v.input} → ${v.output}`)),
-  h('p', { class: 'reason', 'data-testid': 'verdict-reason' }, v.reason),
-  h('p', { class: 'evidence hint' }, evidenceLine(v)))));
+/** Verdict cards; DOFs the run does not excite (by its description) are dimmed: nothing was asked of them. */
+function verdictCards(verdicts, excited) {
+  return h('div', { class: 'verdict-cards', 'data-testid': 'run-verdicts' }, verdicts.map((v) => {
+    const aside = excited && !excited.includes(v.dof);
+    return h('div', {
+      class: `verdict-card ${v.verdict}${aside ? ' not-excited' : ''}`, 'data-testid': 'verdict', 'data-dof': v.dof, 'data-verdict': v.verdict,
+    },
+    h('div', { class: 'vc-head' }, verdictBadge(v, { text: `${v.dof}: ${v.verdict}` }), h('span', { class: 'mono muted' }, `${v.input} → ${v.output}`)),
+    aside ? h('p', { class: 'hint', 'data-testid': 'verdict-aside' }, `${v.dof} is not among the DOFs this run excites: its verdict is no fault of the run`) : null,
+    h('p', { class: 'reason', 'data-testid': 'verdict-reason' }, v.reason),
+    h('p', { class: 'evidence hint' }, evidenceLine(v)));
+  }));
 }
 
 function gapsText(gaps) {
@@ -140,6 +148,7 @@ export async function runPage(view, rid) {
     run.experiment_id ? api.coverage(run.campaign_id).catch(() => null) : null,
   ]);
   const exp = coverage && run.experiment_id ? coverage.experiments.find((e) => e.experiment_id === run.experiment_id) : null;
+  const vessel = campaign ? await api.vessel(campaign.vessel_id).catch(() => null) : null;
   const s = run.summary || {};
   const qualityHost = h('section', { class: 'quality', 'data-testid': 'quality', 'aria-label': 'Quality report' });
   let destroyed = false;
@@ -164,7 +173,9 @@ export async function runPage(view, rid) {
       h('p', { class: 'hint' }, 'Fix the file and upload it again; the bytes above are kept as received.')) : null,
     run.status === 'stored' ? h('p', { class: 'empty' }, 'Stored, not processed yet.') : null,
 
-    s.verdicts && s.verdicts.length ? [h('h2', null, 'Verdict per DOF ', h('span', { class: 'hint' }, 'green good · amber weak · red insufficient — the reason says what to do')), verdictCards(s.verdicts)] : null,
+    descriptionSection(run, { vessel }),
+
+    s.verdicts && s.verdicts.length ? [h('h2', null, 'Verdict per DOF ', h('span', { class: 'hint' }, 'green good · amber weak · red insufficient — the reason says what to do')), verdictCards(s.verdicts, run.description && run.description.excited_dofs ? run.description.excited_dofs.value : null)] : null,
 
     h('div', { class: 'run-cols' },
       h('div', null,

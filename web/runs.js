@@ -8,6 +8,7 @@ import {
   COVERAGE_HELP, COVERAGE_LABEL, FAMILY_LABEL, VERDICT_ICON, bytes, fmt, fmtDate,
 } from './format.js';
 import { h, fill, banner, labelled, num, clearErrors, showFieldError } from './forms.js';
+import { describeCell } from './rundescribe.js';
 
 // ---- shared bits (the run page uses them too) ------------------------------
 
@@ -394,6 +395,7 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
         h('td', { class: 'nowrap' }, fmtDate(r.created_at)),
         h('td', null, h('a', { href: urls.run(r.id), 'data-testid': 'run-link' }, r.name)),
         h('td', { class: 'mono nowrap' }, r.experiment_id ? codes.get(r.experiment_id) || h('span', { class: 'muted', title: r.experiment_id }, 'older plan') : h('span', { class: 'muted' }, '–')),
+        h('td', { class: 'nowrap' }, describeCell(r)),
         h('td', null, r.layout === 'split' ? 'control + nav' : 'one log'),
         h('td', null, statusBadge(r.status)),
         h('td', { class: 'badges' }, r.status === 'rejected'
@@ -404,7 +406,8 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
     fill(listBox, h('h3', null, `Runs (${runs.length}) `, h('span', { class: 'hint' }, 'newest first · badge colours: green good, amber weak, red insufficient; hover for the reason')),
       h('div', { class: 'table-x' },
         h('table', { class: 'grid-table runs-table', 'data-testid': 'runs-table' },
-          h('thead', null, h('tr', null, h('th', null, 'Uploaded'), h('th', null, 'Name'), h('th', null, 'Experiment'), h('th', null, 'Layout'),
+          h('thead', null, h('tr', null, h('th', null, 'Uploaded'), h('th', null, 'Name'), h('th', null, 'Experiment'),
+            h('th', { title: 'role · grid speed · excited DOFs; “?”: inferred from the data, confirm on the run page' }, 'What it is'), h('th', null, 'Layout'),
             h('th', null, 'Status'), h('th', null, 'Verdict per DOF'), h('th', { class: 'num' }, 'Size'))),
           h('tbody', null, rows))));
   }

@@ -6,6 +6,7 @@
 //! and uploaded as a run, so identification can be started at once. Seeded
 //! only into an empty database.
 
+use seatrial_core::identification::UserDescription;
 use seatrial_core::planning::examples::{
     supply_vessel, supply_vessel_trial_campaign, surveyor_campaign, surveyor_rov,
 };
@@ -115,6 +116,10 @@ pub async fn upload_all(
     stored: &plans::StoredPlan,
     logs: Vec<(String, String)>,
 ) -> anyhow::Result<()> {
+    let grid = campaigns::get(db, campaign_id)
+        .await?
+        .map(|c| c.grid_speeds_mps)
+        .unwrap_or_default();
     for (code, csv) in logs {
         let Some(eid) = stored
             .experiments
@@ -139,10 +144,11 @@ pub async fn upload_all(
                 filename: format!("{code}.csv"),
                 blob,
             }],
+            &UserDescription::default(),
         )
         .await?;
         let planned = plans::experiment(db, campaign_id, &eid).await?;
-        let prof = profile.clone();
+        let (prof, grid) = (profile.clone(), grid.clone());
         let done = tokio::task::spawn_blocking(move || {
             processing::process_run(
                 &prof,
@@ -150,24 +156,19 @@ pub async fn upload_all(
                 &RunMeta::default(),
                 &Default::default(),
                 planned.as_ref(),
+                &grid,
             )
         })
         .await?;
         match done {
-            Ok(d) => {
-                runs::finish(
-                    db,
-                    &r.id,
-                    "accepted",
-                    None,
-                    Some(&d.summary),
-                    Some(&d.quality_json),
-                )
-                .await?
-            }
+            Ok(d) => runs::finish(db, &r.id, "accepted", d.outcome()).await?,
             Err(e) => {
                 let detail = serde_json::to_value(&e)?;
-                runs::finish(db, &r.id, "rejected", Some(&detail), None, None).await?
+                let out = runs::Outcome {
+                    error: Some(&detail),
+                    ..runs::Outcome::default()
+                };
+                runs::finish(db, &r.id, "rejected", out).await?
             }
         }
     }

@@ -12,6 +12,7 @@ use std::collections::BTreeMap;
 use seatrial_core::alignment::{
     AlignmentReport, OffsetOptions, OffsetPriors, align_logs_with, check_user_offset,
 };
+use seatrial_core::identification::{InferredDescription, RunRole, RunSignal, infer_description};
 use seatrial_core::logs::Gap;
 use seatrial_core::logs::{
     LogRole, ParseOptions, ParsedLog, input_columns, output_columns, parse_log, to_uniform,
@@ -44,6 +45,18 @@ pub struct RunMeta {
     /// It overrides the offset estimated from the shared channel; change or
     /// clear it later with `PUT /api/runs/{id}/clock-offset`.
     pub clock_offset_s: Option<f64>,
+    /// What the run is for (default: the planned experiment's family, else inferred).
+    pub role: Option<RunRole>,
+    /// The grid speed it was flown at, m/s (or give `grid_speed_kn`; default: planned, else inferred).
+    pub grid_speed_mps: Option<f64>,
+    /// The grid speed it was flown at, kn (stored in m/s).
+    pub grid_speed_kn: Option<f64>,
+    /// The DOFs it excites, modelled by the vessel (default: planned, else inferred).
+    pub excited_dofs: Option<Vec<Dof>>,
+    /// Its excitation signal (default: planned, else inferred).
+    pub signal: Option<RunSignal>,
+    /// Free notes (at most 2000 characters).
+    pub notes: Option<String>,
 }
 
 impl RunMeta {
@@ -66,7 +79,7 @@ impl RunMeta {
 /// A warning about a run, with the file (or step) it concerns.
 #[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
 pub struct RunWarning {
-    /// `file`, `control`, `nav`, `alignment` or `quality`.
+    /// `file`, `control`, `nav`, `alignment`, `quality` or `description`.
     pub file: String,
     /// The column it concerns.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -145,6 +158,20 @@ pub struct Processed {
     pub summary: Value,
     /// The quality report, serialized once.
     pub quality_json: String,
+    /// What the data say the run is (none when too short to tell).
+    pub inferred: Option<InferredDescription>,
+}
+
+impl Processed {
+    /// What to record for an accepted run.
+    pub fn outcome(&self) -> crate::storage::runs::Outcome<'_> {
+        crate::storage::runs::Outcome {
+            error: None,
+            summary: Some(&self.summary),
+            quality_json: Some(&self.quality_json),
+            inferred: self.inferred.as_ref(),
+        }
+    }
 }
 
 /// Largest number of rows accepted per file.
@@ -335,16 +362,27 @@ pub fn load_record(
 }
 
 /// Parses, aligns (with `priors`, see [`load_record`]), resamples and
-/// scores a run.
+/// scores a run, and infers what it is from its data (role, grid speed on
+/// the campaign's `grid`, excited DOFs, signal).
 pub fn process_run(
     vessel: &VesselProfile,
     files: &[(String, PathBuf)],
     meta: &RunMeta,
     priors: &OffsetPriors,
     planned: Option<&(StoredExperiment, Schedule)>,
+    grid: &[f64],
 ) -> Result<Processed, ProcessError> {
     let mut summary = RunSummary::default();
     let rec = load_record(vessel, files, meta, priors, &mut summary)?;
+    let inferred = infer_description(&rec, vessel, &generalized_force_columns(vessel), grid)
+        .map_err(|e| {
+            summary.warnings.push(RunWarning {
+                file: "description".into(),
+                column: None,
+                message: format!("nothing inferred about what the run is: {e}"),
+            })
+        })
+        .ok();
     let dofs: Vec<DofChannels> = vessel
         .dofs
         .iter()
@@ -404,6 +442,7 @@ pub fn process_run(
     Ok(Processed {
         summary,
         quality_json,
+        inferred,
     })
 }
 

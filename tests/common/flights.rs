@@ -37,42 +37,16 @@ pub fn diagonal_truth() -> RovTruth {
 /// validation experiments, flies every planned experiment (≤ 240 s each)
 /// through `truth`, and uploads the logs linked to their experiments.
 pub async fn flown_campaign(app: &TestApp, truth: &RovTruth) -> String {
-    let r = app
-        .call("POST", "/api/vessels", &[], Some(rov_profile()))
-        .await;
-    let vid = r.json["id"].as_str().unwrap().to_string();
     let spec = json!({
-        "vessel_id": vid,
         "name": "identification trial",
         "grid": { "unit": "kn", "speeds": [1.0, 2.0] },
         "families": ["recursive", "validation"],
         "repetitions": 2,
         "seed": 11
     });
-    let r = app
-        .call("POST", "/api/campaigns", &[], Some(spec.clone()))
-        .await;
-    assert_eq!(r.status, 201, "{}", r.text);
-    let cid = r.json["id"].as_str().unwrap().to_string();
-    let plan = app
-        .call("POST", "/api/campaigns/{id}/plan", &[&cid], None)
-        .await;
-    assert_eq!(plan.status, 201, "{}", plan.text);
-    // The same plan, generated in-process to fly it (plans are deterministic).
-    let profile = seatrial_core::planning::examples::surveyor_rov();
-    let mut core_spec = spec.clone();
-    core_spec.as_object_mut().unwrap().remove("vessel_id");
-    let core_spec: CampaignSpec = serde_json::from_value(core_spec).unwrap();
-    let core_plan = generate_plan(&profile, &core_spec).unwrap();
-    let settings = TrialSettings {
-        max_duration_s: Some(240.0),
-        seed: 3,
-        ..TrialSettings::default()
-    };
-    for planned in &core_plan.experiments {
-        let code = &planned.experiment.code;
-        let flown = fly_experiment(&profile, truth, planned, &settings).unwrap();
-        upload_planned(app, &cid, &plan.json, code, &flown.csv).await;
+    let (cid, plan, logs) = flown_logs(app, spec, truth, |_| true).await;
+    for (code, csv) in &logs {
+        upload_planned(app, &cid, &plan, code, csv).await;
     }
     cid
 }
@@ -98,4 +72,53 @@ pub async fn upload_planned(app: &TestApp, cid: &str, plan: &Value, code: &str, 
         )
         .await;
     assert_eq!(r.status, 201, "{code}: {}", r.text);
+}
+
+/// Creates the Surveyor and a campaign from `spec` (no `vessel_id`), plans
+/// it, and flies the planned experiments whose codes `keep` accepts
+/// (≤ 240 s each) through `truth`. Returns the campaign id, the stored plan
+/// and the `(code, csv)` logs, not uploaded.
+pub async fn flown_logs(
+    app: &TestApp,
+    spec: Value,
+    truth: &RovTruth,
+    keep: impl Fn(&str) -> bool,
+) -> (String, Value, Vec<(String, String)>) {
+    let (cid, plan) = planned_campaign(app, rov_profile(), spec.clone()).await;
+    let profile = seatrial_core::planning::examples::surveyor_rov();
+    let core_spec: CampaignSpec = serde_json::from_value(spec).unwrap();
+    let core_plan = generate_plan(&profile, &core_spec).unwrap();
+    let settings = TrialSettings {
+        max_duration_s: Some(240.0),
+        seed: 3,
+        ..TrialSettings::default()
+    };
+    let logs = core_plan
+        .experiments
+        .iter()
+        .filter(|p| keep(&p.experiment.code))
+        .map(|p| {
+            let flown = fly_experiment(&profile, truth, p, &settings).unwrap();
+            (p.experiment.code.clone(), flown.csv)
+        })
+        .collect();
+    (cid, plan, logs)
+}
+
+/// Creates a vessel of `profile` and a campaign of `spec` (without
+/// `vessel_id`) for it, and generates its plan. Returns the campaign id and
+/// the stored plan.
+pub async fn planned_campaign(app: &TestApp, profile: Value, spec: Value) -> (String, Value) {
+    let r = app.call("POST", "/api/vessels", &[], Some(profile)).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let mut body = spec;
+    body["vessel_id"] = json!(r.json["id"]);
+    let r = app.call("POST", "/api/campaigns", &[], Some(body)).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let cid = r.json["id"].as_str().unwrap().to_string();
+    let plan = app
+        .call("POST", "/api/campaigns/{id}/plan", &[&cid], None)
+        .await;
+    assert_eq!(plan.status, 201, "{}", plan.text);
+    (cid, plan.json)
 }

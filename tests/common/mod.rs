@@ -4,6 +4,7 @@
 
 #![allow(dead_code)]
 
+pub mod finite;
 pub mod flights;
 pub mod jobs;
 pub mod sim;
@@ -235,6 +236,26 @@ pub fn rov_profile() -> Value {
 /// Fossen's supply vessel profile as JSON.
 pub fn dp_profile() -> Value {
     serde_json::to_value(seatrial_core::planning::examples::supply_vessel()).unwrap()
+}
+
+/// Submits the job `body` and waits for it (at most two minutes); it must
+/// succeed. Its JSON.
+pub async fn run_job(app: &TestApp, body: Value) -> Value {
+    let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    let job = wait_for_job(app, r.json["id"].as_str().unwrap(), 120).await;
+    assert_eq!(job["state"], "succeeded", "{job}");
+    job
+}
+
+/// Identifies campaign `cid` by `method`; the stored model's id.
+pub async fn identified(app: &TestApp, cid: &str, method: &str) -> String {
+    let job = run_job(
+        app,
+        json!({ "kind": "identify", "campaign_id": cid, "method": method }),
+    )
+    .await;
+    job["result"]["model_id"].as_str().unwrap().to_string()
 }
 
 /// Polls `GET /api/jobs/{id}` until the job ends (at most `seconds`); its JSON.

@@ -120,8 +120,9 @@ test('identify from the campaign page, follow the job, read the model page', asy
     assert.ok(nParams >= 12, `${nParams} parameter rows`);
     const stds = await page.locator(tid('param-std')).allTextContents();
     assert.ok(stds.some((s) => /^± \S+/.test(s)), `± std shown: ${stds.slice(0, 5)}`);
-    // Grouped by grid speed (two grid points), and sortable.
-    assert.equal(await page.locator(tid('param-group-head')).count(), 2);
+    // Grouped by grid speed (two grid points, and the campaign-wide g(η)),
+    // and sortable.
+    assert.equal(await page.locator(tid('param-group-head')).count(), 3);
     await page.getByRole('button', { name: /^Value/ }).click();
     await page.getByLabel('group by grid speed').uncheck();
     const values = await page.locator(`${tid('param-row')} td:nth-child(4)`).evaluateAll((tds) => tds.map((t) => Number(t.title)));
@@ -130,8 +131,13 @@ test('identify from the campaign page, follow the job, read the model page', asy
     // Validation: fits as numbers, plots drawn.
     const fitTable = page.locator(tid('fit-table'));
     assert.ok(await fitTable.locator(tid('fit-row')).count() >= 6);
-    const fits = await fitTable.locator(`${tid('fit-one-step')}, ${tid('fit-k-step')}, ${tid('fit-simulation')}`).allTextContents();
+    const fits = await fitTable.locator(`${tid('fit-one-step')}, ${tid('fit-k-step')}, ${tid('fit-restarted')}, ${tid('fit-simulation')}`).allTextContents();
     assert.ok(fits.some((f) => /^−?\d+(\.\d)? %$/.test(f)), `fits: ${fits}`);
+    // One format: a percentage with one decimal, or "—" where there is no fit.
+    assert.ok(fits.every((f) => /^(−?\d+\.\d %|< −1000 %|—)$/.test(f)), `fits: ${fits}`);
+    const restarted = await fitTable.locator(tid('fit-restarted')).allTextContents();
+    assert.ok(restarted.length >= 6 && restarted.every((f) => /^(−?\d+\.\d %|< −1000 %)$/.test(f)), `restarted fits: ${restarted}`);
+    assert.match(await fitTable.locator('thead').textContent(), /Restarted 10 s fit/);
     const pvm = page.locator(`${tid('pvm-plot')}[data-channel="u"] canvas`);
     const acf = page.locator(`${tid('acf-plot')}[data-channel="u"] canvas`);
     await pvm.waitFor();
@@ -141,7 +147,7 @@ test('identify from the campaign page, follow the job, read the model page', asy
       const n = await inked(c);
       assert.ok(n > 1000, `plot looks blank (${n} painted pixels)`);
     }
-    assert.match(await page.textContent(`${tid('pvm-plot')}[data-channel="u"] .u-legend`), /measured.*1-step.*-step.*simulated/s);
+    assert.match(await page.textContent(`${tid('pvm-plot')}[data-channel="u"] .u-legend`), /measured.*1-step.*-step.*restarted 10 s.*simulated/s);
     assert.match(await page.textContent(`${tid('acf-plot')}[data-channel="u"] .u-legend`), /r\(lag\).*bound/s);
     // Zooming one channel zooms the others of the run.
     const xr = (k) => page.evaluate((key) => [window.__plots[key].scales.x.min, window.__plots[key].scales.x.max], k);

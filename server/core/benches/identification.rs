@@ -102,7 +102,7 @@ fn campaign() -> Vec<(f64, Vec<Experiment>)> {
                             nu[(k, j)] += sigma[j] * rng.normal();
                         }
                     }
-                    Experiment { h: H, nu, gamma }
+                    Experiment::new(H, nu, gamma)
                 })
                 .collect();
             (speed, runs)

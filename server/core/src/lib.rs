@@ -17,7 +17,8 @@
 //!   estimators are proven against.
 //! - [`estimation`]: restoring forces, λ-filter Kalman identification,
 //!   parallel state-augmented EKF, N4SID.
-//! - [`validation`]: prediction and simulation NRMSE, residual tests.
+//! - [`validation`]: prediction and simulation NRMSE, divergence, residual tests.
+//! - [`numbers`]: numbers in sentences (three significant digits, units).
 //! - [`discrepancy`]: missing-physics discovery — locate where a model and
 //!   the recordings part, name the left-out physics, model it.
 
@@ -27,6 +28,7 @@ pub mod estimation;
 pub mod identification;
 pub mod logs;
 pub mod models;
+pub mod numbers;
 pub mod planning;
 pub mod quality;
 pub mod rng;

@@ -297,8 +297,16 @@ pub async fn put_run_clock_offset(
         .iter()
         .map(|f| (f.role.clone(), s.blobs.path(&f.sha256)))
         .collect();
+    let grid = campaign.grid_speeds_mps.clone();
     let outcome = blocking(move || {
-        processing::process_run(&vessel.profile, &files, &meta, &priors, planned.as_ref())
+        processing::process_run(
+            &vessel.profile,
+            &files,
+            &meta,
+            &priors,
+            planned.as_ref(),
+            &grid,
+        )
     })
     .await?;
     let done = outcome.map_err(|e| {
@@ -309,14 +317,6 @@ pub async fn put_run_clock_offset(
         ApiError::invalid(field, e.message)
     })?;
     clock_offsets::set_run_offset(&s.db, &run.id, offset).await?;
-    runs::finish(
-        &s.db,
-        &run.id,
-        "accepted",
-        None,
-        Some(&done.summary),
-        Some(&done.quality_json),
-    )
-    .await?;
+    runs::finish(&s.db, &run.id, "accepted", done.outcome()).await?;
     Ok(Json(found(runs::get(&s.db, &id).await?, "run", &id)?))
 }

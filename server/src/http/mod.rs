@@ -13,6 +13,7 @@ pub mod json;
 pub mod models;
 pub mod plans;
 pub mod query;
+pub mod run_description;
 pub mod runs;
 pub mod vessels;
 
@@ -114,7 +115,7 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(plans::schedule_csv))
         .routes(routes!(plans::run_sheet))
         .routes(routes!(runs::list_runs))
-        .routes(routes!(runs::get_run))
+        .routes(routes!(runs::get_run, run_description::describe_run))
         .routes(routes!(runs::raw_run))
         .routes(routes!(runs::run_quality))
         .routes(routes!(runs::coverage))

@@ -14,11 +14,12 @@ use super::query::ApiQuery;
 use super::{AppState, blocking, found};
 use crate::clock::CampaignClocks;
 use crate::error::{ApiError, ApiResult, ErrorBody};
-use crate::processing::{self, RunMeta, RunSummary};
+use crate::jobs::run_inputs::StoredRun;
+use crate::processing::{self, RunSummary};
 use crate::storage::models::{self, ModelSummary, StoredModel};
 use crate::storage::{campaigns, runs, vessels};
-use seatrial_core::identification::RunInput;
-use seatrial_core::identification::predictor::validate_on_run;
+use seatrial_core::identification::predictor::validate_on_run_with;
+use seatrial_core::validation::ValidationSettings;
 
 /// Filters of the model list.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
@@ -201,6 +202,8 @@ pub struct CompareQuery {
     pub run_id: String,
     /// Horizon of the k-step predictions (default 10).
     pub k: Option<usize>,
+    /// Period of the restarted free runs in seconds (default 10).
+    pub restart_s: Option<f64>,
 }
 
 /// One model's validation in a comparison.
@@ -227,13 +230,13 @@ pub struct Comparison {
     pub models: Vec<ComparedModel>,
 }
 
-/// Validate two models on the same run, side by side (1-step, k-step and
-/// simulation fits; residual tests).
+/// Validate two models on the same run, side by side (1-step, k-step,
+/// restarted free-run and simulation fits, divergences; residual tests).
 #[utoipa::path(get, path = "/api/models/compare", tag = "models", params(CompareQuery),
     responses((status = 200, description = "Both validations", body = Comparison),
               (status = 400, description = "Missing or malformed query parameter", body = ErrorBody),
               (status = 404, description = "No such model or run", body = ErrorBody),
-              (status = 422, description = "The run cannot validate a model (vessel, columns, kind)", body = ErrorBody)))]
+              (status = 422, description = "The run cannot validate a model (vessel, columns, kind), or `restart_s` is not a positive number of seconds", body = ErrorBody)))]
 pub async fn compare_models(
     State(s): State<AppState>,
     ApiQuery(q): ApiQuery<CompareQuery>,
@@ -272,38 +275,42 @@ pub async fn compare_models(
         "vessel",
         &campaign.vessel_id,
     )?;
-    let meta = RunMeta::of_stored(run.summary.as_ref());
-    let priors = CampaignClocks::load(&s.db, &run.campaign_id)
-        .await?
-        .priors_for(Some(&run.id));
-    let files: Vec<_> = run
-        .files
-        .iter()
-        .map(|f| (f.role.clone(), s.blobs.path(&f.sha256)))
-        .collect();
+    let clocks = CampaignClocks::load(&s.db, &run.campaign_id).await?;
+    let stored_run = StoredRun::of(&s.job_context(), run.clone(), &clocks);
     let k = q.k.unwrap_or(10).max(1);
+    let restart_s = q.restart_s.unwrap_or(10.0);
+    if !(restart_s.is_finite() && restart_s > 0.0) {
+        return Err(ApiError::invalid(
+            "restart_s",
+            format!("the restart period must be a positive number of seconds, got {restart_s}"),
+        ));
+    }
     let docs: Vec<ModelDocument> = stored
         .iter()
         .map(|m| view(m.clone()).map(|v| v.document))
         .collect::<Result<_, _>>()?;
     let profile = vessel.profile.clone();
-    let (run_id, run_name) = (run.id.clone(), run.name.clone());
     let reports = blocking(move || -> Result<Vec<serde_json::Value>, ApiError> {
         let mut summary = RunSummary::default();
-        let record = processing::load_record(&profile, &files, &meta, &priors, &mut summary)
-            .map_err(|e| ApiError::invalid("run_id", e.message))?;
-        let input = RunInput {
-            run_id: run_id.clone(),
-            name: run_name.clone(),
-            family: None,
-            grid_speed_mps: None,
-            record,
-        };
+        let record = processing::load_record(
+            &profile,
+            &stored_run.files,
+            &stored_run.meta,
+            &stored_run.priors,
+            &mut summary,
+        )
+        .map_err(|e| ApiError::invalid("run_id", e.message))?;
+        let input = stored_run.input(record);
         let forces = processing::generalized_force_columns(&profile);
         docs.iter()
             .zip(["a", "b"])
             .map(|(doc, field)| {
-                let rep = validate_on_run(doc, &input, &forces, k)
+                let settings = ValidationSettings {
+                    k,
+                    restart_s,
+                    ..ValidationSettings::default()
+                };
+                let rep = validate_on_run_with(doc, &input, &forces, settings)
                     .map_err(|e| ApiError::invalid(field, e.to_string()))?;
                 serde_json::to_value(&rep).map_err(|e| ApiError::Internal(e.into()))
             })

@@ -10,6 +10,7 @@ use axum::response::{IntoResponse, Response};
 use serde::Deserialize;
 
 use super::json::parse_json;
+use super::run_description::{DescriptionChange, from_value};
 use super::{AppState, blocking, found};
 use seatrial_core::alignment::{OffsetPriors, check_user_offset};
 
@@ -17,14 +18,17 @@ use crate::clock::CampaignClocks;
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::processing::{self, Coverage, RunMeta};
 use crate::storage::blobs::BlobWriter;
-use crate::storage::runs::{self, NewFile, Run};
+use crate::storage::runs::{self, NewFile, Outcome, Run};
 use crate::storage::{campaigns, clock_offsets, plans, vessels};
 
 /// The multipart form of an upload (documentation of the parts).
 #[derive(Debug, utoipa::ToSchema)]
 #[allow(dead_code)]
 pub struct UploadForm {
-    /// JSON metadata: `{"experiment_id"?, "name"?, "shared_channel"? (default "z"), "rate_hz"?, "clock_offset_s"? (two-file runs: the offset set by hand, s)}`.
+    /// JSON metadata: `{"experiment_id"?, "name"?, "shared_channel"? (default "z"), "rate_hz"?,
+    /// "clock_offset_s"? (two-file runs: the offset set by hand, s), "role"?, "grid_speed_mps"?
+    /// or "grid_speed_kn"?, "excited_dofs"?, "signal"?, "notes"?}`; what is not said about the
+    /// run comes from its planned experiment, else from its data.
     meta: Option<RunMeta>,
     /// A single log with every column the vessel needs.
     #[schema(value_type = Option<String>, format = Binary)]
@@ -79,7 +83,10 @@ async fn stream_field(
 /// and either one `file` part or `control` + `nav` parts. Files are streamed
 /// to disk and stored verbatim with their SHA-256 before they are parsed; a
 /// run that fails validation stays stored (status `rejected`) and the 422
-/// names its file, line and column.
+/// names its file, line and column. What the run is (role, grid speed,
+/// excited DOFs, signal) is taken from `meta`, else from the planned
+/// experiment, else inferred from the data; a `meta` field the service does
+/// not accept is a 422 naming it (`meta.role`, …) and nothing is recorded.
 #[utoipa::path(post, path = "/api/campaigns/{id}/runs", tag = "runs",
     params(("id" = String, Path, description = "Campaign id")),
     request_body(content = UploadForm, content_type = "multipart/form-data"),
@@ -89,7 +96,7 @@ async fn stream_field(
         (status = 404, description = "No such campaign or experiment", body = ErrorBody),
         (status = 413, description = "Over the upload limit", body = ErrorBody),
         (status = 415, description = "Not multipart/form-data", body = ErrorBody),
-        (status = 422, description = "Stored but invalid: `field` is the file, with `line` and `column`; `run_id` names the stored run", body = ErrorBody)))]
+        (status = 422, description = "Stored but invalid: `field` is the file, with `line` and `column`; `run_id` names the stored run. Or a `meta` field not accepted (`field` = `meta.…`, no run recorded)", body = ErrorBody)))]
 pub async fn upload_run(
     State(s): State<AppState>,
     Path(id): Path<String>,
@@ -97,6 +104,11 @@ pub async fn upload_run(
     multipart: Result<Multipart, MultipartRejection>,
 ) -> ApiResult<(StatusCode, Json<Run>)> {
     let campaign = found(campaigns::get(&s.db, &id).await?, "campaign", &id)?;
+    let vessel = found(
+        vessels::get(&s.db, &campaign.vessel_id).await?,
+        "vessel",
+        &campaign.vessel_id,
+    )?;
     if let Some(len) = headers
         .get(header::CONTENT_LENGTH)
         .and_then(|v| v.to_str().ok())
@@ -111,6 +123,7 @@ pub async fn upload_run(
         ))
     })?;
     let mut meta = RunMeta::default();
+    let mut user = Default::default();
     let mut files: Vec<NewFile> = Vec::new();
     let mut total = 0u64;
     loop {
@@ -131,13 +144,21 @@ pub async fn upload_run(
             if bytes.len() > MAX_META_BYTES {
                 return Err(ApiError::bad_field("meta", "metadata is limited to 64 KB"));
             }
-            meta = parse_json(&bytes).map_err(|e| match e {
+            let v: serde_json::Value = parse_json(&bytes).map_err(|e| match e {
                 ApiError::BadRequest { message, field } => ApiError::BadRequest {
                     message,
                     field: Some(field.map_or("meta".into(), |f| format!("meta.{f}"))),
                 },
                 other => other,
             })?;
+            meta = from_value(v, "meta.")?;
+            // Checked at once: a `meta` sent before the files refuses the
+            // upload before any byte is stored.
+            DescriptionChange::of_meta(&meta).apply(&mut user, &vessel.profile, "meta.")?;
+            if let Some(v) = meta.clock_offset_s {
+                check_user_offset("meta.clock_offset_s", v)
+                    .map_err(|e| ApiError::invalid("meta.clock_offset_s", e.message()))?;
+            }
             continue;
         }
         if !FILE_ROLES.contains(&name.as_str()) {
@@ -196,15 +217,11 @@ pub async fn upload_run(
             ));
         }
     };
-    if let Some(v) = meta.clock_offset_s {
-        if layout == "single" {
-            return Err(ApiError::invalid(
-                "meta.clock_offset_s",
-                "a single-file run has one clock: a clock offset applies to two-file runs (control + nav)",
-            ));
-        }
-        check_user_offset("meta.clock_offset_s", v)
-            .map_err(|e| ApiError::invalid("meta.clock_offset_s", e.message()))?;
+    if meta.clock_offset_s.is_some() && layout == "single" {
+        return Err(ApiError::invalid(
+            "meta.clock_offset_s",
+            "a single-file run has one clock: a clock offset applies to two-file runs (control + nav)",
+        ));
     }
     let planned = match &meta.experiment_id {
         Some(eid) => Some(
@@ -230,14 +247,10 @@ pub async fn upload_run(
         &name,
         layout,
         &files,
+        &user,
     )
     .await?;
 
-    let vessel = found(
-        vessels::get(&s.db, &campaign.vessel_id).await?,
-        "vessel",
-        &campaign.vessel_id,
-    )?;
     let inputs: Vec<(String, std::path::PathBuf)> = files
         .iter()
         .map(|f| (f.role.clone(), s.blobs.path(&f.blob.sha256)))
@@ -249,8 +262,16 @@ pub async fn upload_run(
             .priors_for(None)
     };
     let user_offset = meta.clock_offset_s;
+    let grid = campaign.grid_speeds_mps.clone();
     let outcome = blocking(move || {
-        processing::process_run(&vessel.profile, &inputs, &meta, &priors, planned.as_ref())
+        processing::process_run(
+            &vessel.profile,
+            &inputs,
+            &meta,
+            &priors,
+            planned.as_ref(),
+            &grid,
+        )
     })
     .await?;
     match outcome {
@@ -258,21 +279,17 @@ pub async fn upload_run(
             if user_offset.is_some() {
                 clock_offsets::set_run_offset(&s.db, &run.id, user_offset).await?;
             }
-            runs::finish(
-                &s.db,
-                &run.id,
-                "accepted",
-                None,
-                Some(&done.summary),
-                Some(&done.quality_json),
-            )
-            .await?;
+            runs::finish(&s.db, &run.id, "accepted", done.outcome()).await?;
             let run = found(runs::get(&s.db, &run.id).await?, "run", &run.id)?;
             Ok((StatusCode::CREATED, Json(run)))
         }
         Err(e) => {
             let detail = serde_json::to_value(&e).map_err(anyhow::Error::from)?;
-            runs::finish(&s.db, &run.id, "rejected", Some(&detail), None, None).await?;
+            let out = Outcome {
+                error: Some(&detail),
+                ..Outcome::default()
+            };
+            runs::finish(&s.db, &run.id, "rejected", out).await?;
             Err(ApiError::InvalidUpload {
                 message: e.message,
                 field: e.file,
@@ -297,7 +314,9 @@ pub async fn list_runs(
     Ok(Json(runs::list(&s.db, &id).await?))
 }
 
-/// One run: files, status, summary (rates, gaps, warnings, alignment, verdicts).
+/// One run: files, status, summary (rates, gaps, warnings, alignment,
+/// verdicts) and what it is (role, grid speed, excited DOFs, signal, notes,
+/// each with its source: `user`, `plan` or `inferred` with the reason).
 #[utoipa::path(get, path = "/api/runs/{id}", tag = "runs",
     params(("id" = String, Path, description = "Run id")),
     responses((status = 200, description = "The run", body = Run),

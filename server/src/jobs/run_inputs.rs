@@ -1,22 +1,24 @@
 //! Runs as jobs read them: the stored rows (async, in `load`) become owned
 //! descriptions, and those become the core's [`RunInput`]s on the worker
-//! thread, where parsing the logs belongs. Two-file runs are merged with the
-//! campaign's clock offsets as they are when the job runs (hand-set, own,
-//! pooled from every accepted two-file run of the campaign; see
-//! [`crate::clock`]), and the job reports which offset each run used.
+//! thread, where parsing the logs belongs. What a run is (its family, grid
+//! speed, excited DOFs) is its effective description: the supervisor's
+//! word, else the matched planned experiment, else what was inferred from
+//! its data on upload. Two-file runs are merged with the campaign's clock
+//! offsets as they are when the job runs (hand-set, own, pooled from every
+//! accepted two-file run of the campaign; see [`crate::clock`]), and the
+//! job reports which offset each run used.
 
 use std::path::PathBuf;
 
 use seatrial_core::alignment::{OffsetPriors, OffsetSource, offset_words};
 use seatrial_core::identification::RunInput;
-use seatrial_core::planning::VesselProfile;
 use seatrial_core::planning::campaign::ExperimentFamily;
+use seatrial_core::planning::{Dof, VesselProfile};
 use serde::Serialize;
 
 use super::handler::{JobContext, JobFailure};
 use crate::clock::CampaignClocks;
 use crate::processing::{self, RunMeta, RunSummary};
-use crate::storage::plans;
 use crate::storage::runs::Run;
 
 /// A run as stored, ready to be re-read on the worker.
@@ -29,10 +31,12 @@ pub struct StoredRun {
     pub files: Vec<(String, PathBuf)>,
     /// How it was uploaded (rate, shared channel).
     pub meta: RunMeta,
-    /// The planned experiment's family.
+    /// The family it counts as (from its role).
     pub family: Option<ExperimentFamily>,
-    /// The planned experiment's grid speed (m/s).
+    /// Its grid speed (m/s).
     pub grid_speed_mps: Option<f64>,
+    /// The DOFs it excites.
+    pub excited_dofs: Vec<Dof>,
     /// Clock offsets known apart from its own estimate (two-file runs).
     pub priors: OffsetPriors,
 }
@@ -72,36 +76,56 @@ impl RunClock {
     }
 }
 
-/// Describes `runs` of campaign `campaign_id` with what their plan says.
-pub async fn describe(
-    cx: &JobContext,
-    campaign_id: &str,
-    runs: Vec<Run>,
-) -> Result<Vec<StoredRun>, JobFailure> {
-    let clocks = CampaignClocks::load(&cx.db, campaign_id).await?;
-    let mut stored = Vec::new();
-    for r in runs {
-        let planned = match &r.experiment_id {
-            Some(eid) => plans::experiment(&cx.db, campaign_id, eid)
-                .await?
-                .map(|(e, _)| e.experiment),
-            None => None,
-        };
-        stored.push(StoredRun {
+impl StoredRun {
+    /// What `run`'s description says it is, with its files under `cx`'s
+    /// blobs and its campaign's `clocks` as priors.
+    pub fn of(cx: &JobContext, r: Run, clocks: &CampaignClocks) -> StoredRun {
+        let d = &r.description;
+        StoredRun {
             meta: RunMeta::of_stored(r.summary.as_ref()),
             files: r
                 .files
                 .iter()
                 .map(|f| (f.role.clone(), cx.blobs.path(&f.sha256)))
                 .collect(),
-            family: planned.as_ref().map(|e| e.family),
-            grid_speed_mps: planned.as_ref().and_then(|e| e.grid_speed_mps),
+            family: d.family,
+            grid_speed_mps: d.grid_speed_mps.as_ref().map(|g| g.value),
+            excited_dofs: d
+                .excited_dofs
+                .as_ref()
+                .map(|x| x.value.clone())
+                .unwrap_or_default(),
             priors: clocks.priors_for(Some(&r.id)),
             id: r.id,
             name: r.name,
-        });
+        }
     }
-    Ok(stored)
+
+    /// The core's run input over `record`.
+    pub fn input(&self, record: seatrial_core::timeseries::UniformRecord) -> RunInput {
+        RunInput {
+            run_id: self.id.clone(),
+            name: self.name.clone(),
+            family: self.family,
+            grid_speed_mps: self.grid_speed_mps,
+            excited_dofs: self.excited_dofs.clone(),
+            record,
+        }
+    }
+}
+
+/// Describes `runs` of campaign `campaign_id` by their effective
+/// descriptions, with the campaign's clock offsets as they are now.
+pub async fn describe(
+    cx: &JobContext,
+    campaign_id: &str,
+    runs: Vec<Run>,
+) -> Result<Vec<StoredRun>, JobFailure> {
+    let clocks = CampaignClocks::load(&cx.db, campaign_id).await?;
+    Ok(runs
+        .into_iter()
+        .map(|r| StoredRun::of(cx, r, &clocks))
+        .collect())
 }
 
 /// Reads and resamples the logs (on the worker thread); an unreadable run
@@ -127,13 +151,7 @@ pub fn read(
                 own_offset_s: a.offset.map(|o| o.offset_s),
             });
         }
-        inputs.push(RunInput {
-            run_id: s.id.clone(),
-            name: s.name.clone(),
-            family: s.family,
-            grid_speed_mps: s.grid_speed_mps,
-            record,
-        });
+        inputs.push(s.input(record));
     }
     Ok((inputs, clocks))
 }

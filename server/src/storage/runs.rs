@@ -1,6 +1,12 @@
 //! Runs: uploaded logs of one experiment (one file, or control + nav), their
-//! processing outcome and quality report.
+//! processing outcome and quality report, and what they are (the
+//! supervisor's description, the matched plan's experiment, the inference).
 
+use seatrial_core::identification::{
+    InferredDescription, PlanDescription, RunDescription, RunRole, RunSignal, UserDescription,
+    describe_run,
+};
+use seatrial_core::planning::{Dof, Experiment};
 use serde::Serialize;
 
 use super::blobs::StoredBlob;
@@ -44,6 +50,10 @@ pub struct Run {
     pub created_at: String,
     /// The stored files.
     pub files: Vec<RunFile>,
+    /// What the run is — role, grid speed, excited DOFs, signal, notes —
+    /// each with its source: the supervisor (`user`, wins), the matched
+    /// planned experiment (`plan`), or the data (`inferred`, with the reason).
+    pub description: RunDescription,
 }
 
 #[derive(sqlx::FromRow)]
@@ -57,10 +67,55 @@ struct Row {
     error: Option<String>,
     summary: Option<String>,
     created_at: String,
+    role: Option<String>,
+    grid_speed_mps: Option<f64>,
+    excited_dofs: Option<String>,
+    signal: Option<String>,
+    notes: Option<String>,
+    inferred: Option<String>,
+    plan_detail: Option<String>,
 }
 
-const COLUMNS: &str =
-    "id, campaign_id, experiment_id, name, layout, status, error, summary, created_at";
+/// The run's columns, and its planned experiment's description (if any).
+const FROM: &str = "SELECT r.id, r.campaign_id, r.experiment_id, r.name, r.layout, r.status, r.error, \
+     r.summary, r.created_at, r.role, r.grid_speed_mps, r.excited_dofs, r.signal, r.notes, \
+     r.inferred, e.detail AS plan_detail \
+     FROM run r LEFT JOIN experiment e ON e.id = r.experiment_id";
+
+impl Row {
+    fn user(&self) -> anyhow::Result<UserDescription> {
+        Ok(UserDescription {
+            role: self.role.as_deref().and_then(RunRole::from_name),
+            grid_speed_mps: self.grid_speed_mps,
+            excited_dofs: self
+                .excited_dofs
+                .as_deref()
+                .map(serde_json::from_str::<Vec<Dof>>)
+                .transpose()?,
+            signal: self.signal.as_deref().and_then(RunSignal::from_name),
+            notes: self.notes.clone(),
+        })
+    }
+
+    fn description(&self) -> anyhow::Result<RunDescription> {
+        let plan = self
+            .plan_detail
+            .as_deref()
+            .map(serde_json::from_str::<Experiment>)
+            .transpose()?
+            .map(|e| PlanDescription::of_experiment(&e));
+        let inferred = self
+            .inferred
+            .as_deref()
+            .map(serde_json::from_str::<InferredDescription>)
+            .transpose()?;
+        Ok(describe_run(
+            &self.user()?,
+            plan.as_ref(),
+            inferred.as_ref(),
+        ))
+    }
+}
 
 async fn with_files(db: &Db, r: Row) -> anyhow::Result<Run> {
     let files = sqlx::query_as::<_, RunFile>(
@@ -69,6 +124,7 @@ async fn with_files(db: &Db, r: Row) -> anyhow::Result<Run> {
     .bind(&r.id)
     .fetch_all(db)
     .await?;
+    let description = r.description()?;
     Ok(Run {
         id: r.id,
         campaign_id: r.campaign_id,
@@ -80,6 +136,7 @@ async fn with_files(db: &Db, r: Row) -> anyhow::Result<Run> {
         summary: r.summary.map(|e| serde_json::from_str(&e)).transpose()?,
         created_at: r.created_at,
         files,
+        description,
     })
 }
 
@@ -93,7 +150,22 @@ pub struct NewFile {
     pub blob: StoredBlob,
 }
 
-/// Records a run whose files are already stored, in one transaction.
+/// The supervisor's description as column values.
+fn user_columns(
+    u: &UserDescription,
+) -> anyhow::Result<(Option<&'static str>, Option<String>, Option<&'static str>)> {
+    Ok((
+        u.role.map(RunRole::name),
+        u.excited_dofs
+            .as_ref()
+            .map(serde_json::to_string)
+            .transpose()?,
+        u.signal.map(RunSignal::name),
+    ))
+}
+
+/// Records a run whose files are already stored, with what the supervisor
+/// said it is, in one transaction.
 pub async fn insert(
     db: &Db,
     campaign_id: &str,
@@ -101,13 +173,16 @@ pub async fn insert(
     name: &str,
     layout: &str,
     files: &[NewFile],
+    user: &UserDescription,
 ) -> anyhow::Result<Run> {
     let id = new_id();
     let created_at = now();
+    let (role, dofs, signal) = user_columns(user)?;
     let mut tx = db.begin().await?;
     sqlx::query(
-        "INSERT INTO run (id, campaign_id, experiment_id, name, layout, status, created_at) \
-         VALUES ($1, $2, $3, $4, $5, 'stored', $6)",
+        "INSERT INTO run (id, campaign_id, experiment_id, name, layout, status, created_at, \
+         role, grid_speed_mps, excited_dofs, signal, notes) \
+         VALUES ($1, $2, $3, $4, $5, 'stored', $6, $7, $8, $9, $10, $11)",
     )
     .bind(&id)
     .bind(campaign_id)
@@ -115,6 +190,11 @@ pub async fn insert(
     .bind(name)
     .bind(layout)
     .bind(&created_at)
+    .bind(role)
+    .bind(user.grid_speed_mps)
+    .bind(dofs)
+    .bind(signal)
+    .bind(&user.notes)
     .execute(&mut *tx)
     .await?;
     for f in files {
@@ -141,23 +221,34 @@ pub async fn insert(
         .ok_or_else(|| anyhow::anyhow!("run {id} vanished after insert"))
 }
 
-/// Records the outcome of processing, with the quality report when accepted.
-pub async fn finish(
-    db: &Db,
-    id: &str,
-    status: &str,
-    error: Option<&serde_json::Value>,
-    summary: Option<&serde_json::Value>,
-    quality_json: Option<&str>,
-) -> anyhow::Result<()> {
+/// What processing found, to record with [`finish`].
+#[derive(Default)]
+pub struct Outcome<'a> {
+    /// Why it was rejected.
+    pub error: Option<&'a serde_json::Value>,
+    /// The processing summary.
+    pub summary: Option<&'a serde_json::Value>,
+    /// The quality report (JSON text).
+    pub quality_json: Option<&'a str>,
+    /// What the data say the run is.
+    pub inferred: Option<&'a InferredDescription>,
+}
+
+/// Records the outcome of processing, with the quality report and the
+/// inferred description when accepted, in one transaction.
+pub async fn finish(db: &Db, id: &str, status: &str, out: Outcome<'_>) -> anyhow::Result<()> {
     let mut tx = db.begin().await?;
-    sqlx::query("UPDATE run SET status = $1, error = $2, summary = $3 WHERE id = $4")
-        .bind(status)
-        .bind(error.map(|e| e.to_string()))
-        .bind(summary.map(|s| s.to_string()))
-        .bind(id)
-        .execute(&mut *tx)
-        .await?;
+    sqlx::query(
+        "UPDATE run SET status = $1, error = $2, summary = $3, inferred = $4 WHERE id = $5",
+    )
+    .bind(status)
+    .bind(out.error.map(|e| e.to_string()))
+    .bind(out.summary.map(|s| s.to_string()))
+    .bind(out.inferred.map(serde_json::to_string).transpose()?)
+    .bind(id)
+    .execute(&mut *tx)
+    .await?;
+    let quality_json = out.quality_json;
     if let Some(q) = quality_json {
         sqlx::query("DELETE FROM run_quality WHERE run_id = $1")
             .bind(id)
@@ -174,14 +265,78 @@ pub async fn finish(
     Ok(())
 }
 
+/// A field of the supervisor's description (a column of `run`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DescriptionField {
+    /// `role`.
+    Role,
+    /// `grid_speed_mps`.
+    GridSpeed,
+    /// `excited_dofs`.
+    ExcitedDofs,
+    /// `signal`.
+    Signal,
+    /// `notes`.
+    Notes,
+}
+
+impl DescriptionField {
+    fn column(self) -> &'static str {
+        match self {
+            DescriptionField::Role => "role",
+            DescriptionField::GridSpeed => "grid_speed_mps",
+            DescriptionField::ExcitedDofs => "excited_dofs",
+            DescriptionField::Signal => "signal",
+            DescriptionField::Notes => "notes",
+        }
+    }
+}
+
+/// Writes the `fields` of what the supervisor said about a run from `user`
+/// (one statement in one transaction; fields not named keep their value, so
+/// two edits of different fields never undo each other).
+pub async fn set_description(
+    db: &Db,
+    id: &str,
+    user: &UserDescription,
+    fields: &[DescriptionField],
+) -> anyhow::Result<()> {
+    if fields.is_empty() {
+        return Ok(());
+    }
+    let (role, dofs, signal) = user_columns(user)?;
+    let sets: Vec<String> = fields
+        .iter()
+        .enumerate()
+        .map(|(i, f)| format!("{} = ${}", f.column(), i + 1))
+        .collect();
+    let sql = format!(
+        "UPDATE run SET {} WHERE id = ${}",
+        sets.join(", "),
+        fields.len() + 1
+    );
+    let mut tx = db.begin().await?;
+    let mut q = sqlx::query(sqlx::AssertSqlSafe(sql));
+    for f in fields {
+        q = match f {
+            DescriptionField::Role => q.bind(role),
+            DescriptionField::GridSpeed => q.bind(user.grid_speed_mps),
+            DescriptionField::ExcitedDofs => q.bind(dofs.clone()),
+            DescriptionField::Signal => q.bind(signal),
+            DescriptionField::Notes => q.bind(user.notes.clone()),
+        };
+    }
+    q.bind(id).execute(&mut *tx).await?;
+    tx.commit().await?;
+    Ok(())
+}
+
 /// One run.
 pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Run>> {
-    let row = sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!(
-        "SELECT {COLUMNS} FROM run WHERE id = $1"
-    )))
-    .bind(id)
-    .fetch_optional(db)
-    .await?;
+    let row = sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!("{FROM} WHERE r.id = $1")))
+        .bind(id)
+        .fetch_optional(db)
+        .await?;
     match row {
         Some(r) => Ok(Some(with_files(db, r).await?)),
         None => Ok(None),
@@ -191,7 +346,7 @@ pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Run>> {
 /// The runs of a campaign, oldest first.
 pub async fn list(db: &Db, campaign_id: &str) -> anyhow::Result<Vec<Run>> {
     let rows = sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!(
-        "SELECT {COLUMNS} FROM run WHERE campaign_id = $1 ORDER BY id"
+        "{FROM} WHERE r.campaign_id = $1 ORDER BY r.id"
     )))
     .bind(campaign_id)
     .fetch_all(db)

@@ -9,7 +9,8 @@ use crate::models::LinearVesselModel;
 use crate::planning::Dof;
 
 /// Restoring forces and moments g(η) of the baseline (thesis eq. 1.6):
-/// W−B, z_G·W − z_B·B and the tether pitch moment τ_θ.
+/// W−B, z_G·W − z_B·B and the tether pitch moment τ_θ, plus the model's
+/// constant loads.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 pub struct Restoring {
@@ -19,6 +20,10 @@ pub struct Restoring {
     pub zg_w_minus_zb_b: f64,
     /// τ_θ (N·m): tether pitch moment already known to the baseline.
     pub tether_pitch_moment: f64,
+    /// Constant load b per DOF [X, Y, Z, K, M, N] (N, N·m) of the baseline's
+    /// M ν̇ + D̄ ν + b = τ − g(η) (zero when the model has none).
+    #[serde(default)]
+    pub constant: [f64; 6],
 }
 
 impl Restoring {
@@ -28,13 +33,14 @@ impl Restoring {
         let (st, ct) = eta[4].sin_cos();
         let w = self.w_minus_b;
         let z = self.zg_w_minus_zb_b;
+        let b = &self.constant;
         [
-            w * st,
-            -w * ct * sp,
-            -w * ct * cp,
-            z * ct * sp,
-            z * st + self.tether_pitch_moment,
-            0.0,
+            w * st + b[0],
+            -w * ct * sp + b[1],
+            -w * ct * cp + b[2],
+            z * ct * sp + b[3],
+            z * st + self.tether_pitch_moment + b[4],
+            b[5],
         ]
     }
 }

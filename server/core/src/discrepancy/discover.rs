@@ -462,7 +462,7 @@ pub fn discover(
                     .map(|(j, (v, name))| Estimate {
                         name,
                         value: *v,
-                        std: term.covariance.get(j).and_then(|r| r.get(j)).map_or(f64::NAN, |x| x.max(0.0).sqrt()),
+                        std: term.covariance.get(j).and_then(|r| r.get(j)).map(|x| x.max(0.0).sqrt()).filter(|s| s.is_finite()),
                     })
                     .collect(),
                 shape: h_rep.shape,
@@ -538,7 +538,10 @@ fn hypothesis(s: &Scored, step: usize, verdict: Verdict, _c: &Criteria) -> Hypot
         .map(|(i, (v, name))| Estimate {
             name,
             value: *v,
-            std: cov.as_ref().map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt()),
+            std: cov
+                .as_ref()
+                .map(|c| c[(i, i)].max(0.0).sqrt())
+                .filter(|s| s.is_finite()),
         })
         .collect();
     let shape = s.spec.shape.map(|v| Estimate {
@@ -549,7 +552,7 @@ fn hypothesis(s: &Scored, step: usize, verdict: Verdict, _c: &Criteria) -> Hypot
             _ => "δ".into(),
         },
         value: v,
-        std: s.shape_std.unwrap_or(f64::NAN),
+        std: s.shape_std.filter(|s| s.is_finite()),
     });
     HypothesisReport {
         effect: e,

@@ -19,6 +19,7 @@ use super::candidates::Effect;
 use super::data::{Baseline, Record};
 use super::fit::{Prepared, Spec};
 use super::model::AugmentedModel;
+use crate::numbers::{p_value as p_text, sig3};
 use crate::validation::distributions::chi_square_sf;
 
 /// One window's current.
@@ -215,38 +216,42 @@ pub(crate) fn current_drift(
         (lo.min(s), hi.max(s))
     });
     let spread = format!(
-        "over {} windows of {:.0} s its speed ranges {:.3}–{:.3} m/s (χ² = {:.0} on {} degrees of freedom, p = {:.1e})",
+        "over {} windows of {:.0} s its speed ranges {}–{} m/s (χ² = {} on {} degrees of freedom, {})",
         est_w.len(),
         t,
-        lo,
-        hi,
-        chi2,
+        sig3(lo),
+        sig3(hi),
+        sig3(chi2),
         dof,
-        p_value
+        p_text(p_value)
     );
+    // The von Neumann clause, when the runs hold enough windows for it.
+    let ratio = |z_words: &str| match (von_neumann, z) {
+        (Some(r), Some(z)) => format!("von Neumann ratio {}, z = {}{z_words}", sig3(r), sig3(z)),
+        _ => "too few windows per run for a von Neumann ratio".to_owned(),
+    };
     let text = if drifts {
         format!(
-            "The current is not constant: {spread}, and it wanders (von Neumann ratio {:.2}, z = {:.1}){}; the model keeps its mean, and an observer should carry the current as a state.",
-            von_neumann.unwrap_or(f64::NAN),
-            z.unwrap_or(f64::NAN),
+            "The current is not constant: {spread}, and it wanders ({}){}; the model keeps its mean, and an observer should carry the current as a state.",
+            ratio(""),
             sigma.map_or(String::new(), |s| format!(
-                ", as a random walk of σ = {s:.4} m/s per √s"
+                ", as a random walk of σ = {} m/s per √s",
+                sig3(s)
             )),
         )
     } else if varies {
         format!(
-            "The window currents disagree but do not drift ({spread}; neighbouring windows differ as much as any two, von Neumann ratio {:.2}, z = {:.1}, where a drifting current lies far below 2): the disagreement follows the manoeuvres, so the current's size is uncertain beyond its std — the runs cannot separate it from a damping error, or other physics is missing. A deciding run: the same manoeuvre at four headings.",
-            von_neumann.unwrap_or(f64::NAN),
-            z.unwrap_or(f64::NAN)
+            "The window currents disagree but do not drift ({spread}; neighbouring windows differ as much as any two, {}): the disagreement follows the manoeuvres, so the current's size is uncertain beyond its std — the runs cannot separate it from a damping error, or other physics is missing. A deciding run: the same manoeuvre at four headings.",
+            ratio(", where a drifting current lies far below 2")
         )
     } else {
         format!(
-            "The current is steady: {} windows of {:.0} s agree with one value (χ² = {:.1} on {} degrees of freedom, p = {:.2}).",
+            "The current is steady: {} windows of {:.0} s agree with one value (χ² = {} on {} degrees of freedom, {}).",
             est_w.len(),
             t,
-            chi2,
+            sig3(chi2),
             dof,
-            p_value
+            p_text(p_value)
         )
     };
     Some(CurrentDrift {

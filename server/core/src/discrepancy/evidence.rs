@@ -18,10 +18,14 @@ fn pm(v: f64, s: Option<f64>) -> String {
     }
 }
 
-/// Three significant digits without noise.
+/// Three significant digits without noise (`—` for no number, `2.5e7`
+/// beyond 10⁶: [`crate::numbers::sig3`]).
 fn sig(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
+    if v == 0.0 {
+        return "0".into();
+    }
+    if !v.is_finite() || v.abs() >= 1e6 {
+        return crate::numbers::sig3(v);
     }
     let d = (3 - 1 - v.abs().log10().floor() as i32).max(0) as usize;
     format!("{v:.d$}")

@@ -368,8 +368,14 @@ fn bin_condition(dof: Dof, c: Condition, mut v: Vec<(f64, f64)>) -> Option<Condi
     })
 }
 
+/// A fit with two decimals; far below the mean (a run-away simulation) the
+/// digits mean nothing: `< −10`.
 fn fmt_fit(f: Option<f64>) -> String {
-    f.map_or("–".into(), |x| format!("{x:.2}"))
+    match f.filter(|x| x.is_finite()) {
+        None => "–".into(),
+        Some(x) if x < crate::numbers::FIT_FLOOR => "< −10".into(),
+        Some(x) => format!("{x:.2}"),
+    }
 }
 
 fn sentences(rep: &LocationReport) -> Vec<String> {

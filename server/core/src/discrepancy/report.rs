@@ -19,16 +19,10 @@ pub struct Estimate {
     pub name: String,
     /// Estimate.
     pub value: f64,
-    /// Standard deviation (HAC, or profile curvature for shapes); NaN if
-    /// unavailable, which JSON carries as null.
-    #[serde(deserialize_with = "nan_if_null")]
-    #[cfg_attr(feature = "openapi", schema(value_type = Option<f64>))]
-    pub std: f64,
-}
-
-/// JSON has no NaN: serde_json writes it as null; read null back as NaN.
-fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+    /// Standard deviation (HAC, or profile curvature for shapes); `None`
+    /// when the fit gives none (no covariance, a flat profile).
+    #[serde(default)]
+    pub std: Option<f64>,
 }
 
 /// Whether a hypothesis made it into the model.
@@ -224,18 +218,18 @@ mod tests {
     use super::Estimate;
 
     #[test]
-    fn an_unavailable_std_travels_as_null_and_comes_back_nan() {
+    fn an_unavailable_std_travels_as_null_and_comes_back_none() {
         let e = Estimate {
             name: "T_a (s)".into(),
             value: 0.73,
-            std: f64::NAN,
+            std: None,
         };
         let v = serde_json::to_value(&e).unwrap();
         assert!(v["std"].is_null(), "{v}");
         let back: Estimate = serde_json::from_value(v).unwrap();
-        assert!(back.std.is_nan() && back.value == 0.73);
+        assert!(back.std.is_none() && back.value == 0.73);
         let known: Estimate =
             serde_json::from_str(r#"{"name":"d","value":1.0,"std":0.5}"#).unwrap();
-        assert_eq!(known.std, 0.5);
+        assert_eq!(known.std, Some(0.5));
     }
 }

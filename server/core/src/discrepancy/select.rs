@@ -16,7 +16,8 @@
 use super::candidates::{Effect, Family, ShapeKind};
 use super::data::Record;
 use super::fit::{FitOut, Prepared, Spec, profile};
-use crate::validation::nrmse_fit;
+use crate::numbers::FIT_FLOOR;
+use crate::validation::{PlausibleBand, nrmse_fit};
 
 /// Thresholds of the selection.
 #[derive(Debug, Clone, Copy)]
@@ -186,7 +187,12 @@ pub(crate) fn score(
     })
 }
 
-/// Free-run NRMSE fits of `model` on `rec` for the channels `rows`.
+/// Free-run NRMSE fits of `model` on `rec` for the channels `rows`. A run
+/// that diverges (leaves validation's plausible band, see
+/// [`crate::validation::divergence`]) or fits worse than
+/// [`FIT_FLOOR`] scores the floor: how far beyond it says nothing, and an
+/// unbounded −1e55 would make any candidate that tames it look like the
+/// best gain.
 pub(crate) fn free_run_fits(
     model: &super::model::AugmentedModel,
     rec: &Record,
@@ -194,7 +200,14 @@ pub(crate) fn free_run_fits(
 ) -> Vec<f64> {
     let sim = model.simulate(rec);
     rows.iter()
-        .map(|&r| nrmse_fit(rec.nu.column(r).as_slice(), sim.column(r).as_slice()).unwrap_or(0.0))
+        .map(|&r| {
+            let (y, yhat) = (rec.nu.column(r), sim.column(r));
+            let band = PlausibleBand::of(y.as_slice());
+            if !yhat.iter().all(|v| band.contains(*v)) {
+                return FIT_FLOOR;
+            }
+            nrmse_fit(y.as_slice(), yhat.as_slice()).map_or(0.0, |f| f.max(FIT_FLOOR))
+        })
         .collect()
 }
 
@@ -223,7 +236,14 @@ pub(crate) fn cv_gain(
         let rec = &prep.records[held];
         let a = free_run_fits(&m0, rec, &channels);
         let b = free_run_fits(&m1, rec, &channels);
-        let g = b.iter().zip(&a).map(|(b, a)| b - a).sum::<f64>();
+        // A free run that diverges has a fit of −∞: below −1 (twice the
+        // error of the mean) every fit counts as −1, so a gain is finite.
+        let floor = |x: &f64| if x.is_finite() { x.max(-1.0) } else { -1.0 };
+        let g = b
+            .iter()
+            .zip(&a)
+            .map(|(b, a)| floor(b) - floor(a))
+            .sum::<f64>();
         gains.push(g);
     }
     (!gains.is_empty()).then(|| gains.iter().sum::<f64>() / gains.len() as f64)

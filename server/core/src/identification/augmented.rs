@@ -27,8 +27,19 @@ pub fn restoring_of(doc: &ModelDocument) -> Restoring {
             w_minus_b: r.params.weight_minus_buoyancy_n,
             zg_w_minus_zb_b: r.params.zg_weight_minus_zb_buoyancy_nm,
             tether_pitch_moment: r.params.tether_pitch_moment_nm,
+            constant: [0.0; 6],
         })
         .unwrap_or_default()
+}
+
+/// The constant load b of a sub-model, as a vector over the modelled DOFs
+/// (zero when the model has none).
+pub fn load_of(doc: &ModelDocument, point: &LpvPoint) -> nalgebra::DVector<f64> {
+    let n = doc.dofs.len();
+    match &point.load {
+        Some(b) if b.len() == n => nalgebra::DVector::from_column_slice(b),
+        _ => nalgebra::DVector::zeros(n),
+    }
 }
 
 fn matrix(rows: &super::document::Matrix, what: &str) -> Result<DMatrix<f64>, IdentifyError> {
@@ -38,11 +49,15 @@ fn matrix(rows: &super::document::Matrix, what: &str) -> Result<DMatrix<f64>, Id
 
 /// The baseline M ν̇ + D̄ ν = τ − g(η) of one LPV sub-model.
 pub fn baseline_at(doc: &ModelDocument, point: &LpvPoint) -> Result<Baseline, IdentifyError> {
+    let mut restoring = restoring_of(doc);
+    for (i, d) in doc.dofs.iter().enumerate() {
+        restoring.constant[d.index()] = load_of(doc, point)[i];
+    }
     Ok(Baseline {
         dofs: doc.dofs.clone(),
         m: matrix(&point.m, "M")?,
         d_bar: matrix(&point.d_bar, "D̄")?,
-        restoring: restoring_of(doc),
+        restoring,
     })
 }
 
@@ -206,6 +221,8 @@ mod tests {
 
     fn doc(d_fast: f64) -> ModelDocument {
         let point = |speed: f64, d: f64| LpvPoint {
+            load: None,
+            load_std: None,
             speed_mps: speed,
             m: vec![vec![100.0, 0.0], vec![0.0, 50.0]],
             m_std: vec![vec![0.0; 2]; 2],

@@ -5,12 +5,14 @@
 //!
 //! x″ = x/L, y″ = y/L, ψ″ = ψ, t″ = t/√(L/g), u″ = u/√(L·g), r″ = r·√(L/g).
 
-use nalgebra::{DMatrix, Matrix3};
+use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use crate::estimation::ekf::IdentifiedDpShip;
 use crate::planning::vessel::DpPrior;
 use crate::simulation::dp_ship::Matrix3x6;
-use crate::validation::{Predictor, ValidationRecord};
+use crate::simulation::dp_ship::model::rotation;
+use crate::simulation::integrate::rk4_step;
+use crate::validation::{Predictor, ValidationRecord, restart_windows};
 
 /// Length and time units of a ship's Bis system.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,6 +120,53 @@ impl Predictor for SiDpShip {
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
         self.in_bis(rec, |r| self.model.simulate(r))
     }
+
+    /// Each window starts from the state estimator's x̂(s|s) = [ĥ, η̂, b̂_h]
+    /// (momentum and bias are not measured; the same estimate the k-step
+    /// prediction starts from) and runs on the recorded commands with b̂_h
+    /// held.
+    fn simulate_restarted(&self, rec: &ValidationRecord<'_>, every: usize) -> DMatrix<f64> {
+        self.in_bis(rec, |r| restarted_free_runs(&self.model, r, every))
+    }
+}
+
+/// [`Predictor::simulate_restarted`] of a Bis DP ship (Bis units).
+fn restarted_free_runs(
+    model: &IdentifiedDpShip,
+    rec: &ValidationRecord<'_>,
+    every: usize,
+) -> DMatrix<f64> {
+    let n = rec.y.nrows();
+    let mut out = DMatrix::from_element(n, 3, f64::NAN);
+    if rec.u.ncols() != 6 || rec.u.nrows() != n {
+        return out;
+    }
+    let Some(states) = model.estimate_states(rec) else {
+        return out;
+    };
+    let ship = &model.ship;
+    let m_inv = ship.m_inv();
+    let mut w = [0.0; 6];
+    for (s, e) in restart_windows(n, every) {
+        let b = Vector3::new(states[(s, 6)], states[(s, 7)], states[(s, 8)]);
+        let mut x: [f64; 6] = std::array::from_fn(|j| states[(s, j)]);
+        let mut f = |x: &[f64], u: &[f64], dx: &mut [f64]| {
+            let hm = Vector3::new(x[0], x[1], x[2]);
+            let eta_dot = rotation(x[5]) * (m_inv * hm);
+            dx[..3].copy_from_slice(ship.h_dot(&m_inv, &hm, u, &b).as_slice());
+            dx[3..].copy_from_slice(eta_dot.as_slice());
+        };
+        for t in s..e {
+            for j in 0..3 {
+                out[(t, j)] = x[3 + j];
+            }
+            for (j, v) in w.iter_mut().enumerate() {
+                *v = rec.u[(t, j)];
+            }
+            rk4_step(&mut f, &mut x, &w, rec.h);
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -4,20 +4,27 @@
 
 use nalgebra::DMatrix;
 
+use crate::planning::Dof;
 use crate::planning::campaign::ExperimentFamily;
 use crate::timeseries::UniformRecord;
 
-/// A run as identification sees it: its record and what the plan says it was.
+/// A run as identification sees it: its record and what it is — from the
+/// supervisor's description, else its planned experiment, else inferred
+/// from its data (see [`super::description::describe_run`]).
 #[derive(Debug, Clone)]
 pub struct RunInput {
     /// Run id (for provenance and messages).
     pub run_id: String,
     /// Run name (the experiment code when planned).
     pub name: String,
-    /// The planned experiment family, when the run flew a planned experiment.
+    /// The family the run counts as: its role (static, dynamic, recursive,
+    /// validation) as an experiment family, or the planned / inferred DP
+    /// manoeuvre. `None`: unknown, used as estimation data.
     pub family: Option<ExperimentFamily>,
-    /// The LPV grid speed of its experiment (m/s).
+    /// The LPV grid speed it was flown at (m/s).
     pub grid_speed_mps: Option<f64>,
+    /// The DOFs it excites (empty: not known).
+    pub excited_dofs: Vec<Dof>,
     /// The resampled record (inputs, ν, η; τ_T for thruster-actuated vessels).
     pub record: UniformRecord,
 }
@@ -144,6 +151,7 @@ mod tests {
             name: "test".into(),
             family: None,
             grid_speed_mps: None,
+            excited_dofs: vec![],
             record: UniformRecord {
                 sample_rate_hz: 10.0,
                 t0: 5.0,

@@ -100,6 +100,8 @@ mod tests {
         // ν̇ = −(D/M) ν + γ/M: Φ = e^{−Dh/M}, Γ = (1 − Φ)/D.
         let (m, d, h) = (2000.0, 500.0, 0.1);
         let point = |speed: f64, d: f64| LpvPoint {
+            load: None,
+            load_std: None,
             speed_mps: speed,
             m: vec![vec![m]],
             m_std: vec![vec![0.0]],

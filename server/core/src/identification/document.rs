@@ -122,6 +122,14 @@ pub struct LpvPoint {
     pub b: Matrix,
     /// Std of B's entries.
     pub b_std: Matrix,
+    /// Constant load b of M ν̇ + D̄ ν + b = γ per DOF (N, N·m): tether,
+    /// the heave part of W − B, and the offset of the damping's
+    /// linearization about this speed. Absent in models without it (zero).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load: Option<Vec<f64>>,
+    /// Std of `load`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load_std: Option<Vec<f64>>,
     /// Samples used.
     pub n_samples: usize,
     /// Runs used.

@@ -27,6 +27,7 @@ use crate::estimation::ekf::{
     identify_dp_ship,
 };
 use crate::estimation::{Progress, SubProgress};
+use crate::numbers::sig3;
 use crate::planning::campaign::ExperimentFamily;
 use crate::planning::dof::Dof;
 use crate::planning::vessel::{InputChannels, ThrusterKind, VesselKind, VesselProfile};
@@ -318,7 +319,8 @@ pub fn structure_findings(m: &Matrix3<f64>, a_h: &Matrix3<f64>, k: &[f64]) -> Ve
     let min = eig.min();
     if min <= 0.0 {
         out.push(format!(
-            "D″ = −A″_h·M″ is not dissipative: its symmetric part has eigenvalue {min:.3e} ≤ 0 (νᵀDν ≤ 0 for some motion); the estimate is reported, not corrected"
+            "D″ = −A″_h·M″ is not dissipative: its symmetric part has eigenvalue {} ≤ 0 (νᵀDν ≤ 0 for some motion); the estimate is reported, not corrected",
+            sig3(min)
         ));
     }
     let a = m.try_inverse().map(|mi| mi * a_h * m);
@@ -330,15 +332,17 @@ pub fn structure_findings(m: &Matrix3<f64>, a_h: &Matrix3<f64>, k: &[f64]) -> Ve
             .fold(f64::MIN, f64::max);
         if re >= 0.0 {
             out.push(format!(
-                "A″ = M″⁻¹A″_h M″ is not stable: an eigenvalue has real part {re:.3e} ≥ 0"
+                "A″ = M″⁻¹A″_h M″ is not stable: an eigenvalue has real part {} ≥ 0",
+                sig3(re)
             ));
         }
     }
     for (j, &kj) in k.iter().enumerate() {
         if kj <= 0.0 {
             out.push(format!(
-                "K″{} = {kj:.3e} ≤ 0: thruster {} pushes against its configuration column",
+                "K″{} = {} ≤ 0: thruster {} pushes against its configuration column",
                 j + 1,
+                sig3(kj),
                 j + 1
             ));
         }
@@ -559,11 +563,11 @@ fn document(
     for p in 0..N_THETA {
         if std[p] > 0.5 * id.theta[p].abs() {
             findings.push(format!(
-                "θ″{} ({}) = {:.3e} ± {:.1e} is poorly determined (σ > 50 %): excite its manoeuvre more or fly more runs",
+                "θ″{} ({}) = {} ± {} is poorly determined (σ > 50 %): excite its manoeuvre more or fly more runs",
                 p + 1,
                 THETA_NAMES[p],
-                id.theta[p],
-                std[p]
+                sig3(id.theta[p]),
+                sig3(std[p])
             ));
         }
     }

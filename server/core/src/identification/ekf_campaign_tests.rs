@@ -42,6 +42,7 @@ fn runs_of(profile: &VesselProfile, plan: &crate::planning::Plan, seed: u64) -> 
                 name: f.code.clone(),
                 family: Some(f.family),
                 grid_speed_mps: Some(0.0),
+                excited_dofs: vec![],
                 record,
             }
         })
@@ -108,10 +109,14 @@ fn campaign_identifies_the_supply_vessel_within_five_percent() {
     let v = &out.validation[0].report;
     for c in &v.channels {
         eprintln!(
-            "{}: 1-step {:?} k-step {:?} sim {:?}",
-            c.output, c.fit_one_step, c.fit_k_step, c.fit_simulation
+            "{}: 1-step {:?} k-step {:?} restarted {:?} sim {:?}",
+            c.output, c.fit_one_step, c.fit_k_step, c.fit_restarted, c.fit_simulation
         );
         assert!(c.fit_k_step.unwrap() > 0.8, "{} k-step fit", c.output);
+        // Restarted from the estimator's state every 10 s, the identified
+        // ship stays on the recording (no window diverges).
+        assert_eq!(c.restarted.diverged, 0, "{}", c.verdict);
+        assert!(c.fit_restarted.unwrap() > 0.8, "{} restarted fit", c.output);
     }
     let json = serde_json::to_value(v).unwrap();
     assert!(json.to_string().contains("\"psi\""));

@@ -161,6 +161,8 @@ mod tests {
                 structure: "diagonal".into(),
                 coupling: vec![vec![true]],
                 points: vec![LpvPoint {
+                    load: None,
+                    load_std: None,
                     speed_mps: 0.5,
                     m: vec![vec![2700.0]],
                     m_std: vec![vec![30.0]],

@@ -1,28 +1,28 @@
 //! Identification of an LPV model on forward speed by the λ-filter Kalman
-//! method (thesis sec. 2.5): restoring forces from static runs, then one
-//! M ν̇ + D̄ ν = γ per grid point from the dynamic and recursive runs, with
-//! γ = τ − g(η); validated on the held-out runs.
+//! method (thesis sec. 2.5): one M ν̇ + D̄ ν + b = γ per grid point, with
+//! γ = τ − g(η) and g(η) estimated jointly from the runs themselves;
+//! physical structure enforced; validated on the held-out runs.
 
-use nalgebra::DMatrix;
+use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 
-use super::dataset::{RunInput, Segment, segments};
+use super::dataset::{RunInput, segments};
 use super::document::{
     LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, to_rows,
 };
 use super::error::IdentifyError;
+use super::joint_restoring::{Functions, PooledRestoring, load, specification};
+use super::lambda_coriolis::fit_points;
+use super::lambda_data::{experiment, per_point, static_holds};
+use super::lambda_physical::enforce;
+use super::lambda_structure::choose_structure;
 use super::outcome::{Identified, RunValidation};
-use super::roles::{assign_roles, nearest_grid_index};
-use crate::estimation::lambda::{
-    CouplingMask, Experiment, LambdaSettings, MIN_T_OVER_H, Prior, Structure, identify_lpv,
-    propose_coupling,
-};
-use crate::estimation::restoring::{
-    RestoringParams, RestoringSettings, StaticRecord, estimate_restoring,
-};
+use super::roles::assign_roles;
+use crate::estimation::lambda::{Experiment, LambdaEstimate, LambdaSettings, MIN_T_OVER_H, Prior};
+use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
 use crate::estimation::{Progress, SubProgress};
 use crate::logs::schema::pose_column;
-use crate::models::{LinearVesselModel, LpvModel, Scheduling};
+use crate::models::{LpvModel, Scheduling};
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
 use crate::validation::{ValidationRecord, ValidationSettings, validate};
@@ -32,9 +32,15 @@ use crate::validation::{ValidationRecord, ValidationSettings, validate};
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum StructureChoice {
-    /// Propose the coupling from partial coherence between DOFs (default).
+    /// Port–starboard symmetry (default for 6-DOF and 3-DOF vessels) plus
+    /// any pair the partial coherence between DOFs proposes; for other DOF
+    /// sets the coherence proposal alone.
     #[default]
     Auto,
+    /// Port–starboard (xz-plane) symmetry: surge, heave and pitch couple
+    /// among themselves, sway, roll and yaw among themselves (Fossen 2011,
+    /// sec. 7.5: the longitudinal and lateral subsystems).
+    Symmetric,
     /// Each DOF alone (the thesis's first, uncoupled LPV model).
     Diagonal,
     /// Every entry of A and B free.
@@ -82,10 +88,20 @@ pub struct LambdaCampaignSettings {
     /// Scheduling of predictions on forward speed.
     #[serde(default)]
     pub scheduling: SchedulingChoice,
-    /// Estimate W − B, z_G·W − z_B·B and the tether moment from static runs
-    /// (needs a 6-DOF vessel with static holds at several attitudes).
+    /// Estimate g(η) (W − B, z_G·W − z_B·B) jointly with M and D̄ from every
+    /// run where the attitude moves, sharpened by static attitude holds when
+    /// there are any (6-DOF vessels).
     #[serde(default = "default_true")]
     pub estimate_restoring: bool,
+    /// Estimate a constant load b per DOF and grid point (tether, the heave
+    /// part of W − B, the offset of the damping's linearization at speed).
+    #[serde(default = "default_true")]
+    pub constant_loads: bool,
+    /// Take the couplings of C(ν)ν at the grid speed from the estimated M
+    /// (Fossen 2011, eq. 6.43; 6-DOF and 3-DOF horizontal models), so the
+    /// structure constrains the damping D and D̄ = D + J_C(M, u₀).
+    #[serde(default = "default_true")]
+    pub coriolis_from_m: bool,
 }
 
 fn default_threshold() -> f64 {
@@ -109,6 +125,8 @@ impl Default for LambdaCampaignSettings {
             k: default_k(),
             scheduling: SchedulingChoice::Interpolate,
             estimate_restoring: true,
+            constant_loads: true,
+            coriolis_from_m: true,
         }
     }
 }
@@ -127,23 +145,16 @@ fn unit(dofs: &[Dof], i: usize, j: usize, per_s: bool) -> String {
     }
 }
 
-/// The segment's γ = τ − g(η) (or τ when no restoring model), and ν.
-fn gamma_nu(
-    seg: &Segment,
-    n: usize,
-    restoring: Option<&RestoringParams>,
-) -> Result<(DMatrix<f64>, DMatrix<f64>), IdentifyError> {
-    let tau = seg.u.columns(0, n).into_owned();
-    let gamma = match restoring {
-        Some(r) => {
-            let eta = seg.u.columns(n, 6).into_owned();
-            r.gamma(&tau, &eta).map_err(|e| {
-                IdentifyError::invalid(format!("runs[{}]", seg.run_id), e.to_string())
-            })?
-        }
-        None => tau,
-    };
-    Ok((gamma, seg.y.clone()))
+/// Unit of a force (N) or moment (N·m) in DOF `d`.
+fn force_unit(d: Dof) -> &'static str {
+    if d.is_angular() { "N·m" } else { "N" }
+}
+
+fn lambda_error(e: crate::estimation::lambda::LambdaError) -> IdentifyError {
+    match e {
+        crate::estimation::lambda::LambdaError::Cancelled => IdentifyError::Cancelled,
+        e => IdentifyError::invalid(e.field().to_string(), e.to_string()),
+    }
 }
 
 /// Runs the λ-filter identification of a campaign.
@@ -151,6 +162,15 @@ fn gamma_nu(
 /// `inputs` are the generalized-force columns in the order of
 /// `profile.dofs` (τ, or τ_T = T·u for a thruster-actuated vessel); `grid`
 /// is the campaign's LPV grid (m/s).
+///
+/// 1. g(η) (6-DOF): W − B and z_G W − z_B B estimated jointly with M, D̄
+///    and constant loads at every grid point ([`super::joint_restoring`]),
+///    pooled over the grid, sharpened by station-keeping holds if flown.
+/// 2. Per grid point, M ν̇ + D̄ ν + b = τ − g(η) with the pooled g(η).
+/// 3. A sub-model that is not physical (M not symmetric positive definite,
+///    D̄ not dissipative) is projected onto the physical set and the cost in
+///    1-step fit is reported ([`crate::models::project_physical`]).
+/// 4. Validation on the held-out runs.
 pub fn identify_lambda_campaign(
     profile: &VesselProfile,
     grid: &[f64],
@@ -192,121 +212,32 @@ pub fn identify_lambda_campaign(
         .collect();
     let six_dof = n == 6;
     let mut notes = Vec::new();
-    progress.update(0.0, "restoring forces from static runs")?;
+    progress.update(0.0, "collecting estimation data")?;
 
-    // Restoring forces g(η) from the static runs (6-DOF vessels only: g(η)
-    // couples heave, roll and pitch through the attitude).
-    let mut restoring: Option<(RestoringParams, RestoringDoc)> = None;
-    let with_pose: Vec<String> = inputs
-        .iter()
-        .cloned()
-        .chain(Dof::ALL.iter().map(|d| pose_column(*d).to_string()))
-        .collect();
-    if settings.estimate_restoring && six_dof && !roles.statics.is_empty() {
-        let mut segs = Vec::new();
-        for r in &roles.statics {
-            segs.extend(segments(r, &with_pose, &outputs, 20).map_err(|e| {
-                IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string())
-            })?);
-        }
-        let taus: Vec<DMatrix<f64>> = segs
+    // Columns: τ, then η when g(η) is part of the model.
+    let with_restoring = settings.estimate_restoring && six_dof;
+    let cols: Vec<String> = if with_restoring {
+        inputs
             .iter()
-            .map(|s| s.u.columns(0, 6).into_owned())
-            .collect();
-        let etas: Vec<DMatrix<f64>> = segs
-            .iter()
-            .map(|s| s.u.columns(6, 6).into_owned())
-            .collect();
-        let records: Vec<StaticRecord<'_>> = segs
-            .iter()
-            .zip(taus.iter().zip(&etas))
-            .map(|(s, (tau, eta))| StaticRecord {
-                h: s.h,
-                nu: &s.y,
-                eta,
-                tau,
-            })
-            .collect();
-        match estimate_restoring(&records, &RestoringSettings::default()) {
-            Ok(est) => {
-                let p = &est.params;
-                let s = &est.std;
-                let row = |symbol: &str, value: f64, std: f64, unit: &str| ParameterRow {
-                    group: "g(η)".into(),
-                    symbol: symbol.into(),
-                    grid_speed_mps: None,
-                    value,
-                    std: Some(std),
-                    unit: unit.into(),
-                };
-                let doc = RestoringDoc {
-                    parameters: vec![
-                        row("W−B", p.weight_minus_buoyancy_n, s.weight_minus_buoyancy_n, "N"),
-                        row(
-                            "z_G·W − z_B·B",
-                            p.zg_weight_minus_zb_buoyancy_nm,
-                            s.zg_weight_minus_zb_buoyancy_nm,
-                            "N·m",
-                        ),
-                        row("τ_θ (tether)", p.tether_pitch_moment_nm, s.tether_pitch_moment_nm, "N·m"),
-                    ],
-                    evidence: vec![format!(
-                        "{} steady segments from {} static runs; moment-term correlation {:.2}",
-                        est.segments.len(),
-                        roles.statics.len(),
-                        est.moment_correlation
-                    )],
-                    params: *p,
-                };
-                restoring = Some((*p, doc));
-            }
-            Err(e) => notes.push(format!(
-                "restoring forces not estimated ({e}); γ = τ, so W − B and the tether moment end up in the fit"
-            )),
-        }
-    } else if !six_dof {
-        notes.push("restoring forces need all six DOFs and the attitude; γ = τ".into());
-    } else if roles.statics.is_empty() && settings.estimate_restoring {
-        notes.push("no static runs: restoring forces not estimated; γ = τ".into());
-    }
-    let g = restoring.as_ref().map(|(p, _)| p);
-    let cols_in: &[String] = if g.is_some() { &with_pose } else { inputs };
-    let to_experiments = |run: &RunInput| -> Result<Vec<Experiment>, IdentifyError> {
-        segments(run, cols_in, &outputs, 50)
-            .map_err(|e| IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string()))?
-            .iter()
-            .map(|s| {
-                let (gamma, nu) = gamma_nu(s, n, g)?;
-                Ok(Experiment { h: s.h, nu, gamma })
-            })
+            .cloned()
+            .chain(Dof::ALL.iter().map(|d| pose_column(*d).to_string()))
             .collect()
+    } else {
+        inputs.to_vec()
     };
-
-    // Estimation data per grid point; a run without a planned grid speed
-    // goes to the grid point nearest its mean forward speed.
-    let surge = dofs.iter().position(|d| *d == Dof::Surge);
-    let mut per_point: Vec<Vec<Experiment>> = vec![Vec::new(); grid.len()];
-    let mut runs_per_point: Vec<Vec<String>> = vec![Vec::new(); grid.len()];
-    for r in &roles.estimation {
-        for e in to_experiments(r)? {
-            let speed = r
-                .grid_speed_mps
-                .unwrap_or_else(|| surge.map_or(grid[0], |j| e.nu.column(j).mean()));
-            let i = nearest_grid_index(grid, speed);
-            if !runs_per_point[i].contains(&r.run_id) {
-                runs_per_point[i].push(r.run_id.clone());
-            }
-            per_point[i].push(e);
-        }
+    if !six_dof && settings.estimate_restoring {
+        notes.push("g(η) needs all six DOFs and the attitude; γ = τ".into());
     }
-    let h = per_point
+    let data = per_point(&roles, grid, &dofs, &cols, &outputs, &mut notes)?;
+    let h = data
+        .segments
         .iter()
         .flatten()
-        .map(|e| e.h)
+        .map(|s| s.h)
         .next()
         .ok_or_else(|| IdentifyError::invalid("run_ids", "no usable estimation data"))?;
-    for (speed, exps) in grid.iter().zip(&per_point) {
-        if exps.is_empty() {
+    for (speed, segs) in grid.iter().zip(&data.segments) {
+        if segs.is_empty() {
             notes.push(format!(
                 "no estimation data at {speed:.2} m/s: the LPV model has no sub-model there"
             ));
@@ -331,105 +262,109 @@ pub fn identify_lambda_campaign(
         ));
     }
 
-    // Coupling structure.
-    let all: Vec<Experiment> = per_point.iter().flatten().cloned().collect();
-    let (structure, mask_rows, structure_name) = match settings.structure {
-        StructureChoice::Diagonal => (Structure::Diagonal, CouplingMask::diagonal(n), "diagonal"),
-        StructureChoice::Coupled => (
-            Structure::Coupled(CouplingMask::full(n)),
-            CouplingMask::full(n),
-            "coupled",
-        ),
-        StructureChoice::Custom => {
-            let rows = settings.coupling.as_ref().ok_or_else(|| {
-                IdentifyError::invalid(
-                    "settings.coupling",
-                    "structure 'custom' needs the coupling pattern",
-                )
-            })?;
-            if rows.len() != n || rows.iter().any(|r| r.len() != n) {
-                return Err(IdentifyError::invalid(
-                    "settings.coupling",
-                    format!("must be {n} × {n} booleans in the order {dofs:?}"),
-                ));
-            }
-            let mut p = DMatrix::from_fn(n, n, |i, j| rows[i][j]);
-            for i in 0..n {
-                p[(i, i)] = true;
-            }
-            let mask = CouplingMask::from_pattern(&p);
-            (Structure::Coupled(mask.clone()), mask, "coupled")
-        }
-        StructureChoice::Auto => {
-            progress.update(0.08, "proposing coupling from partial coherence")?;
-            let proposal = propose_coupling(&all, settings.coupling_threshold).map_err(|e| {
-                IdentifyError::invalid(format!("settings.{}", e.field()), e.to_string())
-            })?;
-            let coupled: Vec<String> = proposal
-                .evidence
-                .iter()
-                .filter(|p| proposal.mask.a[(p.output, p.input)])
-                .map(|p| {
-                    format!(
-                        "{}←{} (partial coherence {:.2})",
-                        dofs[p.output].name(),
-                        dofs[p.input].name(),
-                        p.median_partial_coherence
-                    )
-                })
-                .collect();
-            notes.push(if coupled.is_empty() {
-                "coupling proposal: no DOF pair is coupled above the threshold; diagonal model"
-                    .into()
-            } else {
-                format!("coupling proposed from the data: {}", coupled.join(", "))
-            });
-            let mask = proposal.mask.clone();
-            (Structure::Coupled(mask.clone()), mask, "coupled")
-        }
+    let build = |restoring: Option<&RestoringParams>, f: Option<Functions>| {
+        data.segments
+            .iter()
+            .map(|segs| {
+                segs.iter()
+                    .map(|s| experiment(s, n, restoring, f))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .collect::<Result<Vec<_>, _>>()
     };
-
-    // Weak rigid-body prior from the profile: D ≈ F_max/v_max, M ≈ T·D.
-    let lambda_settings = LambdaSettings::new(
+    let points_of = |exps: Vec<Vec<Experiment>>| -> Vec<(f64, Vec<Experiment>)> {
+        grid.iter()
+            .zip(exps)
+            .filter(|(_, e)| !e.is_empty())
+            .map(|(s, e)| (*s, e))
+            .collect()
+    };
+    let plain = build(None, None)?;
+    let all: Vec<Experiment> = plain.iter().flatten().cloned().collect();
+    let chosen = choose_structure(settings, &dofs, &all, progress, &mut notes)?;
+    let mut lambda_settings = LambdaSettings::new(
         dofs.clone(),
         t_lambda,
-        structure,
+        chosen.structure.clone(),
         Prior::from_profile(profile, &dofs),
     );
-    let points: Vec<(f64, Vec<Experiment>)> = grid
-        .iter()
-        .zip(per_point)
-        .filter(|(_, e)| !e.is_empty())
-        .map(|(s, e)| (*s, e))
-        .collect();
+
+    // 1. g(η) jointly with M, D̄ and constant loads, pooled over the grid.
+    let mut restoring: Option<(RestoringParams, RestoringDoc)> = None;
+    if with_restoring {
+        let holds = static_holds(&roles, &dofs, &cols, &outputs, &mut notes)?;
+        lambda_settings.exogenous = Some(specification(
+            profile,
+            &dofs,
+            Functions::ConstantAndRestoring,
+        ));
+        let joint = {
+            let mut sub = SubProgress::new(progress, 0.05, 0.4);
+            fit_points(
+                &points_of(build(None, Some(Functions::ConstantAndRestoring))?),
+                &lambda_settings,
+                settings.coriolis_from_m,
+                &mut sub,
+                &mut notes,
+            )
+            .map_err(lambda_error)?
+        };
+        match PooledRestoring::from_points(&joint) {
+            Some(pooled) => {
+                let pooled = match &holds {
+                    Some(est) => pooled.with_static(&est.params, &est.std),
+                    None => pooled,
+                };
+                restoring = Some((pooled.params(), restoring_doc(&pooled, &joint, holds.as_ref())));
+            }
+            None => notes.push(
+                "g(η) could not be estimated (no attitude motion in roll or pitch): γ = τ, the constant loads absorb W − B"
+                    .into(),
+            ),
+        }
+    }
+    let g = restoring.as_ref().map(|(p, _)| p);
+
+    // 2. The sub-models with g(η) fixed at the pooled value.
+    let loads = settings.constant_loads.then_some(Functions::Constant);
+    lambda_settings.exogenous = loads.map(|f| specification(profile, &dofs, f));
+    let exps = build(g, loads)?;
     let estimates = {
-        let mut sub = SubProgress::new(progress, 0.1, 0.75);
-        identify_lpv(&points, &lambda_settings, &mut sub).map_err(|e| match e {
-            crate::estimation::lambda::LambdaError::Cancelled => IdentifyError::Cancelled,
-            e => IdentifyError::invalid(e.field().to_string(), e.to_string()),
-        })?
+        let from = if with_restoring { 0.4 } else { 0.1 };
+        let mut sub = SubProgress::new(progress, from, 0.8);
+        fit_points(
+            &points_of(exps.clone()),
+            &lambda_settings,
+            settings.coriolis_from_m,
+            &mut sub,
+            &mut notes,
+        )
+        .map_err(lambda_error)?
     };
 
-    // Sub-models, their physical checks, parameters.
+    // 3. Sub-models, physical structure enforced, parameters.
     let mut models = Vec::new();
     let mut lpv_points = Vec::new();
     let mut parameters = Vec::new();
     let mut findings = Vec::new();
     for (speed, est) in &estimates {
-        let model = LinearVesselModel::new(dofs.clone(), est.m.clone(), est.d_bar.clone())
-            .map_err(|e| IdentifyError::invalid("model", format!("at {speed:.2} m/s: {e}")))?;
-        if let Ok(rep) = model.check_structure(1e-3) {
-            findings.extend(
-                rep.violations
-                    .iter()
-                    .map(|v| format!("at {speed:.2} m/s: {v}")),
-            );
-        }
+        let idx = grid.iter().position(|g| g == speed).unwrap_or(0);
+        let (load, load_std) = joint_load(est, n);
+        let physical = enforce(
+            &dofs,
+            est,
+            &load,
+            &exps[idx],
+            *speed,
+            settings.coriolis_from_m,
+        )?;
+        findings.extend(physical.findings);
+        let model = physical.model;
         for i in 0..n {
             for j in 0..n {
                 for (group, value, std, per_s) in [
-                    ("M", est.m[(i, j)], est.std_m[(i, j)], false),
-                    ("D̄", est.d_bar[(i, j)], est.std_d_bar[(i, j)], true),
+                    ("M", model.m()[(i, j)], est.std_m[(i, j)], false),
+                    ("D̄", model.d_bar()[(i, j)], est.std_d_bar[(i, j)], true),
                 ] {
                     if value != 0.0 || std > 0.0 {
                         parameters.push(ParameterRow {
@@ -443,20 +378,35 @@ pub fn identify_lambda_campaign(
                     }
                 }
             }
+            if settings.constant_loads {
+                parameters.push(ParameterRow {
+                    group: "b".into(),
+                    symbol: format!("b[{}]", dofs[i].name()),
+                    grid_speed_mps: Some(*speed),
+                    value: load[i],
+                    std: Some(load_std[i]),
+                    unit: force_unit(dofs[i]).into(),
+                });
+            }
         }
-        let idx = grid.iter().position(|g| g == speed).unwrap_or(0);
         lpv_points.push(LpvPoint {
             speed_mps: *speed,
-            m: to_rows(&est.m),
+            m: to_rows(model.m()),
             m_std: to_rows(&est.std_m),
-            d_bar: to_rows(&est.d_bar),
+            d_bar: to_rows(model.d_bar()),
             d_bar_std: to_rows(&est.std_d_bar),
-            a: to_rows(&est.a),
+            a: to_rows(model.a()),
             a_std: to_rows(&est.std_a),
-            b: to_rows(&est.b),
+            b: to_rows(model.b()),
             b_std: to_rows(&est.std_b),
+            load: settings
+                .constant_loads
+                .then(|| load.iter().copied().collect()),
+            load_std: settings
+                .constant_loads
+                .then(|| load_std.iter().copied().collect()),
             n_samples: est.n_samples,
-            run_ids: runs_per_point[idx].clone(),
+            run_ids: data.run_ids[idx].clone(),
             augmentation: None,
         });
         models.push(model);
@@ -472,7 +422,7 @@ pub fn identify_lambda_campaign(
         .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
         .with_scheduling(scheduling);
 
-    // Validation on the held-out runs.
+    // 4. Validation on the held-out runs.
     progress.update(0.85, "validating on held-out runs")?;
     let input_names: Vec<String> = dofs
         .iter()
@@ -485,17 +435,17 @@ pub fn identify_lambda_campaign(
     };
     let mut validation = Vec::new();
     for r in &roles.validation {
-        let segs = segments(r, cols_in, &outputs, 50)
+        let segs = segments(r, &cols, &outputs, 50)
             .map_err(|e| IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string()))?;
         let longest = segs
             .iter()
             .max_by_key(|s| s.y.nrows())
             .expect("segments is non-empty");
-        let (gamma, nu) = gamma_nu(longest, n, g)?;
+        let e = experiment(longest, n, g, None)?;
         let rec = ValidationRecord {
             h: longest.h,
-            u: &gamma,
-            y: &nu,
+            u: &e.gamma,
+            y: &e.nu,
         };
         let report = validate(&lpv, &rec, &vsettings)
             .map_err(|e| IdentifyError::invalid(format!("runs[{}]", r.run_id), e.to_string()))?;
@@ -508,7 +458,7 @@ pub fn identify_lambda_campaign(
     progress.update(1.0, "done")?;
 
     let coupling = (0..n)
-        .map(|i| (0..n).map(|j| mask_rows.a[(i, j)]).collect())
+        .map(|i| (0..n).map(|j| chosen.mask.a[(i, j)]).collect())
         .collect();
     let document = ModelDocument {
         kind: ModelKind::Lpv,
@@ -519,7 +469,7 @@ pub fn identify_lambda_campaign(
         restoring: restoring.map(|(_, d)| d),
         lpv: Some(LpvDoc {
             t_lambda_s: t_lambda,
-            structure: structure_name.into(),
+            structure: chosen.name.into(),
             coupling,
             points: lpv_points,
         }),
@@ -531,11 +481,65 @@ pub fn identify_lambda_campaign(
     };
     let mut used = settings.clone();
     used.t_lambda_s = Some(t_lambda);
+    let estimation_run_ids = {
+        let mut ids: Vec<String> = Vec::new();
+        for id in data.run_ids.iter().flatten() {
+            if !ids.contains(id) {
+                ids.push(id.clone());
+            }
+        }
+        ids
+    };
     Ok(Identified {
         document,
         validation,
-        estimation_run_ids: roles.estimation.iter().map(|r| r.run_id.clone()).collect(),
+        estimation_run_ids,
         validation_run_ids: roles.validation.iter().map(|r| r.run_id.clone()).collect(),
         settings_used: serde_json::to_value(&used).unwrap_or_default(),
     })
+}
+
+/// The constant load b and its std of an estimate (zero without loads).
+fn joint_load(est: &LambdaEstimate, n: usize) -> (DVector<f64>, DVector<f64>) {
+    load(est).unwrap_or_else(|| (DVector::zeros(n), DVector::zeros(n)))
+}
+
+/// The restoring document of the pooled estimate.
+fn restoring_doc(
+    pooled: &PooledRestoring,
+    joint: &[(f64, LambdaEstimate)],
+    holds: Option<&RestoringEstimate>,
+) -> RestoringDoc {
+    let row = |symbol: &str, p: &super::joint_restoring::Pooled, unit: &str| ParameterRow {
+        group: "g(η)".into(),
+        symbol: symbol.into(),
+        grid_speed_mps: None,
+        value: p.value,
+        std: Some(p.std),
+        unit: unit.into(),
+    };
+    let (wb, bg) = (&pooled.weight_minus_buoyancy, &pooled.metacentric);
+    let mut evidence = vec![format!(
+        "estimated with M, D̄ and the constant loads from every run where the attitude moves, at {} grid speeds; W − B from surge (sin θ) and sway (cos θ·sin φ): {} estimates, χ²/dof {:.2}; z_G·W − z_B·B from roll and pitch: {} estimates, χ²/dof {:.2}",
+        joint.len(),
+        wb.count,
+        wb.birge_ratio_sq,
+        bg.count,
+        bg.birge_ratio_sq
+    )];
+    if let Some(h) = holds {
+        evidence.push(format!(
+            "sharpened by {} steady segments of station-keeping attitude holds (W − B {:.1} ± {:.1} N, z_G·W − z_B·B {:.2} ± {:.2} N·m on their own)",
+            h.segments.len(),
+            h.params.weight_minus_buoyancy_n,
+            h.std.weight_minus_buoyancy_n,
+            h.params.zg_weight_minus_zb_buoyancy_nm,
+            h.std.zg_weight_minus_zb_buoyancy_nm
+        ));
+    }
+    RestoringDoc {
+        parameters: vec![row("W−B", wb, "N"), row("z_G·W − z_B·B", bg, "N·m")],
+        evidence,
+        params: pooled.params(),
+    }
 }

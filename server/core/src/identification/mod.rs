@@ -6,6 +6,9 @@
 //!   per grid speed, and the augmented model as its next version.
 //! - [`augmented`]: an LPV model with discovered terms as a predictor.
 //! - [`dataset`]: runs → segments (one per valid block, never concatenated).
+//! - [`describe`]: what a run is (role, grid speed, excited DOFs, signal),
+//!   inferred from its data; [`description`]: that, the plan and the
+//!   supervisor's word merged, each value with its source.
 //! - [`roles`]: static, estimation and held-out validation runs.
 //! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method.
 //! - [`n4sid_campaign`]: black-box LTI comparison model by N4SID.
@@ -14,24 +17,38 @@
 //! - [`discrete`]: ZOH matrices at a chosen h.
 //! - [`export`]: parameter CSV and the Fossen-form parameter set.
 //! - [`predictor`]: a stored model back as a predictor; validation on any run.
+//! - [`state_space`]: an N4SID model's restarted free runs from its Kalman
+//!   predictor state.
 //! - [`outcome`], [`error`]: what an identification returns.
 
 pub mod augmented;
 pub mod bis;
 pub mod dataset;
+pub mod describe;
+pub mod description;
 pub mod discover_campaign;
 pub mod discrete;
 pub mod document;
 pub mod ekf_campaign;
 pub mod error;
 pub mod export;
+mod joint_restoring;
 pub mod lambda_campaign;
+mod lambda_coriolis;
+mod lambda_data;
+mod lambda_physical;
+mod lambda_structure;
 pub mod n4sid_campaign;
 pub mod outcome;
 pub mod predictor;
 pub mod roles;
+pub mod state_space;
 
 pub use dataset::{DatasetError, RunInput, Segment, segments};
+pub use describe::{DescribeError, DofActivity, InferredDescription, infer_description};
+pub use description::{
+    PlanDescription, RunDescription, RunRole, RunSignal, Source, UserDescription, describe_run,
+};
 pub use discover_campaign::{CampaignDiscovery, DiscoverCampaignSettings, discover_campaign};
 pub use document::{Method, ModelDocument, ModelKind, ParameterRow};
 pub use ekf_campaign::{EkfCampaignSettings, identify_ekf_campaign};

@@ -11,6 +11,7 @@ use super::document::{Method, ModelDocument, ModelKind, ParameterRow, StateSpace
 use super::error::IdentifyError;
 use super::outcome::{Identified, RunValidation};
 use super::roles::assign_roles;
+use super::state_space::StateSpacePredictor;
 use crate::estimation::n4sid::{N4sidError, N4sidSettings, Weighting, n4sid};
 use crate::estimation::{Progress, SubProgress};
 use crate::planning::vessel::VesselProfile;
@@ -164,6 +165,7 @@ pub fn identify_n4sid_campaign(
         input_names: inputs.to_vec(),
         ..ValidationSettings::default()
     };
+    let predictor = StateSpacePredictor(model.clone());
     let mut validation = Vec::new();
     for r in &roles.validation {
         let vs = segments(r, inputs, &outputs, min_len)
@@ -173,8 +175,12 @@ pub fn identify_n4sid_campaign(
             .max_by_key(|s| s.y.nrows())
             .expect("segments is non-empty");
         let (u, y) = (centered(&longest.u, &u_mean), centered(&longest.y, &y_mean));
-        let report = validate(&model, &ValidationRecord { h, u: &u, y: &y }, &vsettings)
-            .map_err(|e| IdentifyError::invalid(format!("runs[{}]", r.run_id), e.to_string()))?;
+        let report = validate(
+            &predictor,
+            &ValidationRecord { h, u: &u, y: &y },
+            &vsettings,
+        )
+        .map_err(|e| IdentifyError::invalid(format!("runs[{}]", r.run_id), e.to_string()))?;
         validation.push(RunValidation {
             run_id: r.run_id.clone(),
             run_name: r.name.clone(),

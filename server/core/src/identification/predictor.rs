@@ -9,6 +9,7 @@ use super::bis::{BisScale, SiDpShip, unwrap_heading};
 use super::dataset::{RunInput, segments};
 use super::document::{ModelDocument, ModelKind, from_rows};
 use super::error::IdentifyError;
+use super::state_space::StateSpacePredictor;
 use crate::estimation::ekf::IdentifiedDpShip;
 use crate::estimation::n4sid::{N4sidModel, NoiseCovariances, Weighting};
 use crate::logs::schema::pose_column;
@@ -40,6 +41,7 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                         matrix(&p.m, "M")?,
                         matrix(&p.d_bar, "D̄")?,
                     )
+                    .and_then(|m| m.with_load(super::augmented::load_of(doc, p)))
                     .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?,
                 );
             }
@@ -55,7 +57,7 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                 .ok_or_else(|| IdentifyError::invalid("document.state_space", "missing"))?;
             let (a, c) = (matrix(&s.phi, "Φ")?, matrix(&s.c, "C")?);
             let (n, l) = (a.nrows(), c.nrows());
-            Ok(Box::new(N4sidModel {
+            Ok(Box::new(StateSpacePredictor(N4sidModel {
                 a,
                 b: matrix(&s.gamma, "Γ")?,
                 c,
@@ -75,7 +77,7 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                 state_covariance: DMatrix::zeros(n, n),
                 hankel_columns: 0,
                 output_names: doc.outputs.clone(),
-            }))
+            })))
         }
         ModelKind::DpShip => Ok(Box::new(dp_ship(doc)?)),
     }
@@ -196,19 +198,34 @@ pub fn validation_data(
     }
 }
 
-/// Validates a stored model on one run.
+/// Validates a stored model on one run with horizon `k` (other settings
+/// default).
 pub fn validate_on_run(
     doc: &ModelDocument,
     run: &RunInput,
     inputs: &[String],
     k: usize,
 ) -> Result<ValidationReport, IdentifyError> {
+    let settings = ValidationSettings {
+        k,
+        ..ValidationSettings::default()
+    };
+    validate_on_run_with(doc, run, inputs, settings)
+}
+
+/// Validates a stored model on one run with `settings` (the input names
+/// are the model's own).
+pub fn validate_on_run_with(
+    doc: &ModelDocument,
+    run: &RunInput,
+    inputs: &[String],
+    settings: ValidationSettings,
+) -> Result<ValidationReport, IdentifyError> {
     let model = predictor(doc)?;
     let (h, u, y) = validation_data(doc, run, inputs)?;
     let settings = ValidationSettings {
-        k,
         input_names: doc.inputs.clone(),
-        ..ValidationSettings::default()
+        ..settings
     };
     validate(
         model.as_ref(),

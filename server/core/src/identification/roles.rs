@@ -17,10 +17,13 @@ pub struct Roles<'a> {
 }
 
 /// Splits `runs`: the ids in `validation_run_ids` (or, when none are given,
-/// the runs of the plan's validation family) are held out; static runs go to
-/// restoring; everything else is estimation data. A validation run is
-/// required — a model is only stored with a test on data it was not fitted
-/// to.
+/// the runs whose family is validation) are held out; static runs go to
+/// restoring; everything else is estimation data. A run's family is its role
+/// as the supervisor described it, else its planned experiment's family,
+/// else the role inferred from its data ([`RunInput::family`]): a static or
+/// validation role from metadata counts exactly like the plan's. A
+/// validation run is required — a model is only stored with a test on data
+/// it was not fitted to.
 pub fn assign_roles<'a>(
     runs: &'a [RunInput],
     validation_run_ids: Option<&[String]>,
@@ -52,7 +55,7 @@ pub fn assign_roles<'a>(
     if roles.validation.is_empty() {
         return Err(IdentifyError::invalid(
             "settings.validation_run_ids",
-            "no validation run: fly the plan's validation experiment, or name held-out runs in settings.validation_run_ids",
+            "no validation run: fly the plan's validation experiment, set a run's role to validation (PATCH /api/runs/{id}), or name held-out runs in settings.validation_run_ids",
         ));
     }
     if roles.estimation.is_empty() {
@@ -83,6 +86,7 @@ mod tests {
             name: id.into(),
             family,
             grid_speed_mps: None,
+            excited_dofs: vec![],
             record: UniformRecord {
                 sample_rate_hz: 10.0,
                 t0: 0.0,
@@ -119,6 +123,27 @@ mod tests {
         assert_eq!(e.field(), "settings.validation_run_ids");
         let e = assign_roles(&runs[..2], None).unwrap_err();
         assert!(e.to_string().contains("no validation run"));
+    }
+
+    #[test]
+    fn a_role_from_the_supervisor_counts_like_the_plans_family() {
+        use crate::identification::description::{RunRole, UserDescription, describe_run};
+        let said = |role| {
+            let user = UserDescription {
+                role: Some(role),
+                ..UserDescription::default()
+            };
+            describe_run(&user, None, None).family
+        };
+        let runs = vec![
+            run("s", said(RunRole::Static)),
+            run("d", said(RunRole::Dynamic)),
+            run("v", said(RunRole::Validation)),
+        ];
+        let r = assign_roles(&runs, None).unwrap();
+        assert_eq!(r.statics[0].run_id, "s");
+        assert_eq!(r.estimation[0].run_id, "d");
+        assert_eq!(r.validation[0].run_id, "v");
     }
 
     #[test]

@@ -77,6 +77,7 @@ pub(crate) fn to_run(
         name: id.into(),
         family: Some(family),
         grid_speed_mps: grid,
+        excited_dofs: vec![],
         record: UniformRecord {
             sample_rate_hz: 1.0 / H,
             t0: 0.0,

@@ -221,7 +221,8 @@ impl LpvModel {
             l.dofs().to_vec(),
             blend(w.w_lower, l.m(), u.m()),
             blend(w.w_lower, l.d_bar(), u.d_bar()),
-        )
+        )?
+        .with_load(l.load() * w.w_lower + u.load() * (1.0 - w.w_lower))
     }
 
     /// Every sub-model discretized (ZOH) at sample time `h` (s).
@@ -285,7 +286,8 @@ impl DiscreteLpv {
             l.c().clone(),
             l.d().clone(),
             l.h(),
-        )
+        )?
+        .with_offset(l.offset() * w.w_lower + u.offset() * (1.0 - w.w_lower))
     }
 
     /// x̂(k+1 | k) from ν(k) = `x` and γ(k) = `u`, scheduled on the surge

@@ -4,9 +4,11 @@
 //! - [`state_space`]: continuous (A, B, C, D) models, exact ZOH
 //!   discretization to (Φ, Γ), poles, discrete simulation.
 //! - [`vessel`]: the thesis's M ν̇ + D̄ ν = γ with γ = τ − g(η)
-//!   (eq. 2.9–2.12), A = −M⁻¹D̄, B = M⁻¹; a [`Predictor`](crate::validation::Predictor).
+//!   (eq. 2.9–2.12), A = −M⁻¹D̄, B = M⁻¹, with an optional constant load b;
+//!   a [`Predictor`](crate::validation::Predictor).
 //! - [`structure`]: physical plausibility of M and D̄ (symmetry, positive
 //!   definiteness, dissipativity) in words.
+//! - [`projection`]: the nearest physical (M, D̄) when an estimate is not.
 //! - [`coriolis`]: C(ν) from M (Fossen 2011, eq. 6.43), 6-DOF and 3-DOF.
 //! - [`lpv`]: sub-models on a forward-speed grid, nearest (eq. 2.17) or
 //!   interpolated (eq. 2.18) scheduling; a `Predictor` scheduled on u.
@@ -17,6 +19,7 @@ pub mod coriolis;
 pub mod error;
 pub mod lpv;
 mod predict;
+pub mod projection;
 pub mod state_space;
 pub mod structure;
 pub mod vessel;
@@ -24,6 +27,7 @@ pub mod vessel;
 pub use coriolis::{coriolis, coriolis_3dof, coriolis_6dof, skew};
 pub use error::ModelError;
 pub use lpv::{DiscreteLpv, LpvModel, ScheduleWeights, Scheduling};
+pub use projection::{Projection, project_physical};
 pub use state_space::{DiscreteStateSpace, StateSpace};
 pub use structure::StructureReport;
 pub use vessel::LinearVesselModel;

@@ -19,8 +19,10 @@ pub struct StateSpace {
     d: DMatrix<f64>,
 }
 
-/// Discrete-time x(k+1) = Φ x(k) + Γ u(k), y(k) = C x(k) + D u(k) with the
-/// input held constant over each sample interval of length h.
+/// Discrete-time x(k+1) = Φ x(k) + Γ u(k) + w, y(k) = C x(k) + D u(k) with
+/// the input held constant over each sample interval of length h; the
+/// constant w (zero unless set) carries a constant load, w = −Γ·b for
+/// M ν̇ + D̄ ν + b = γ.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DiscreteStateSpace {
     phi: DMatrix<f64>,
@@ -28,6 +30,7 @@ pub struct DiscreteStateSpace {
     c: DMatrix<f64>,
     d: DMatrix<f64>,
     h: f64,
+    offset: DVector<f64>,
 }
 
 /// Validates the four matrices of a state-space model named `names`
@@ -122,6 +125,7 @@ impl StateSpace {
         check_finite("Φ = e^{Ah}", phi.iter())?;
         check_finite("Γ", gamma.iter())?;
         Ok(DiscreteStateSpace {
+            offset: DVector::zeros(n),
             phi,
             gamma,
             c: self.c.clone(),
@@ -148,13 +152,35 @@ impl DiscreteStateSpace {
     ) -> Result<Self, ModelError> {
         check_sample_time(h)?;
         check_quadruple(["Φ", "Γ", "C", "D"], &phi, &gamma, &c, &d)?;
+        let offset = DVector::zeros(phi.nrows());
         Ok(DiscreteStateSpace {
             phi,
             gamma,
             c,
             d,
             h,
+            offset,
         })
+    }
+
+    /// The same model with the constant state increment w (n entries,
+    /// finite).
+    pub fn with_offset(mut self, w: DVector<f64>) -> Result<Self, ModelError> {
+        if w.len() != self.n_states() {
+            return Err(ModelError::Shape {
+                name: "w".into(),
+                expected: format!("{}×1 (one entry per state)", self.n_states()),
+                found: (w.len(), 1),
+            });
+        }
+        check_finite("w", w.iter())?;
+        self.offset = w;
+        Ok(self)
+    }
+
+    /// Constant state increment w per step (zero for a linear model).
+    pub fn offset(&self) -> &DVector<f64> {
+        &self.offset
     }
 
     /// Transition matrix Φ (n × n).
@@ -195,9 +221,9 @@ impl DiscreteStateSpace {
         self.phi.complex_eigenvalues().iter().copied().collect()
     }
 
-    /// One step x(k+1) = Φ x(k) + Γ u(k) (shapes are the caller's duty).
+    /// One step x(k+1) = Φ x(k) + Γ u(k) + w (shapes are the caller's duty).
     pub(crate) fn step(&self, x: &DVector<f64>, u: &DVector<f64>) -> DVector<f64> {
-        &self.phi * x + &self.gamma * u
+        &self.phi * x + &self.gamma * u + &self.offset
     }
 
     /// Response from x(0) = `x0` to the inputs `u` (N × m, row k held over

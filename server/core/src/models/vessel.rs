@@ -14,8 +14,11 @@ use crate::validation::{Predictor, ValidationRecord};
 /// Reciprocal condition number below which M (or B) counts as singular.
 const RCOND_MIN: f64 = 1e-13;
 
-/// M ν̇ + D̄ ν = γ over the modelled `dofs` (rows and columns of M and D̄ in
-/// that order). Inputs are γ = τ − g(η) per DOF, outputs the measured ν.
+/// M ν̇ + D̄ ν + b = γ over the modelled `dofs` (rows and columns of M and
+/// D̄ in that order). Inputs are γ = τ − g(η) per DOF, outputs the measured
+/// ν. The constant load b (zero unless set) holds what is constant at the
+/// operating point: a tether's pull, the heave part of W − B, and the offset
+/// of the linearization of the damping about the forward speed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearVesselModel {
     dofs: Vec<Dof>,
@@ -23,6 +26,7 @@ pub struct LinearVesselModel {
     d_bar: DMatrix<f64>,
     a: DMatrix<f64>,
     b: DMatrix<f64>,
+    load: DVector<f64>,
 }
 
 /// Rejects an empty DOF list or a repeated DOF.
@@ -79,12 +83,33 @@ impl LinearVesselModel {
         let a = -&b * &d_bar;
         check_finite("A = −M⁻¹D̄", a.iter())?;
         Ok(LinearVesselModel {
+            load: DVector::zeros(n),
             dofs,
             m,
             d_bar,
             a,
             b,
         })
+    }
+
+    /// The same model with the constant load b (one entry per DOF, N or
+    /// N·m, finite).
+    pub fn with_load(mut self, load: DVector<f64>) -> Result<Self, ModelError> {
+        if load.len() != self.dofs.len() {
+            return Err(ModelError::Shape {
+                name: "b".into(),
+                expected: format!("{}×1 (one entry per modelled DOF)", self.dofs.len()),
+                found: (load.len(), 1),
+            });
+        }
+        check_finite("b", load.iter())?;
+        self.load = load;
+        Ok(self)
+    }
+
+    /// Constant load b (N, N·m), zero unless set.
+    pub fn load(&self) -> &DVector<f64> {
+        &self.load
     }
 
     /// The model from identified A and B: M = B⁻¹, D̄ = −M A (inverting
@@ -136,10 +161,13 @@ impl LinearVesselModel {
         .expect("shapes are consistent by construction")
     }
 
-    /// ZOH discretization at sample time `h` (s).
+    /// ZOH discretization at sample time `h` (s); the load enters as the
+    /// constant increment w = −Γ·b.
     pub fn discretize(&self, h: f64) -> Result<DiscreteStateSpace, ModelError> {
         check_sample_time(h)?;
-        self.to_state_space().discretize_zoh(h)
+        let d = self.to_state_space().discretize_zoh(h)?;
+        let w = -(d.gamma() * &self.load);
+        d.with_offset(w)
     }
 
     /// Physical plausibility: M symmetric positive definite, D̄ dissipative

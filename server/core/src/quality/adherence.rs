@@ -49,9 +49,15 @@ pub(crate) fn adherence(
 ) -> Result<Adherence, QualityError> {
     let plan = resample(schedule, schedule_rate_hz, fs);
     let fit = best_lag(log, blocks, &plan)?;
-    let followed = fit.correlation >= MIN_ADHERENCE_CORRELATION
-        && (AMPLITUDE_RATIO_RANGE[0]..=AMPLITUDE_RATIO_RANGE[1]).contains(&fit.amplitude_ratio)
-        && fit.coverage >= MIN_COVERAGE;
+    let ratio_ok = fit
+        .amplitude_ratio
+        .is_some_and(|r| (AMPLITUDE_RATIO_RANGE[0]..=AMPLITUDE_RATIO_RANGE[1]).contains(&r));
+    let followed =
+        fit.correlation >= MIN_ADHERENCE_CORRELATION && ratio_ok && fit.coverage >= MIN_COVERAGE;
+    let ratio_text = fit.amplitude_ratio.map_or_else(
+        || "undefined (the schedule holds one value)".to_owned(),
+        num,
+    );
     let lag_s = fit.lag as f64 / fs;
     let message = if followed {
         format!(
@@ -59,7 +65,7 @@ pub(crate) fn adherence(
              correlation {}, amplitude ratio {}, coverage {}",
             num(lag_s),
             num(fit.correlation),
-            num(fit.amplitude_ratio),
+            ratio_text,
             pct(fit.coverage)
         )
     } else {
@@ -71,13 +77,16 @@ pub(crate) fn adherence(
                 MIN_ADHERENCE_CORRELATION
             ));
         }
-        if !(AMPLITUDE_RATIO_RANGE[0]..=AMPLITUDE_RATIO_RANGE[1]).contains(&fit.amplitude_ratio) {
-            why.push(format!(
-                "amplitude ratio {} outside {}–{}",
-                num(fit.amplitude_ratio),
-                AMPLITUDE_RATIO_RANGE[0],
-                AMPLITUDE_RATIO_RANGE[1]
-            ));
+        if !ratio_ok {
+            why.push(match fit.amplitude_ratio {
+                Some(r) => format!(
+                    "amplitude ratio {} outside {}–{}",
+                    num(r),
+                    AMPLITUDE_RATIO_RANGE[0],
+                    AMPLITUDE_RATIO_RANGE[1]
+                ),
+                None => format!("amplitude ratio {ratio_text}"),
+            });
         }
         if fit.coverage < MIN_COVERAGE {
             why.push(format!(
@@ -120,10 +129,17 @@ pub(crate) struct Fit {
     /// Log index of the schedule's first sample.
     pub lag: i64,
     pub correlation: f64,
-    pub amplitude_ratio: f64,
-    pub nrmse: f64,
+    /// `None` when the schedule holds one value over the overlap.
+    pub amplitude_ratio: Option<f64>,
+    pub nrmse: Option<f64>,
     pub coverage: f64,
 }
+
+/// A schedule whose spread over the overlap is below this fraction of its
+/// level and of the log's spread holds one value (interpolation leaves
+/// rounding noise ~1e-16 of the level, which must not become a ratio of
+/// 1e12).
+const CONSTANT_SCHEDULE: f64 = 1e-9;
 
 /// Slides `plan` (M samples) along `log` (N samples, valid on `blocks`) and
 /// returns the lag of the largest Pearson correlation over the overlap.
@@ -233,8 +249,8 @@ fn fit_at(log: &[f64], mask: &[f64], plan: &[f64], lag: i64, correlation: f64) -
         return Fit {
             lag,
             correlation,
-            amplitude_ratio: 0.0,
-            nrmse: f64::INFINITY,
+            amplitude_ratio: None,
+            nrmse: None,
             coverage,
         };
     }
@@ -247,12 +263,10 @@ fn fit_at(log: &[f64], mask: &[f64], plan: &[f64], lag: i64, correlation: f64) -
     }
     let (sd_a, sd_p) = ((va / cnt).sqrt(), (vp / cnt).sqrt());
     let rmse = (se / cnt).sqrt();
-    let (amplitude_ratio, nrmse) = if sd_p > 0.0 {
-        (sd_a / sd_p, rmse / sd_p)
-    } else if rmse == 0.0 {
-        (1.0, 0.0)
+    let (amplitude_ratio, nrmse) = if sd_p > CONSTANT_SCHEDULE * (mp.abs() + sd_a) {
+        (Some(sd_a / sd_p), Some(rmse / sd_p))
     } else {
-        (f64::INFINITY, f64::INFINITY)
+        (None, None)
     };
     Fit {
         lag,
@@ -389,6 +403,26 @@ mod tests {
         let plan: Vec<f64> = (0..50).map(|j| (j as f64).sin()).collect();
         let fit = best_lag(&[2.0; 100], &[0..100], &plan).unwrap();
         assert_eq!(fit.correlation, 0.0);
-        assert_eq!(fit.amplitude_ratio, 0.0);
+        assert_eq!(fit.amplitude_ratio, Some(0.0));
+    }
+
+    #[test]
+    fn a_hold_has_no_amplitude_ratio_rather_than_1e12() {
+        // A held level with the rounding noise of interpolation (1e-16 of
+        // the level) against a log that moves about it.
+        let plan: Vec<f64> = (0..100)
+            .map(|j| 250.0 * (1.0 + 1e-16 * ((j % 3) as f64 - 1.0)))
+            .collect();
+        let log: Vec<f64> = (0..100).map(|t| 250.0 + 3.0 * (t as f64).sin()).collect();
+        let fit = best_lag(&log, &[0..100], &plan).unwrap();
+        assert_eq!((fit.amplitude_ratio, fit.nrmse), (None, None));
+        let a = adherence("tau_X", "surge_hold", &log, &[0..100], 1.0, &plan, 1.0).unwrap();
+        assert!(!a.followed);
+        assert!(
+            a.message
+                .contains("amplitude ratio undefined (the schedule holds one value)"),
+            "{}",
+            a.message
+        );
     }
 }

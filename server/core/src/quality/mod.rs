@@ -350,11 +350,13 @@ pub struct Adherence {
     pub lag_s: f64,
     /// Pearson correlation of log and schedule over their overlap at the lag.
     pub correlation: f64,
-    /// Standard deviation of the log over that of the schedule, at the lag.
-    pub amplitude_ratio: f64,
+    /// Standard deviation of the log over that of the schedule, at the lag;
+    /// `None` when the schedule does not vary over the overlap (a hold) or
+    /// nothing overlaps: there is no amplitude to compare.
+    pub amplitude_ratio: Option<f64>,
     /// RMS of (log − schedule) over the schedule's standard deviation, at
-    /// the lag (an offset between them counts).
-    pub nrmse: f64,
+    /// the lag (an offset between them counts); `None` likewise.
+    pub nrmse: Option<f64>,
     /// Fraction of the schedule's samples that fall on valid log samples.
     pub coverage: f64,
     /// `correlation ≥ MIN_ADHERENCE_CORRELATION`, amplitude ratio within

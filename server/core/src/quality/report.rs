@@ -132,6 +132,7 @@ pub fn quality_report(
             adherence: &adherences,
             regressor: &regressor.report,
             own_rank,
+            planned: spec.planned.is_some(),
         }));
     }
 

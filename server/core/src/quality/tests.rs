@@ -315,9 +315,9 @@ fn constant_input_is_insufficient_and_named() {
         "{}",
         d.reason
     );
+    // No plan: nothing to repeat, and not exciting a DOF is no failure of the run.
     assert!(
-        d.reason
-            .contains("repeat it following the planned schedule"),
+        d.reason.contains("fly a run that excites it") && !d.reason.contains("planned schedule"),
         "{}",
         d.reason
     );
@@ -636,8 +636,8 @@ fn plan_adherence_finds_the_lag_and_flags_half_amplitude() {
         assert!((a.lag_s - lag_s).abs() <= 0.15, "lag {}", a.lag_s);
         assert!(a.correlation > 0.95, "r {}", a.correlation);
         assert!(
-            (a.amplitude_ratio - gain).abs() < 0.05 * gain,
-            "ratio {}",
+            (a.amplitude_ratio.unwrap() - gain).abs() < 0.05 * gain,
+            "ratio {:?}",
             a.amplitude_ratio
         );
         assert!((a.coverage - 1.0).abs() < 1e-9, "coverage {}", a.coverage);
@@ -645,7 +645,7 @@ fn plan_adherence_finds_the_lag_and_flags_half_amplitude() {
         let d = &r.dofs[0];
         assert_eq!(d.evidence.plan_followed, Some(followed));
         if followed {
-            assert!(a.nrmse < 0.3, "nrmse {}", a.nrmse);
+            assert!(a.nrmse.unwrap() < 0.3, "nrmse {:?}", a.nrmse);
             assert_eq!(d.verdict, Verdict::Good, "{}", d.reason);
         } else {
             assert!(a.message.contains("amplitude ratio 0.49"), "{}", a.message);

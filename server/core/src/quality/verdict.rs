@@ -8,7 +8,8 @@
 //! 1. the DOF's input is not excited: PE order < [`MIN_PE_ORDER`], or its
 //!    RMS about the mean is ≤ [`FLAT_INPUT_RELATIVE_RMS`] × |mean| (0 for a
 //!    zero-mean input), or its PSD has no usable band — action: repeat the
-//!    run following the planned schedule;
+//!    run following the planned schedule (a run matched to no planned
+//!    experiment: fly one that excites the DOF, if it is to be identified);
 //! 2. the record gives fewer than [`MIN_SEGMENTS`] Welch segments
 //!    (coherence of one segment is 1 whatever the data) — action: log
 //!    longer continuous data;
@@ -23,7 +24,9 @@
 //!    median ≥ 0.5 *is* coherence ≥ 0.5 over half the band — so it uses the
 //!    "good" level 0.8: Good needs coherence ≥ 0.8 over half the band.);
 //! 5. the input's Nyquist warning fires;
-//! 6. a planned column of the DOF (its input or output) was not followed;
+//! 6. a planned column of the DOF (its input or output) was not followed
+//!    (only for a run matched to a planned experiment: a run flown without
+//!    a plan has no adherence to fail);
 //! 7. the full regressor has fewer identifiable parameters than columns
 //!    *because of the inputs*: one of its deficient directions lies mostly
 //!    (≥ [`MIN_INPUT_SHARE`] of its energy) on input columns and involves
@@ -76,6 +79,10 @@ pub const MIN_INPUT_SHARE: f64 = 0.5;
 pub const FLAT_INPUT_RELATIVE_RMS: f64 = 1e-6;
 
 const ACT_REPEAT: &str = "repeat it following the planned schedule";
+/// The action for an input that is not excited in a run matched to no
+/// planned experiment: there is no schedule to repeat, and a run flown for
+/// other DOFs is no failure of this one.
+const ACT_EXCITE: &str = "if this DOF is to be identified, fly a run that excites it (the run is matched to no planned experiment)";
 const ACT_SNR: &str = "fly it again with twice the amplitude or a slower PRBS clock";
 const ACT_NYQUIST: &str = "log the inputs at the controller rate";
 const ACT_INDEPENDENT: &str =
@@ -93,6 +100,8 @@ pub(crate) struct DofContext<'a> {
     pub regressor: &'a RegressorReport,
     /// Identifiable parameters and columns of the DOF's own regressor.
     pub own_rank: (usize, usize),
+    /// The run was matched to a planned experiment (a schedule to follow).
+    pub planned: bool,
 }
 
 /// Coherence over the usable band.
@@ -253,9 +262,10 @@ pub(crate) fn judge(ctx: &DofContext<'_>) -> DofVerdict {
         issues.push((
             Verdict::Insufficient,
             format!(
-                "the input {} {what} ({}); the run holds no dynamic information — {ACT_REPEAT}",
+                "the input {} {what} ({}); the run holds no dynamic information — {}",
                 d.input,
-                describe(q)
+                describe(q),
+                if ctx.planned { ACT_REPEAT } else { ACT_EXCITE }
             ),
         ));
     }

@@ -2,25 +2,10 @@
 //! report.
 
 /// `x` with three significant digits, trailing zeros removed: `0.31`,
-/// `12.3`, `410`, `5`; scientific notation outside `1e-4 ..= 1e6`.
+/// `12.3`, `410`, `5`, `−0.0123`, `2.5e7`; `—` when not finite (the one
+/// formatter of [`crate::numbers::sig3`]).
 pub(crate) fn num(x: f64) -> String {
-    if x == 0.0 {
-        return "0".into();
-    }
-    if !x.is_finite() {
-        return format!("{x}");
-    }
-    let mag = x.abs().log10().floor();
-    if !(-4.0..6.0).contains(&mag) {
-        return format!("{x:.2e}");
-    }
-    let decimals = (2.0 - mag).max(0.0) as usize;
-    let s = format!("{x:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_owned()
-    } else {
-        s
-    }
+    crate::numbers::sig3(x)
 }
 
 /// A fraction as a whole percentage: `0.234` → `23 %`.
@@ -44,9 +29,9 @@ mod tests {
         assert_eq!(num(12.345), "12.3");
         assert_eq!(num(409.6), "410");
         assert_eq!(num(5.0), "5");
-        assert_eq!(num(-0.0123456), "-0.0123");
-        assert_eq!(num(2.5e7), "2.50e7");
-        assert_eq!(num(f64::INFINITY), "inf");
+        assert_eq!(num(-0.0123456), "−0.0123");
+        assert_eq!(num(2.5e7), "2.5e7");
+        assert_eq!(num(f64::INFINITY), "—");
         assert_eq!(pct(0.234), "23 %");
         assert_eq!(band([0.02, 0.6]), "0.02–0.6 Hz");
     }

@@ -30,4 +30,43 @@ pub trait Predictor {
     /// Free-run simulation ŷ(t) from the record's initial condition on the
     /// recorded inputs alone (thesis eq. 2.20–2.21), N × p.
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64>;
+
+    /// Free runs restarted from the measured (or estimated) state every
+    /// `every` samples (≥ 1), N × p: rows of window [s, s + every) are the
+    /// simulation started at s on the recorded inputs (see
+    /// [`restart_windows`]).
+    ///
+    /// The default simulates each window as a record of its own, so a model
+    /// whose [`Predictor::simulate`] starts from the measured state of the
+    /// record's first sample needs nothing more; a model with an estimated
+    /// state (Kalman filter, EKF) should restart from the state its filter
+    /// holds at s, using no sample after s.
+    fn simulate_restarted(&self, rec: &ValidationRecord<'_>, every: usize) -> DMatrix<f64> {
+        let (n, p) = (rec.y.nrows(), self.output_names().len());
+        let mut out = DMatrix::from_element(n, p, f64::NAN);
+        for (start, end) in restart_windows(n, every) {
+            let u = rec.u.rows(start, end - start).into_owned();
+            let y = rec.y.rows(start, end - start).into_owned();
+            let sim = self.simulate(&ValidationRecord {
+                h: rec.h,
+                u: &u,
+                y: &y,
+            });
+            if sim.shape() != (end - start, p) {
+                continue;
+            }
+            out.rows_mut(start, end - start).copy_from(&sim);
+        }
+        out
+    }
+}
+
+/// The windows [s, s + every) of a record of `n` samples restarted every
+/// `every` samples (the last one may be shorter).
+pub fn restart_windows(n: usize, every: usize) -> Vec<(usize, usize)> {
+    let every = every.max(1);
+    (0..n)
+        .step_by(every)
+        .map(|s| (s, (s + every).min(n)))
+        .collect()
 }

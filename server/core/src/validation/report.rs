@@ -1,21 +1,24 @@
 //! One call that validates an identified model on a record (thesis sec.
 //! 2.6): per output channel the NRMSE fits (eq. 1.13) of 1-step predictions
-//! (eq. 2.16/2.18), k-step predictions and free-run simulation (eq.
-//! 2.20–2.21), the residual analysis of the 1-step and k-step errors (eq.
-//! 2.19), input–residual cross-correlations, and thinned series to plot.
+//! (eq. 2.16/2.18), k-step predictions, free runs restarted from the
+//! measured state every `restart_s` and the whole-record free-run
+//! simulation (eq. 2.20–2.21); where a prediction diverged (see
+//! [`super::divergence`]); the residual analysis of the 1-step and k-step
+//! errors (eq. 2.19), input–residual cross-correlations, and thinned series
+//! to plot.
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
+use super::channel::{Checked, check_free_run, check_k_step, check_restarted, residual};
+use super::divergence::{Channel, Divergence, PlausibleBand, channel_words};
 use super::error::ValidationError;
-use super::metrics::nrmse_fit;
 use super::predictor::{Predictor, ValidationRecord};
 use super::residuals::{
     CrossCorrelation, ResidualAnalysis, ResidualSettings, analyze_residuals,
     input_residual_correlation,
 };
-use super::verdict::{Fits, channel_findings};
-
+use super::verdict::{Facts, channel_findings};
 /// What [`validate`] computes.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
@@ -34,6 +37,11 @@ pub struct ValidationSettings {
     /// this many for display).
     #[serde(default = "default_plot_points")]
     pub plot_points: usize,
+    /// Period of the restarted free runs (s): the model is started again
+    /// from the measured state every `restart_s` (10 s, the window engineers
+    /// judge controllers over), rounded to whole samples.
+    #[serde(default = "default_restart_s")]
+    pub restart_s: f64,
     /// Keep every sample in the plotted series.
     #[serde(default)]
     pub full_resolution: bool,
@@ -45,6 +53,9 @@ pub struct ValidationSettings {
 
 fn default_k() -> usize {
     10
+}
+fn default_restart_s() -> f64 {
+    10.0
 }
 fn default_max_lag() -> usize {
     50
@@ -63,16 +74,16 @@ impl Default for ValidationSettings {
             max_lag: default_max_lag(),
             confidence: default_confidence(),
             plot_points: default_plot_points(),
+            restart_s: default_restart_s(),
             full_resolution: false,
             input_names: Vec::new(),
         }
     }
 }
 
-/// The validation of a model on one record.
-///
-/// Non-finite numbers (predictions that do not exist, e.g. the first k
-/// samples of a k-step prediction) serialize as `null` with `serde_json`.
+/// The validation of a model on one record. Every number is finite: a
+/// prediction that diverged is cut where it left the plausible range and
+/// its fit is `None` (see [`Divergence`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 pub struct ValidationReport {
@@ -82,6 +93,9 @@ pub struct ValidationReport {
     pub n_samples: usize,
     /// Horizon of the k-step predictions.
     pub k: usize,
+    /// Period of the restarted free runs as used: a whole number of samples
+    /// (s).
+    pub restart_s: f64,
     /// Largest correlation lag.
     pub max_lag: usize,
     /// Confidence level of bounds and tests.
@@ -99,16 +113,27 @@ pub struct ChannelValidation {
     /// Output name (from the model).
     pub output: String,
     /// NRMSE fit (eq. 1.13) of the 1-step predictions; 1 is perfect, 0 no
-    /// better than the mean. `None` when undefined (constant output).
+    /// better than the mean. `None` when undefined (constant output) or the
+    /// prediction diverged.
     pub fit_one_step: Option<f64>,
-    /// NRMSE fit of the k-step predictions.
+    /// NRMSE fit of the k-step predictions (`None` likewise).
     pub fit_k_step: Option<f64>,
-    /// NRMSE fit of the free-run simulation.
+    /// NRMSE fit of the free runs restarted every `restart_s`, over the
+    /// windows that did not diverge (`None` when all did).
+    pub fit_restarted: Option<f64>,
+    /// NRMSE fit of the whole-record free-run simulation (`None` when it
+    /// diverged).
     pub fit_simulation: Option<f64>,
-    /// Residual analysis of the 1-step errors e(t) = y(t) − ŷ(t|t−1).
-    pub one_step: ResidualAnalysis,
-    /// Residual analysis of the k-step errors, judged beyond lag k − 1.
-    pub k_step: ResidualAnalysis,
+    /// The restarted free runs: windows and how many diverged.
+    pub restarted: RestartedWindows,
+    /// Where each prediction left the plausible range, if it did.
+    pub diverged: Divergences,
+    /// Residual analysis of the 1-step errors e(t) = y(t) − ŷ(t|t−1);
+    /// `None` when the 1-step prediction diverged.
+    pub one_step: Option<ResidualAnalysis>,
+    /// Residual analysis of the k-step errors, judged beyond lag k − 1;
+    /// `None` when the k-step prediction diverged.
+    pub k_step: Option<ResidualAnalysis>,
     /// Cross-correlation of each input with the 1-step errors.
     pub input_correlations: Vec<CrossCorrelation>,
     /// The 1-step residuals pass the whiteness test.
@@ -121,8 +146,34 @@ pub struct ChannelValidation {
     pub plot: ChannelPlot,
 }
 
+/// The windows of the restarted free runs of one channel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct RestartedWindows {
+    /// Windows in the record (the last may be shorter).
+    pub windows: usize,
+    /// Windows whose free run left the plausible range; left out of
+    /// `fit_restarted`.
+    pub diverged: usize,
+}
+
+/// Where the predictions of a channel diverged (`None`: they did not).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct Divergences {
+    /// First implausible 1-step prediction.
+    pub one_step: Option<Divergence>,
+    /// First implausible k-step prediction.
+    pub k_step: Option<Divergence>,
+    /// The first restarted window that diverged.
+    pub restarted: Option<Divergence>,
+    /// The whole-record free run.
+    pub simulation: Option<Divergence>,
+}
+
 /// Measured, predicted and simulated series of a channel on a common,
-/// possibly thinned, time grid.
+/// possibly thinned, time grid. Predictions are `null` where none exists
+/// (the first k rows of a k-step prediction) and after a divergence.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 pub struct ChannelPlot {
@@ -132,20 +183,20 @@ pub struct ChannelPlot {
     pub time_s: Vec<f64>,
     /// Measured y.
     pub measured: Vec<f64>,
-    /// 1-step predictions ŷ(t|t−1) (null where none exists).
-    #[cfg_attr(feature = "openapi", schema(value_type = Vec<Option<f64>>))]
-    pub one_step: Vec<f64>,
-    /// k-step predictions ŷ(t|t−k) (null where none exists).
-    #[cfg_attr(feature = "openapi", schema(value_type = Vec<Option<f64>>))]
-    pub k_step: Vec<f64>,
-    /// Free-run simulation.
-    #[cfg_attr(feature = "openapi", schema(value_type = Vec<Option<f64>>))]
-    pub simulated: Vec<f64>,
+    /// 1-step predictions ŷ(t|t−1).
+    pub one_step: Vec<Option<f64>>,
+    /// k-step predictions ŷ(t|t−k).
+    pub k_step: Vec<Option<f64>>,
+    /// Free runs restarted from the measured state every `restart_s`.
+    pub restarted: Vec<Option<f64>>,
+    /// Whole-record free-run simulation.
+    pub simulated: Vec<Option<f64>>,
 }
 
-/// Validate `model` on `rec`: fits, residual tests and plot data per output
-/// channel. Errors name the offending field; the model's predictions are
-/// checked for shape and for NaN inside the record.
+/// Validate `model` on `rec`: fits, divergence, residual tests and plot
+/// data per output channel. Errors name the offending field; a model whose
+/// k-step predictions are all missing (wrong record shape) is an error, a
+/// prediction that blows up is a finding.
 pub fn validate(
     model: &dyn Predictor,
     rec: &ValidationRecord<'_>,
@@ -153,12 +204,15 @@ pub fn validate(
 ) -> Result<ValidationReport, ValidationError> {
     let (n, p) = check_record(model, rec, settings)?;
     let inputs = input_names(rec.u.ncols(), settings)?;
+    let every = restart_samples(settings.restart_s, rec.h);
     let one = model.predict_k_step(rec, 1);
     let kstep = model.predict_k_step(rec, settings.k);
+    let restarted = model.simulate_restarted(rec, every);
     let sim = model.simulate(rec);
     for (field, m) in [
         ("predict_k_step(1)", &one),
         ("predict_k_step(k)", &kstep),
+        ("simulate_restarted", &restarted),
         ("simulate", &sim),
     ] {
         if m.shape() != (n, p) {
@@ -173,7 +227,6 @@ pub fn validate(
         }
     }
     let names = model.output_names();
-    let alpha = 1.0 - settings.confidence;
     let stride = if settings.full_resolution {
         1
     } else {
@@ -184,73 +237,158 @@ pub fn validate(
     for (j, name) in names.iter().enumerate() {
         let y = rec.y.column(j);
         let y = y.as_slice();
-        let (c1, c2, cs) = (one.column(j), kstep.column(j), sim.column(j));
-        let (c1, c2, cs) = (c1.as_slice(), c2.as_slice(), cs.as_slice());
-        let (start1, e1) = residual(y, c1, "predict_k_step(1)")?;
-        let (_, ek) = residual(y, c2, "predict_k_step(k)")?;
-        let base = ResidualSettings {
-            max_lag: settings.max_lag,
-            ma_order: 0,
-            confidence: settings.confidence,
-            plot_points: 200,
+        let ch = Channel {
+            output: name,
+            y,
+            h: rec.h,
+            band: PlausibleBand::of(y),
         };
-        let one_step = analyze_residuals(&e1, &base, &format!("{name} 1-step residual"))?;
-        let k_settings = ResidualSettings {
-            ma_order: settings.k - 1,
-            ..base
+        let col = |m: &DMatrix<f64>| m.column(j).iter().copied().collect::<Vec<f64>>();
+        let preds = Predictions {
+            one: check_k_step(&ch, &col(&one), 1, "predict_k_step(1)")?,
+            k: check_k_step(&ch, &col(&kstep), settings.k, "predict_k_step(k)")?,
+            restarted: check_restarted(&ch, &col(&restarted), every),
+            sim: check_free_run(&ch, &col(&sim)),
         };
-        let k_step = analyze_residuals(&ek, &k_settings, &format!("{name} k-step residual"))?;
-        let input_correlations: Vec<CrossCorrelation> = inputs
-            .iter()
-            .enumerate()
-            .filter_map(|(i, input)| {
-                let col = rec.u.column(i);
-                let u = &col.as_slice()[start1..];
-                input_residual_correlation(&e1, u, input, settings.max_lag, settings.confidence)
-            })
-            .collect();
-        let fit_simulation = nrmse_fit(y, cs);
-        let findings = channel_findings(
-            &one_step,
-            &k_step,
-            settings.k,
-            &input_correlations,
-            &Fits {
-                simulation: fit_simulation,
-            },
-            alpha,
-        );
-        let pick = |s: &[f64]| plot_rows.iter().map(|&t| s[t]).collect::<Vec<f64>>();
-        channels.push(ChannelValidation {
-            output: name.clone(),
-            fit_one_step: nrmse_fit(y, c1),
-            fit_k_step: nrmse_fit(y, c2),
-            fit_simulation,
-            residuals_white: one_step.white,
-            one_step,
-            k_step,
-            input_correlations,
-            verdict: findings.join("; "),
-            findings,
-            plot: ChannelPlot {
-                stride,
-                time_s: plot_rows.iter().map(|&t| t as f64 * rec.h).collect(),
-                measured: pick(y),
-                one_step: pick(c1),
-                k_step: pick(c2),
-                simulated: pick(cs),
-            },
-        });
+        let grid = Grid {
+            every,
+            stride,
+            rows: &plot_rows,
+        };
+        channels.push(channel(&ch, rec, &inputs, settings, &grid, preds)?);
     }
     Ok(ValidationReport {
         sample_time_s: rec.h,
         n_samples: n,
         k: settings.k,
+        restart_s: every as f64 * rec.h,
         max_lag: settings.max_lag,
         confidence: settings.confidence,
         inputs,
         channels,
     })
+}
+
+/// The four predictions of a channel after the plausibility check.
+struct Predictions {
+    one: Checked,
+    k: Checked,
+    restarted: (Checked, RestartedWindows),
+    sim: Checked,
+}
+
+/// Restart period and plotted rows, in samples.
+struct Grid<'a> {
+    every: usize,
+    stride: usize,
+    rows: &'a [usize],
+}
+
+/// Residual tests, findings and plot of one channel.
+fn channel(
+    ch: &Channel<'_>,
+    rec: &ValidationRecord<'_>,
+    inputs: &[String],
+    settings: &ValidationSettings,
+    grid: &Grid<'_>,
+    p: Predictions,
+) -> Result<ChannelValidation, ValidationError> {
+    let name = ch.output;
+    let base = ResidualSettings {
+        max_lag: settings.max_lag,
+        ma_order: 0,
+        confidence: settings.confidence,
+        plot_points: 200,
+    };
+    let mut input_correlations = Vec::new();
+    let one_step = match residual(ch.y, &p.one) {
+        Some((start1, e1)) => {
+            input_correlations = inputs
+                .iter()
+                .enumerate()
+                .filter_map(|(i, input)| {
+                    let col = rec.u.column(i);
+                    let u = &col.as_slice()[start1..];
+                    input_residual_correlation(&e1, u, input, settings.max_lag, settings.confidence)
+                })
+                .collect();
+            Some(analyze_residuals(
+                &e1,
+                &base,
+                &format!("{name} 1-step residual"),
+            )?)
+        }
+        None => None,
+    };
+    let k_step = match residual(ch.y, &p.k) {
+        Some((_, ek)) => {
+            let k_settings = ResidualSettings {
+                ma_order: settings.k - 1,
+                ..base
+            };
+            Some(analyze_residuals(
+                &ek,
+                &k_settings,
+                &format!("{name} k-step residual"),
+            )?)
+        }
+        None => None,
+    };
+    let (rst, windows) = p.restarted;
+    let diverged = Divergences {
+        one_step: p.one.divergence,
+        k_step: p.k.divergence,
+        restarted: rst.divergence,
+        simulation: p.sim.divergence,
+    };
+    let findings = channel_findings(&Facts {
+        one_step: one_step.as_ref(),
+        k_step: k_step.as_ref(),
+        k: settings.k,
+        cross: &input_correlations,
+        alpha: 1.0 - settings.confidence,
+        unit: channel_words(name).1,
+        fit_restarted: rst.fit,
+        fit_simulation: p.sim.fit,
+        restart_s: grid.every as f64 * rec.h,
+        restarted: &windows,
+        diverged: &diverged,
+    });
+    let pick = |s: &[f64]| {
+        grid.rows
+            .iter()
+            .map(|&t| s[t].is_finite().then_some(s[t]))
+            .collect::<Vec<Option<f64>>>()
+    };
+    Ok(ChannelValidation {
+        output: name.to_owned(),
+        fit_one_step: p.one.fit,
+        fit_k_step: p.k.fit,
+        fit_restarted: rst.fit,
+        fit_simulation: p.sim.fit,
+        restarted: windows,
+        diverged,
+        residuals_white: one_step.as_ref().is_some_and(|a| a.white),
+        one_step,
+        k_step,
+        input_correlations,
+        verdict: findings.join("; "),
+        findings,
+        plot: ChannelPlot {
+            stride: grid.stride,
+            time_s: grid.rows.iter().map(|&t| t as f64 * rec.h).collect(),
+            measured: grid.rows.iter().map(|&t| ch.y[t]).collect(),
+            one_step: pick(&p.one.series),
+            k_step: pick(&p.k.series),
+            restarted: pick(&rst.series),
+            simulated: pick(&p.sim.series),
+        },
+    })
+}
+
+/// Samples per restarted window: `restart_s` rounded, at least one.
+fn restart_samples(restart_s: f64, h: f64) -> usize {
+    ((restart_s / h).round() as usize).max(1)
 }
 
 /// Record size, after checking the record, the settings and the names.
@@ -301,6 +439,15 @@ fn check_record(
             format!("must lie strictly between 0 and 1, got {}", s.confidence),
         ));
     }
+    if !(s.restart_s.is_finite() && s.restart_s > 0.0) {
+        return Err(ValidationError::invalid(
+            "settings.restart_s",
+            format!(
+                "the restart period must be finite and > 0 s, got {}",
+                s.restart_s
+            ),
+        ));
+    }
     if s.plot_points < 2 {
         return Err(ValidationError::invalid(
             "settings.plot_points",
@@ -342,32 +489,4 @@ fn input_names(m: usize, s: &ValidationSettings) -> Result<Vec<String>, Validati
 
 fn first_non_finite_row(m: &DMatrix<f64>) -> Option<usize> {
     (0..m.nrows()).find(|&i| m.row(i).iter().any(|v| !v.is_finite()))
-}
-
-/// Residual y − ŷ from the first row with a prediction to the end, and that
-/// row. A NaN after it is a model failure.
-fn residual(y: &[f64], yhat: &[f64], field: &str) -> Result<(usize, Vec<f64>), ValidationError> {
-    let Some(start) = yhat.iter().position(|v| v.is_finite()) else {
-        return Err(ValidationError::model_output(
-            field,
-            "returned no finite prediction",
-        ));
-    };
-    if let Some(i) = yhat[start..].iter().position(|v| !v.is_finite()) {
-        return Err(ValidationError::model_output(
-            field,
-            format!(
-                "prediction at row {} is NaN or infinite inside the record",
-                start + i
-            ),
-        ));
-    }
-    Ok((
-        start,
-        y[start..]
-            .iter()
-            .zip(&yhat[start..])
-            .map(|(a, b)| a - b)
-            .collect(),
-    ))
 }

@@ -5,7 +5,10 @@
 //! N(0, σ²), u white N(0, 1). With the true parameters:
 //! - 1-step error e(t): white, fit₁ = 1 − σ/s_y, s_y² = (b² + σ²)/(1 − a²);
 //! - k-step error Σ_{j<k} a^j e(t−j): MA(k−1), fit_k = 1 − σ·√((1 − a^{2k})/(1 − a²))/s_y;
-//! - simulation error Σ_j a^j e(t−j): fit_sim = 1 − σ/(s_y·√(1 − a²)).
+//! - simulation error Σ_j a^j e(t−j): fit_sim = 1 − σ/(s_y·√(1 − a²));
+//! - a free run restarted from the measured y every R samples has the
+//!   error Σ_{j<τ} a^j e(t−j) τ samples into its window, so
+//!   fit_R = 1 − σ·√((R − (1 − a^{2R})/(1 − a²)) / (R·(1 − a²)))/s_y.
 //!
 //! Output-error plant x(t) = a·x(t−1) + b·u(t−1), y = x + v: the same
 //! predictor leaves v(t) − a·v(t−1), an MA(1) with r(1) = −a/(1 + a²), so
@@ -125,22 +128,36 @@ fn true_model_has_white_residuals_and_the_analytic_fits() {
     let want1 = 1.0 - SIGMA / sy;
     let wantk = 1.0 - SIGMA * ((1.0 - A.powi(2 * k)) / (1.0 - A * A)).sqrt() / sy;
     let wants = 1.0 - SIGMA / (sy * (1.0 - A * A).sqrt());
+    // h = 0.1 s, restart every 10 s: R = 100 samples.
+    let r = 100.0;
+    let a2 = A * A;
+    let wantr =
+        1.0 - SIGMA * ((r - (1.0 - a2.powf(r)) / (1.0 - a2)) / (r * (1.0 - a2))).sqrt() / sy;
+    let want = [want1, wantk, wantr, wants];
     let mut white = 0;
     let seeds = 8;
-    let mut mean_fit = [0.0; 3];
+    let mut mean_fit = [0.0; 4];
     for seed in 0..seeds {
         let d = record(&truth(), 1, N, SIGMA, false, 40 + seed);
         let r = run(&truth(), &d, &s);
         let c = &r.channels[0];
         // Observed spread of the fits between records of N = 20 000 ≈ 0.005.
-        let fits = [c.fit_one_step, c.fit_k_step, c.fit_simulation].map(Option::unwrap);
-        for ((f, want), m) in fits.iter().zip([want1, wantk, wants]).zip(&mut mean_fit) {
+        let fits = [
+            c.fit_one_step,
+            c.fit_k_step,
+            c.fit_restarted,
+            c.fit_simulation,
+        ]
+        .map(Option::unwrap);
+        assert_eq!((c.restarted.windows, c.restarted.diverged), (200, 0));
+        assert_eq!(c.diverged, Divergences::default());
+        for ((f, want), m) in fits.iter().zip(want).zip(&mut mean_fit) {
             assert!((f - want).abs() < 0.025, "fit {f} vs {want}");
             *m += f / seeds as f64;
         }
         // 1-step residual std is σ.
-        assert!((c.one_step.std / SIGMA - 1.0).abs() < 0.03);
-        white += usize::from(c.residuals_white && c.k_step.white);
+        assert!((c.one_step.as_ref().unwrap().std / SIGMA - 1.0).abs() < 0.03);
+        white += usize::from(c.residuals_white && c.k_step.as_ref().unwrap().white);
         assert!(c.input_correlations.iter().all(|x| !x.leak));
         if seed == 0 {
             assert_eq!(c.verdict, "residuals white");
@@ -151,7 +168,7 @@ fn true_model_has_white_residuals_and_the_analytic_fits() {
         "white in {white}/{seeds} records"
     );
     // The mean over records is within its standard error (≈ 0.002).
-    for (m, want) in mean_fit.iter().zip([want1, wantk, wants]) {
+    for (m, want) in mean_fit.iter().zip(want) {
         assert!((m - want).abs() < 0.008, "mean fit {m} vs {want}");
     }
 }
@@ -167,8 +184,8 @@ fn wrong_pole_is_flagged_as_unmodelled_dynamics_with_input_leak() {
     };
     let r = run(&wrong, &d, &s);
     let c = &r.channels[0];
-    assert!(!c.residuals_white && !c.k_step.white);
-    assert!(c.one_step.whiteness_p_value < 1e-50);
+    assert!(!c.residuals_white && !c.k_step.as_ref().unwrap().white);
+    assert!(c.one_step.as_ref().unwrap().whiteness_p_value < 1e-50);
     assert!(
         c.verdict.contains("residual correlated at lags 1–"),
         "{}",
@@ -231,7 +248,8 @@ fn measurement_noise_gives_the_ma1_residual_of_theory() {
     );
     assert!((c.fit_simulation.unwrap() - (1.0 - SIGMA / sy)).abs() < 0.01);
     let r1 = -A / (1.0 + A * A);
-    assert!((c.one_step.autocorrelation.values[1] - r1).abs() < 0.03);
+    let one_step = c.one_step.as_ref().unwrap();
+    assert!((one_step.autocorrelation.values[1] - r1).abs() < 0.03);
     assert!(!c.residuals_white);
     assert!(
         c.verdict.contains("residual correlated at lag"),
@@ -239,7 +257,7 @@ fn measurement_noise_gives_the_ma1_residual_of_theory() {
         c.verdict
     );
     // MA(1) Gaussian: P(sign change) = arccos(r₁)/π ≈ 0.67 > ½.
-    let zc = &c.one_step.zero_crossings;
+    let zc = &one_step.zero_crossings;
     let want = (zc.expected * 2.0) * r1.acos() / std::f64::consts::PI;
     assert!((zc.count as f64 - want).abs() < 5.0 * want.sqrt());
     assert!(c.verdict.contains("too many zero crossings"));
@@ -259,7 +277,10 @@ fn plot_series_are_thinned_unless_full_resolution_is_asked() {
     assert!(p.time_s.len() <= 400);
     assert!((p.time_s[1] - 1.3).abs() < 1e-12);
     assert_eq!(p.measured[2], d.y[(26, 0)]);
-    assert!(p.k_step[0].is_nan() && p.one_step[0].is_nan() && p.simulated[0].is_finite());
+    assert!(p.k_step[0].is_none() && p.one_step[0].is_none() && p.simulated[0].is_some());
+    // Restarted every 10 s = 100 samples: exact at each restart.
+    assert_eq!(p.restarted[0], Some(d.y[(0, 0)]));
+    assert_eq!(r.restart_s, 10.0);
     let full = run(
         &truth(),
         &d,

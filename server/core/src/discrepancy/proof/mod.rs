@@ -308,7 +308,11 @@ fn matches(f: &Finding, e: &Expected) -> bool {
 
 /// The magnitude discovery gives for `e` in finding `f`: value ± std.
 fn estimated(f: &Finding, e: &Expected) -> Option<(f64, f64)> {
-    let c = |i: usize| f.coefficients.get(i).map(|x| (x.value, x.std));
+    let c = |i: usize| {
+        f.coefficients
+            .get(i)
+            .map(|x| (x.value, x.std.unwrap_or(f64::NAN)))
+    };
     match f.effect {
         Effect::Current => {
             let ((vn, sn), (ve, se)) = (c(0)?, c(1)?);
@@ -317,7 +321,10 @@ fn estimated(f: &Finding, e: &Expected) -> Option<(f64, f64)> {
             Some((speed, std))
         }
         _ if e.family == Family::Coriolis && f.effect != Effect::CoriolisFromM => None,
-        x if x.shape().is_some() => f.shape.as_ref().map(|s| (s.value, s.std)),
+        x if x.shape().is_some() => f
+            .shape
+            .as_ref()
+            .map(|s| (s.value, s.std.unwrap_or(f64::NAN))),
         _ => c(0),
     }
 }

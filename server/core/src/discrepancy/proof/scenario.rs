@@ -48,6 +48,7 @@ pub fn restoring_of(t: &RovTruth) -> Restoring {
         w_minus_b: r.weight - r.buoyancy,
         zg_w_minus_zb_b: r.r_g[2] * r.weight - r.r_b[2] * r.buoyancy,
         tether_pitch_moment: 0.0,
+        constant: [0.0; 6],
     }
 }
 
@@ -172,11 +173,7 @@ pub fn identify_baseline(p: &VesselProfile, restoring: Restoring, runs: &[Record
     };
     let exps: Vec<Experiment> = runs
         .iter()
-        .map(|r| Experiment {
-            h: r.h,
-            nu: r.nu.clone(),
-            gamma: &r.tau - g_of(r),
-        })
+        .map(|r| Experiment::new(r.h, r.nu.clone(), &r.tau - g_of(r)))
         .collect();
     let settings = LambdaSettings::new(
         Dof::ALL.to_vec(),

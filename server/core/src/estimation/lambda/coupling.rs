@@ -91,7 +91,8 @@ pub fn propose_coupling(
             "no run, or runs without columns",
         ));
     }
-    let h = validate_runs("runs", runs, n, MIN_COHERENCE_SAMPLES)?;
+    let q = runs.first().map_or(0, |r| r.exogenous.ncols());
+    let h = validate_runs("runs", runs, n, q, MIN_COHERENCE_SAMPLES)?;
     // Channels [γ_0 … γ_{n−1}, ν_0 … ν_{n−1}]; every input–input pair and
     // every input–output pair.
     let mut pairs: Vec<(usize, usize)> = Vec::new();

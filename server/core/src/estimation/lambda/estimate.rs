@@ -52,6 +52,14 @@ pub struct LambdaEstimate {
     pub std_m: DMatrix<f64>,
     /// Standard deviation of every entry of D̄.
     pub std_d_bar: DMatrix<f64>,
+    /// Names of the exogenous functions e (columns of `k`, `force`).
+    pub exogenous: Vec<String>,
+    /// K_λ (n × q), the regression's exogenous block.
+    pub k_lambda: DMatrix<f64>,
+    /// Force coefficients F (n × q) of M ν̇ + D̄ ν + F e = γ, F = −M·K.
+    pub force: DMatrix<f64>,
+    /// Standard deviations of `force`.
+    pub std_force: DMatrix<f64>,
     /// How the standard deviations were computed.
     pub uncertainty: UncertaintyMethod,
     /// Residual variance of each row's regression (equation error).

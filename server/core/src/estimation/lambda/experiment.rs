@@ -20,9 +20,24 @@ pub struct Experiment {
     /// Generalized forces γ = τ − g(η), N × n, held over each sample
     /// interval (zero-order hold).
     pub gamma: DMatrix<f64>,
+    /// Known functions e(t) whose force coefficients F are estimated with
+    /// M and D̄ (M ν̇ + D̄ ν + F e = γ): N × q, held like γ; q = 0 for none.
+    /// E.g. e = [1, sin θ, cos θ sin φ] for constant loads and g(η).
+    pub exogenous: DMatrix<f64>,
 }
 
 impl Experiment {
+    /// A run without exogenous functions (q = 0).
+    pub fn new(h: f64, nu: DMatrix<f64>, gamma: DMatrix<f64>) -> Self {
+        let rows = nu.nrows();
+        Experiment {
+            h,
+            nu,
+            gamma,
+            exogenous: DMatrix::zeros(rows, 0),
+        }
+    }
+
     /// Number of samples N.
     pub fn len(&self) -> usize {
         self.nu.nrows()
@@ -37,8 +52,9 @@ impl Experiment {
 /// Relative tolerance on equal sample times across runs.
 const H_REL_TOL: f64 = 1e-9;
 
-/// Checks `runs` (named `field[i]`) for `n` DOFs with at least `min_len`
-/// samples each, and returns their common sample time h.
+/// Checks `runs` (named `field[i]`) for `n` DOFs and `q` exogenous
+/// functions with at least `min_len` samples each, and returns their common
+/// sample time h.
 ///
 /// # Errors
 /// No run; h not finite or ≤ 0, or differing between runs; ν or γ not
@@ -48,6 +64,7 @@ pub(crate) fn validate_runs(
     field: &str,
     runs: &[Experiment],
     n: usize,
+    q: usize,
     min_len: usize,
 ) -> Result<f64, LambdaError> {
     let Some(first) = runs.first() else {
@@ -91,8 +108,20 @@ pub(crate) fn validate_runs(
                 ),
             ));
         }
+        if run.exogenous.nrows() != run.nu.nrows() || run.exogenous.ncols() != q {
+            return Err(LambdaError::shape(
+                f("exogenous"),
+                format!(
+                    "is {}×{}, expected {}×{q} (the rows of nu, the columns of the settings' exogenous functions)",
+                    run.exogenous.nrows(),
+                    run.exogenous.ncols(),
+                    run.nu.nrows()
+                ),
+            ));
+        }
         require_finite_matrix(&f("nu"), &run.nu)?;
         require_finite_matrix(&f("gamma"), &run.gamma)?;
+        require_finite_matrix(&f("exogenous"), &run.exogenous)?;
         if run.len() < min_len {
             return Err(LambdaError::too_few(
                 f("nu"),

@@ -79,6 +79,31 @@ fn validate_settings(s: &LambdaSettings, n: usize) -> Result<CouplingMask, Lambd
             super::error::require_positive(&format!("settings.noise_variance[{i}]"), v)?;
         }
     }
+    if let Some(x) = &s.exogenous {
+        let q = x.names.len();
+        if x.pattern.shape() != (n, q) {
+            return Err(LambdaError::shape(
+                "settings.exogenous.pattern",
+                format!(
+                    "is {}×{}, expected {n}×{q} (DOFs × functions)",
+                    x.pattern.nrows(),
+                    x.pattern.ncols()
+                ),
+            ));
+        }
+        if x.force_std.len() != n {
+            return Err(LambdaError::shape(
+                "settings.exogenous.force_std",
+                format!(
+                    "has {} entries, expected one per DOF ({n})",
+                    x.force_std.len()
+                ),
+            ));
+        }
+        for (i, &v) in x.force_std.iter().enumerate() {
+            super::error::require_positive(&format!("settings.exogenous.force_std[{i}]"), v)?;
+        }
+    }
     if !(s.random_walk.is_finite() && s.random_walk >= 0.0) {
         return Err(LambdaError::invalid(
             "settings.random_walk",
@@ -88,9 +113,11 @@ fn validate_settings(s: &LambdaSettings, n: usize) -> Result<CouplingMask, Lambd
     Ok(mask)
 }
 
-/// θ₀ = [A_λ0 B_λ0] from (M₀, D̄₀) and the dimensionally scaled stds.
+/// θ₀ = [A_λ0 B_λ0 0] from (M₀, D̄₀) and the dimensionally scaled stds;
+/// the exogenous block K_λ = −B_λ F starts at 0 with the std of T·B₀ᵢᵢ·σ_F.
 fn priors(s: &LambdaSettings, f: &LambdaFilter) -> Result<RowPriors, LambdaError> {
     let n = s.dofs.len();
+    let q = s.exogenous.as_ref().map_or(0, |x| x.names.len());
     let (a0, b0) = state_space(&s.prior.m0, &s.prior.d_bar0, "settings.prior.m0")?;
     if let Some(i) = (0..n).find(|&i| b0[(i, i)] <= 0.0 || !b0[(i, i)].is_finite()) {
         return Err(LambdaError::invalid(
@@ -104,15 +131,24 @@ fn priors(s: &LambdaSettings, f: &LambdaFilter) -> Result<RowPriors, LambdaError
     let mut theta0 = Vec::with_capacity(n);
     let mut p0 = Vec::with_capacity(n);
     for i in 0..n {
-        theta0.push(DVector::from_fn(2 * n, |j, _| {
-            if j < n { al0[(i, j)] } else { bl0[(i, j - n)] }
+        theta0.push(DVector::from_fn(2 * n + q, |j, _| {
+            if j < n {
+                al0[(i, j)]
+            } else if j < 2 * n {
+                bl0[(i, j - n)]
+            } else {
+                0.0
+            }
         }));
-        p0.push(DVector::from_fn(2 * n, |j, _| {
+        p0.push(DVector::from_fn(2 * n + q, |j, _| {
             let sd = if j < n {
                 sa * (b0[(i, i)] / b0[(j, j)]).sqrt()
-            } else {
+            } else if j < 2 * n {
                 let j = j - n;
                 sb * (b0[(i, i)] * b0[(j, j)]).sqrt()
+            } else {
+                let x = s.exogenous.as_ref().expect("q > 0 only with exogenous");
+                s.t_lambda * b0[(i, i)] * x.force_std[i]
             };
             sd * sd
         }));
@@ -143,9 +179,10 @@ pub fn identify_with_progress(
 ) -> Result<LambdaEstimate, LambdaError> {
     let n = settings.dofs.len();
     let mask = validate_settings(settings, n)?;
-    let p = 2 * n;
+    let q = settings.exogenous.as_ref().map_or(0, |x| x.names.len());
+    let p = 2 * n + q;
     // Each run must at least outnumber the regressors plus its transient.
-    let h = validate_runs("runs", runs, n, p + 2)?;
+    let h = validate_runs("runs", runs, n, q, p + 2)?;
     if settings.t_lambda < MIN_T_OVER_H * h {
         return Err(LambdaError::invalid(
             "settings.t_lambda",
@@ -158,7 +195,7 @@ pub fn identify_with_progress(
     let f = LambdaFilter::new(settings.t_lambda, h)?;
     let pri = priors(settings, &f)?;
 
-    let mut stats = RegressionStats::new(n);
+    let mut stats = RegressionStats::new(n, p);
     let mut filtered = Vec::with_capacity(runs.len());
     let kf = settings.random_walk > 0.0;
     for (r, run) in runs.iter().enumerate() {
@@ -168,7 +205,9 @@ pub fn identify_with_progress(
         filtered.push(reg);
     }
     let lag = (LAG_IN_T * settings.t_lambda / h).ceil() as usize;
-    let free: Vec<Vec<usize>> = (0..n).map(|i| mask.free_of_row(i)).collect();
+    let free: Vec<Vec<usize>> = (0..n)
+        .map(|i| free_of_row(&mask, settings.exogenous.as_ref(), i))
+        .collect();
     if let Some(i) = (0..n).find(|&i| residual_dof(&stats, free[i].len()) < 1.0) {
         return Err(LambdaError::too_few(
             "runs",
@@ -209,9 +248,17 @@ pub fn identify_with_progress(
 
     let a_lambda = DMatrix::from_fn(n, n, |i, j| rows[i].theta[j]);
     let b_lambda = DMatrix::from_fn(n, n, |i, j| rows[i].theta[n + j]);
+    let k_lambda = DMatrix::from_fn(n, q, |i, j| rows[i].theta[2 * n + j]);
     let blocks = mask.blocks();
-    let [a, b, m, d_bar] = physical(&a_lambda, &b_lambda, &f, settings.inversion, &blocks)?;
-    let [std_a, std_b, std_m, std_d_bar] =
+    let [a, b, m, d_bar, _, force] = physical(
+        &a_lambda,
+        &b_lambda,
+        &k_lambda,
+        &f,
+        settings.inversion,
+        &blocks,
+    )?;
+    let [std_a, std_b, std_m, std_d_bar, _, std_force] =
         delta_method(&rows, &free, &f, settings.inversion, &blocks);
     progress.update(1.0, "done")?;
     Ok(LambdaEstimate {
@@ -231,12 +278,39 @@ pub fn identify_with_progress(
         std_b,
         std_m,
         std_d_bar,
+        exogenous: settings
+            .exogenous
+            .as_ref()
+            .map_or_else(Vec::new, |x| x.names.clone()),
+        k_lambda,
+        force,
+        std_force,
         uncertainty: UncertaintyMethod::DeltaMethod,
         residual_variance: rows.iter().map(|r| r.residual_variance).collect(),
         noise_variance: rows.iter().map(|r| r.noise_variance).collect(),
         n_samples: stats.n_samples,
         n_runs: runs.len(),
     })
+}
+
+/// Free regressors of row `i`: the mask's entries of [A_λ B_λ] and the
+/// exogenous columns 2n + j that reach row i through a free B entry
+/// (K_λ = −B_λ F mixes the rows of F that B couples).
+fn free_of_row(
+    mask: &CouplingMask,
+    exogenous: Option<&super::settings::Exogenous>,
+    i: usize,
+) -> Vec<usize> {
+    let n = mask.n();
+    let mut free = mask.free_of_row(i);
+    if let Some(x) = exogenous {
+        for j in 0..x.names.len() {
+            if (0..n).any(|l| mask.b[(i, l)] && x.pattern[(l, j)]) {
+                free.push(2 * n + j);
+            }
+        }
+    }
+    free
 }
 
 /// The covariance-form Kalman filter with random-walk parameters for row
@@ -265,7 +339,7 @@ fn kalman_pass(
             format!("the parameter Kalman filter of row {i} diverged"),
         ));
     }
-    let p = 2 * settings.dofs.len();
+    let p = pri.theta0[i].len();
     let mut theta = DVector::zeros(p);
     let mut cov = DMatrix::zeros(p, p);
     for (a, &ja) in free.iter().enumerate() {

@@ -47,6 +47,6 @@ pub use filter::{FilterInit, LambdaFilter};
 pub use identify::{identify, identify_with_progress};
 pub use lpv::identify_lpv;
 pub use predict::ZohModel;
-pub use settings::{LambdaSettings, MIN_T_OVER_H, Prior};
+pub use settings::{Exogenous, LambdaSettings, MIN_T_OVER_H, Prior};
 pub use structure::{CouplingMask, Structure};
 pub use transform::{Inversion, mass_damping, zoh};

@@ -64,6 +64,20 @@ impl Prior {
 }
 
 /// Everything [`super::identify`] needs besides the runs.
+/// Known functions e(t) of each run (its `exogenous` columns) whose force
+/// coefficients F in M ν̇ + D̄ ν + F e = γ are estimated with M and D̄:
+/// constant loads (e = 1), restoring shapes (sin θ, cos θ sin φ) and the like.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Exogenous {
+    /// Name of each function (column), for messages and reports.
+    pub names: Vec<String>,
+    /// `pattern[(i, j)]`: function j can act on DOF i (F_ij is estimated).
+    pub pattern: DMatrix<bool>,
+    /// Prior standard deviation of F_ij per DOF row i (N or N·m per unit
+    /// of e_j): a weak prior, wide against the forces the data carry.
+    pub force_std: Vec<f64>,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct LambdaSettings {
     /// The DOFs of the columns of ν and γ, in order.
@@ -91,6 +105,8 @@ pub struct LambdaSettings {
     /// covariance instead of the white-noise one (constant parameters only;
     /// see `robust`): the λ regression's equation error is coloured.
     pub robust_covariance: bool,
+    /// Exogenous functions estimated with M and D̄ (none by default).
+    pub exogenous: Option<Exogenous>,
 }
 
 impl LambdaSettings {
@@ -109,6 +125,7 @@ impl LambdaSettings {
             filter_init: FilterInit::FirstSample,
             estimate_transient: true,
             robust_covariance: true,
+            exogenous: None,
         }
     }
 }

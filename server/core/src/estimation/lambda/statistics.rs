@@ -20,9 +20,9 @@ use super::regressors::RunRegressors;
 /// Σφφᵀ, Σφyᵀ and Σy² over all runs (transients profiled out).
 #[derive(Debug, Clone)]
 pub(crate) struct RegressionStats {
-    /// Σ φ φᵀ, 2n × 2n.
+    /// Σ φ φᵀ, p × p (p = 2n + q).
     pub gram: DMatrix<f64>,
-    /// Σ φ yᵀ, 2n × n (column i for output row i).
+    /// Σ φ yᵀ, p × n (column i for output row i).
     pub cross: DMatrix<f64>,
     /// Σ y_i², per output row.
     pub yy: Vec<f64>,
@@ -33,11 +33,11 @@ pub(crate) struct RegressionStats {
 }
 
 impl RegressionStats {
-    /// Empty statistics for n DOFs.
-    pub fn new(n: usize) -> Self {
+    /// Empty statistics for n DOFs and p regressors.
+    pub fn new(n: usize, p: usize) -> Self {
         RegressionStats {
-            gram: DMatrix::zeros(2 * n, 2 * n),
-            cross: DMatrix::zeros(2 * n, n),
+            gram: DMatrix::zeros(p, p),
+            cross: DMatrix::zeros(p, n),
             yy: vec![0.0; n],
             n_samples: 0,
             n_nuisance: 0,

@@ -246,20 +246,31 @@ pub(crate) fn state_space(
     Ok((-(&b * d), b))
 }
 
-/// The physical model of a regression estimate: (A, B, M, D̄) from
-/// (A_λ, B_λ), with A, B set to exactly zero outside the block closure
-/// `blocks` of the mask (there the exact map gives only rounding).
+/// A, B, M, D̄ and the exogenous terms from A_λ, B_λ and K_λ (n × q): the
+/// exogenous columns map like inputs, K = (∫₀ʰe^{As}ds)⁻¹·c·K_λ (exact) or
+/// K_λ/T (thesis), and their force coefficients are F = −M·K, so that
+/// M ν̇ + D̄ ν + F e = γ. Entries of A and B outside `blocks` (the coupling
+/// closure of the mask) are zeroed so round-off does not couple DOFs the
+/// structure keeps apart.
 ///
 /// # Errors
 /// As [`from_lambda`] and [`mass_damping`].
 pub(crate) fn physical(
     a_l: &DMatrix<f64>,
     b_l: &DMatrix<f64>,
+    k_l: &DMatrix<f64>,
     f: &LambdaFilter,
     inversion: Inversion,
     blocks: &DMatrix<bool>,
-) -> Result<[DMatrix<f64>; 4], LambdaError> {
-    let (mut a, mut b) = from_lambda(a_l, b_l, f, inversion)?;
+) -> Result<[DMatrix<f64>; 6], LambdaError> {
+    let n = a_l.nrows();
+    let q = k_l.ncols();
+    let mut inputs = DMatrix::zeros(n, n + q);
+    inputs.columns_mut(0, n).copy_from(b_l);
+    inputs.columns_mut(n, q).copy_from(k_l);
+    let (mut a, bk) = from_lambda(a_l, &inputs, f, inversion)?;
+    let mut b = bk.columns(0, n).into_owned();
+    let k = bk.columns(n, q).into_owned();
     for ((x, y), &keep) in a.iter_mut().zip(b.iter_mut()).zip(blocks.iter()) {
         if !keep {
             *x = 0.0;
@@ -267,7 +278,8 @@ pub(crate) fn physical(
         }
     }
     let (m, d) = mass_damping(&a, &b)?;
-    Ok([a, b, m, d])
+    let force = -(&m * &k);
+    Ok([a, b, m, d, k, force])
 }
 
 #[cfg(test)]

@@ -210,7 +210,7 @@ fn covariance_form_kalman_filter_equals_the_information_form() {
         .iter()
         .map(|r| RunRegressors::new(r, &f, FilterInit::FirstSample))
         .collect();
-    let mut stats = RegressionStats::new(3);
+    let mut stats = RegressionStats::new(3, 6);
     for r in &regs {
         stats.add(r, true);
     }

@@ -18,7 +18,7 @@ fn good(len: usize) -> Experiment {
             nu[(k, j)] = 0.95 * nu[(k - 1, j)] + 0.01 * gamma[(k - 1, j)];
         }
     }
-    Experiment { h: 0.1, nu, gamma }
+    Experiment::new(0.1, nu, gamma)
 }
 
 fn settings() -> LambdaSettings {

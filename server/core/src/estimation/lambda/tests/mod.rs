@@ -3,6 +3,7 @@
 mod analytic;
 mod calibration;
 mod errors;
+mod exogenous;
 mod multi;
 mod rov;
 mod truth;

@@ -100,11 +100,11 @@ pub fn run(
 ) -> Experiment {
     let gamma = excitation(len, h, clock_s, amp, mean_gamma, seed);
     let clean = simulate(a, b, &gamma, nu0, h, 10);
-    Experiment {
+    Experiment::new(
         h,
-        nu: noisy(&clean, sigma, crate::rng::mix(seed ^ 0xABCD)),
+        noisy(&clean, sigma, crate::rng::mix(seed ^ 0xABCD)),
         gamma,
-    }
+    )
 }
 
 /// max |x − y| / max |y|.

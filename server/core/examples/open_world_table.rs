@@ -1,0 +1,77 @@
+//! Prints, per seeded vessel of the independent truth (`seatrial-truth`),
+//! the λ-filter identification's parameter errors in σ and its validation
+//! fits against the true model and an affine least-squares baseline.
+//!
+//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto]`
+
+#[path = "../tests/support/open_world.rs"]
+mod open_world;
+
+use seatrial_core::identification::lambda_campaign::StructureChoice;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut seeds = Vec::new();
+    let mut structure = None;
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        if a == "--structure" {
+            structure = it.next().map(|s| match s.as_str() {
+                "diagonal" => StructureChoice::Diagonal,
+                "coupled" => StructureChoice::Coupled,
+                "symmetric" => StructureChoice::Symmetric,
+                _ => StructureChoice::Auto,
+            });
+        } else if let Ok(s) = a.parse::<u64>() {
+            seeds.push(s);
+        }
+    }
+    if seeds.is_empty() {
+        seeds = vec![1, 2, 3, 4, 5];
+    }
+    let settings = open_world::settings(structure);
+    for seed in seeds {
+        let t = std::time::Instant::now();
+        let r = open_world::evaluate(seed, true, &settings);
+        let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
+        println!(
+            "\n## seed {seed}: {within}/{} parameters within ±3σ ({:.0} %), {:.1} s",
+            r.z.len(),
+            100.0 * within as f64 / r.z.len().max(1) as f64,
+            t.elapsed().as_secs_f64()
+        );
+        let mut worst: Vec<_> = r.z.iter().collect();
+        worst.sort_by(|a, b| b.z().abs().total_cmp(&a.z().abs()));
+        let filter = std::env::var("SHOW").ok();
+        let shown: Vec<_> = match &filter {
+            Some(f) => r.z.iter().filter(|z| z.name.contains(f.as_str())).collect(),
+            None => worst.iter().take(12).copied().collect(),
+        };
+        for z in shown {
+            println!(
+                "  {:<22} est {:>11.4} truth {:>11.4} σ {:>9.4} z {:>7.1}",
+                z.name,
+                z.estimate,
+                z.truth,
+                z.std,
+                z.z()
+            );
+        }
+        println!("  channel | 1-step  true   affine | free run  true");
+        let f = |x: Option<f64>| x.map_or("   —  ".into(), |v| format!("{v:6.3}"));
+        for c in &r.fits {
+            println!(
+                "  {:<7} | {} {} {} | {} {}",
+                c.channel,
+                f(c.one_step),
+                f(c.one_step_true),
+                f(c.one_step_affine),
+                f(c.free_run),
+                f(c.free_run_true)
+            );
+        }
+        for s in r.findings.iter().chain(&r.notes) {
+            println!("  - {s}");
+        }
+    }
+}

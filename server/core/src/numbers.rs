@@ -1,0 +1,129 @@
+//! Numbers in sentences: what a finding, verdict or note shows a person.
+//!
+//! One rule everywhere: three significant digits, trailing zeros dropped, the
+//! unit after a space (`0.0123 m/s`, `9860 N·m`), a true minus sign (−). Magnitudes outside 10⁻⁴ … 10⁶ switch to `2.5e7`. A non-finite
+//! value prints as `—`: it means a guard upstream is missing, never a number
+//! to read. Fits (eq. 1.13) are percentages with one decimal (below −1000 %
+//! only `< −1000 %`), times of a record seconds with one decimal, p-values
+//! stop at `p < 0.001`.
+
+const MINUS: char = '\u{2212}';
+
+/// `x` with three significant digits: `0.0123`, `12.3`, `410`, `5`,
+/// `−2.5e7`; `—` when not finite.
+pub fn sig3(x: f64) -> String {
+    if !x.is_finite() {
+        return "—".into();
+    }
+    if x == 0.0 {
+        return "0".into();
+    }
+    let mag = x.abs().log10().floor();
+    let s = if !(-4.0..6.0).contains(&mag) {
+        let e = format!("{x:.2e}");
+        // 2.50e7 → 2.5e7, 1.00e-5 → 1e-5.
+        match e.split_once('e') {
+            Some((m, exp)) => {
+                let m = m.trim_end_matches('0').trim_end_matches('.');
+                format!("{m}e{exp}")
+            }
+            None => e,
+        }
+    } else {
+        let decimals = (2.0 - mag).max(0.0) as usize;
+        let s = format!("{x:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_owned()
+        } else {
+            s
+        }
+    };
+    minus(&s)
+}
+
+/// `x` with its unit: `0.0123 m/s`; the bare number when `unit` is empty.
+pub fn quantity(x: f64, unit: &str) -> String {
+    if unit.is_empty() {
+        sig3(x)
+    } else {
+        format!("{} {unit}", sig3(x))
+    }
+}
+
+/// Fits below this (−1000 %) read as `< −1000 %`: far worse than the mean,
+/// and the digits say nothing more.
+pub const FIT_FLOOR: f64 = -10.0;
+
+/// An NRMSE fit (1 = perfect, 0 the mean) as a percentage with one decimal:
+/// `87.3 %`, `−41.0 %`; `< −1000 %` below [`FIT_FLOOR`]; `—` for no fit.
+pub fn percent(fit: Option<f64>) -> String {
+    match fit.filter(|f| f.is_finite()) {
+        None => "—".into(),
+        Some(f) if f < FIT_FLOOR => format!("< {MINUS}1000 %"),
+        Some(f) => format!("{} %", minus(&format!("{:.1}", 100.0 * f))),
+    }
+}
+
+/// A time within a record, to a tenth of a second: `123.4 s`.
+pub fn seconds(t: f64) -> String {
+    if !t.is_finite() {
+        return "—".into();
+    }
+    format!("{} s", minus(&format!("{t:.1}")))
+}
+
+/// A p-value: `p = 0.034`, `p < 0.001`.
+pub fn p_value(p: f64) -> String {
+    if !p.is_finite() {
+        "p = —".into()
+    } else if p < 0.001 {
+        "p < 0.001".into()
+    } else {
+        format!("p = {}", sig3(p))
+    }
+}
+
+fn minus(s: &str) -> String {
+    match s.strip_prefix('-') {
+        // −0.0 prints as "-0.0": no sign on a zero.
+        Some(rest) if rest.chars().all(|c| c == '0' || c == '.') => rest.to_owned(),
+        Some(rest) => format!("{MINUS}{rest}"),
+        None => s.to_owned(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn three_significant_digits_with_units_and_a_true_minus() {
+        assert_eq!(sig3(0.0), "0");
+        assert_eq!(sig3(0.012345), "0.0123");
+        assert_eq!(sig3(12.345), "12.3");
+        assert_eq!(sig3(409.6), "410");
+        assert_eq!(sig3(1999.5), "2000");
+        assert_eq!(sig3(5.0), "5");
+        assert_eq!(sig3(-0.5), "−0.5");
+        assert_eq!(sig3(2.5e7), "2.5e7");
+        assert_eq!(sig3(-1.0e-5), "−1e-5");
+        assert_eq!(sig3(f64::NAN), "—");
+        assert_eq!(sig3(f64::NEG_INFINITY), "—");
+        assert_eq!(quantity(9860.4, "N·m"), "9860 N·m");
+        assert_eq!(quantity(0.5, ""), "0.5");
+    }
+
+    #[test]
+    fn fits_times_and_p_values() {
+        assert_eq!(percent(Some(0.8731)), "87.3 %");
+        assert_eq!(percent(Some(-0.41)), "−41.0 %");
+        assert_eq!(percent(Some(-9.99)), "−999.0 %");
+        assert_eq!(percent(Some(-23.456)), "< −1000 %");
+        assert_eq!(percent(Some(-0.0001)), "0.0 %");
+        assert_eq!(percent(None), "—");
+        assert_eq!(percent(Some(f64::NAN)), "—");
+        assert_eq!(seconds(123.44), "123.4 s");
+        assert_eq!(p_value(0.0342), "p = 0.0342");
+        assert_eq!(p_value(1e-17), "p < 0.001");
+    }
+}

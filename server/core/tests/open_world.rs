@@ -1,0 +1,121 @@
+//! The λ-filter campaign identification on campaigns it did not plan or
+//! simulate: five vessels drawn from seeded ranges by the independent truth
+//! (`seatrial-truth`), flown by another team's 20 Hz PI controller with a
+//! wrong nominal g(η) feed-forward, logged at 10 Hz, statics at grid speed
+//! with no attitude holds, a validation run stepping between and beyond the
+//! grid. Run `cargo run --release -p seatrial-core --example open_world_table`
+//! for the full table.
+
+mod support;
+
+use seatrial_core::identification::LambdaCampaignSettings;
+use support::open_world::{SeedReport, evaluate};
+
+const SEEDS: [u64; 5] = [1, 2, 3, 4, 5];
+
+/// The five identifications, computed once for all tests.
+fn reports() -> &'static [SeedReport] {
+    static REPORTS: std::sync::OnceLock<Vec<SeedReport>> = std::sync::OnceLock::new();
+    REPORTS.get_or_init(|| {
+        SEEDS
+            .iter()
+            .map(|&s| evaluate(s, true, &LambdaCampaignSettings::default()))
+            .collect()
+    })
+}
+
+/// g(η) comes from ordinary runs (no attitude holds were flown) and the
+/// controller's nominal feed-forward is not mistaken for it: W − B and
+/// z_G·W − z_B·B within 3σ or 1 % of the truth on every vessel.
+#[test]
+fn restoring_forces_come_from_ordinary_runs() {
+    for r in reports() {
+        for name in ["W−B", "z_G·W − z_B·B"] {
+            let z =
+                r.z.iter()
+                    .find(|z| z.name == name)
+                    .unwrap_or_else(|| panic!("seed {}: no {name} in {:?}", r.seed, r.notes));
+            let rel = (z.estimate - z.truth).abs() / z.truth.abs().max(1.0);
+            assert!(
+                z.z().abs() <= 3.0 || rel <= 0.01,
+                "seed {}: {name} = {:.3} ± {:.3} against {:.3}",
+                r.seed,
+                z.estimate,
+                z.std,
+                z.truth
+            );
+        }
+    }
+}
+
+/// Every stored sub-model is physical: M symmetric positive definite and
+/// the damping D = D̄ − J_C(M, u₀) dissipative, and its free run on the
+/// held-out run is finite.
+#[test]
+fn every_stored_sub_model_is_physical_and_simulable() {
+    for r in reports() {
+        assert!(!r.physical.is_empty());
+        for (speed, ok, why) in &r.physical {
+            assert!(ok, "seed {} at {speed:.2} m/s: {why}", r.seed);
+        }
+        for c in &r.fits {
+            assert!(
+                c.free_run.is_some_and(f64::is_finite),
+                "seed {} {}",
+                r.seed,
+                c.channel
+            );
+        }
+    }
+}
+
+/// One-step predictions on the held-out run: never worse than the affine
+/// least-squares baseline, and within 0.02 of the true model in surge,
+/// sway, heave and yaw.
+#[test]
+fn one_step_fits_beat_the_affine_baseline_and_approach_the_truth() {
+    for r in reports() {
+        for c in &r.fits {
+            let (est, truth, affine) = (
+                c.one_step.expect("a 1-step fit"),
+                c.one_step_true.expect("the true model's fit"),
+                c.one_step_affine.expect("the baseline's fit"),
+            );
+            assert!(
+                est >= affine - 0.005,
+                "seed {} {}: {est:.3} below the affine baseline {affine:.3}",
+                r.seed,
+                c.channel
+            );
+            if ["u", "v", "w", "r"].contains(&c.channel.as_str()) {
+                assert!(
+                    est >= truth - 0.02,
+                    "seed {} {}: {est:.3} against the true model's {truth:.3}",
+                    r.seed,
+                    c.channel
+                );
+            }
+        }
+    }
+}
+
+/// The issue's full criteria, not met yet (see the README's identification
+/// section): ≥ 95 % of parameters within ±3σ, 1-step within 0.02 and free
+/// run within 0.05 of the true model in every channel.
+#[test]
+#[ignore = "known gap: roll/pitch inertia biased 5–13 %, free runs of roll and pitch far below the true model's"]
+fn the_issue_criteria_on_five_vessels() {
+    for r in reports() {
+        let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
+        assert!(
+            within as f64 >= 0.95 * r.z.len() as f64,
+            "seed {}: {within}/{}",
+            r.seed,
+            r.z.len()
+        );
+        for c in &r.fits {
+            assert!(c.one_step.unwrap() >= c.one_step_true.unwrap() - 0.02);
+            assert!(c.free_run.unwrap() >= c.free_run_true.unwrap() - 0.05);
+        }
+    }
+}

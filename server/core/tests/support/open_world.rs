@@ -1,0 +1,360 @@
+//! The λ-filter campaign identification graded on the independent truth
+//! (`seatrial-truth`: a 6-DOF Fossen model with C(ν)ν, speed-scheduled
+//! linear + quadratic damping and g(η), flown by another team's 20 Hz PI
+//! controller with a wrong nominal g(η) feed-forward, logged at 10 Hz).
+//! Nothing here is shared with the estimator: the logs go through the
+//! service's CSV parser as a user's upload would.
+
+#![allow(dead_code)]
+
+use nalgebra::DMatrix;
+use nalgebra::DVector;
+use seatrial_core::estimation::NoProgress;
+use seatrial_core::identification::{
+    LambdaCampaignSettings, RunInput, identify_lambda_campaign, lambda_campaign::StructureChoice,
+};
+use seatrial_core::logs::{LogRole, ParseOptions, parse_log, to_uniform};
+use seatrial_core::models::{coriolis, project_physical};
+use seatrial_core::planning::campaign::ExperimentFamily;
+use seatrial_core::planning::dof::Dof;
+use seatrial_core::planning::examples::surveyor_rov;
+use seatrial_core::planning::vessel::VesselProfile;
+use seatrial_core::validation::nrmse_fit;
+use seatrial_truth::{
+    Campaign, CampaignSpec, Role, Run, Vessel, effective_linearization, fly_campaign,
+    true_predictions,
+};
+
+/// One parameter's error in units of its reported std.
+#[derive(Debug, Clone)]
+pub struct ZScore {
+    pub name: String,
+    pub estimate: f64,
+    pub truth: f64,
+    pub std: f64,
+}
+
+impl ZScore {
+    pub fn z(&self) -> f64 {
+        (self.estimate - self.truth) / self.std
+    }
+}
+
+/// Per channel: the service's and the true model's fits on the validation
+/// run, and the affine least-squares baseline's 1-step fit.
+#[derive(Debug, Clone)]
+pub struct ChannelFit {
+    pub channel: String,
+    pub one_step: Option<f64>,
+    pub one_step_true: Option<f64>,
+    pub free_run: Option<f64>,
+    pub free_run_true: Option<f64>,
+    pub one_step_affine: Option<f64>,
+}
+
+pub struct SeedReport {
+    pub seed: u64,
+    pub z: Vec<ZScore>,
+    pub fits: Vec<ChannelFit>,
+    /// Per grid point: speed, physical, and why not.
+    pub physical: Vec<(f64, bool, String)>,
+    pub findings: Vec<String>,
+    pub notes: Vec<String>,
+}
+
+/// The profile a user would write for `campaign`'s vehicle: the Surveyor
+/// template with force limits of twice the largest logged command and
+/// rough time constants.
+pub fn profile_for(campaign: &Campaign) -> VesselProfile {
+    let mut p = surveyor_rov();
+    p.name = format!("drawn ROV {}", campaign.seed);
+    for (j, d) in Dof::ALL.iter().enumerate() {
+        let tau_max = campaign
+            .runs
+            .iter()
+            .map(|r| r.log.tau.column(j).amax())
+            .fold(0.0, f64::max);
+        let lim = p.limits.get_mut(d).expect("six DOFs");
+        lim.max_force = 2.0 * tau_max.max(1.0);
+        lim.max_force_rate = lim.max_force;
+        lim.time_constant_s = 1.0;
+    }
+    p
+}
+
+fn family(role: Role) -> ExperimentFamily {
+    match role {
+        Role::Static => ExperimentFamily::Static,
+        Role::Dynamic => ExperimentFamily::Dynamic,
+        Role::Validation => ExperimentFamily::Validation,
+    }
+}
+
+/// A run as the service reads it: its single-file CSV through the parser.
+pub fn to_input(profile: &VesselProfile, run: &Run, described: bool) -> RunInput {
+    let csv = run.single_csv();
+    let opts = ParseOptions::for_vessel(profile, LogRole::Single, None);
+    let parsed = parse_log(csv.as_bytes(), &opts).expect("the truth's CSV parses");
+    let (record, _) = to_uniform(&parsed.table, None).expect("uniform");
+    RunInput {
+        run_id: run.meta.name.clone(),
+        name: run.meta.name.clone(),
+        family: described.then(|| family(run.meta.role)),
+        grid_speed_mps: if described { run.meta.grid_speed } else { None },
+        excited_dofs: Vec::new(),
+        record,
+    }
+}
+
+/// ν_{k+1} = A ν_k + B τ_k + c by ordinary least squares over the
+/// estimation runs (the few lines of numpy a user would write), and its
+/// 1-step predictions on a log.
+struct Affine {
+    theta: DMatrix<f64>,
+}
+
+impl Affine {
+    fn regressor(nu: &DMatrix<f64>, tau: &DMatrix<f64>, k: usize) -> Vec<f64> {
+        let mut x: Vec<f64> = nu.row(k).iter().copied().collect();
+        x.extend(tau.row(k).iter().copied());
+        x.push(1.0);
+        x
+    }
+
+    fn fit(runs: &[&Run]) -> Self {
+        let rows: usize = runs.iter().map(|r| r.log.nu.nrows() - 1).sum();
+        let mut x = DMatrix::zeros(rows, 13);
+        let mut y = DMatrix::zeros(rows, 6);
+        let mut i = 0;
+        for r in runs {
+            for k in 0..r.log.nu.nrows() - 1 {
+                let reg = Self::regressor(&r.log.nu, &r.log.tau, k);
+                for (j, v) in reg.iter().enumerate() {
+                    x[(i, j)] = *v;
+                }
+                for j in 0..6 {
+                    y[(i, j)] = r.log.nu[(k + 1, j)];
+                }
+                i += 1;
+            }
+        }
+        let theta = x.svd(true, true).solve(&y, 1e-12).expect("least squares");
+        Affine { theta }
+    }
+
+    fn one_step(&self, run: &Run) -> DMatrix<f64> {
+        let n = run.log.nu.nrows();
+        let mut out = run.log.nu.clone();
+        for k in 0..n - 1 {
+            let reg = Self::regressor(&run.log.nu, &run.log.tau, k);
+            for j in 0..6 {
+                out[(k + 1, j)] = (0..13).map(|a| reg[a] * self.theta[(a, j)]).sum();
+            }
+        }
+        out
+    }
+}
+
+fn column_fit(
+    measured: &DMatrix<f64>,
+    predicted: &DMatrix<f64>,
+    j: usize,
+    skip: usize,
+) -> Option<f64> {
+    let m: Vec<f64> = measured.column(j).iter().skip(skip).copied().collect();
+    let p: Vec<f64> = predicted.column(j).iter().skip(skip).copied().collect();
+    nrmse_fit(&m, &p)
+}
+
+/// Flies seed `seed`'s vessel, identifies it with the default settings and
+/// grades the result. `described`: the runs carry their role and grid
+/// speed (else the service must infer them).
+pub fn evaluate(seed: u64, described: bool, settings: &LambdaCampaignSettings) -> SeedReport {
+    let vessel = Vessel::draw(seed);
+    let spec = CampaignSpec::default();
+    let campaign = fly_campaign(&vessel, &spec, seed);
+    let profile = profile_for(&campaign);
+    let inputs: Vec<RunInput> = campaign
+        .runs
+        .iter()
+        .map(|r| to_input(&profile, r, described))
+        .collect();
+    let columns: Vec<String> = profile
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
+    let grid: Vec<f64> = spec.grid_speeds.clone();
+    let out = identify_lambda_campaign(
+        &profile,
+        &grid,
+        &columns,
+        &inputs,
+        settings,
+        &mut NoProgress,
+    )
+    .expect("identification succeeds");
+    let doc = &out.document;
+    let lpv = doc.lpv.as_ref().expect("an LPV model");
+
+    // Parameters against the truth's best linear-affine model over the
+    // runs each grid point was fitted to.
+    let mut z = Vec::new();
+    let restoring = doc.restoring.as_ref().map(|r| r.params);
+    let wb_est = restoring.map_or(0.0, |r| r.weight_minus_buoyancy_n);
+    for point in &lpv.points {
+        let runs: Vec<&Run> = campaign
+            .runs
+            .iter()
+            .filter(|r| point.run_ids.contains(&r.meta.name))
+            .collect();
+        let lin = effective_linearization(&vessel, &runs);
+        let name = |g: &str, i: usize, j: usize| {
+            format!(
+                "{g}[{},{}]@{:.2}",
+                Dof::ALL[i].name(),
+                Dof::ALL[j].name(),
+                point.speed_mps
+            )
+        };
+        for i in 0..6 {
+            for j in 0..6 {
+                for (g, est, std, truth) in [
+                    ("M", point.m[i][j], point.m_std[i][j], lin.m[(i, j)]),
+                    (
+                        "D̄",
+                        point.d_bar[i][j],
+                        point.d_bar_std[i][j],
+                        lin.d_bar[(i, j)],
+                    ),
+                ] {
+                    if std > 0.0 && std.is_finite() {
+                        z.push(ZScore {
+                            name: name(g, i, j),
+                            estimate: est,
+                            truth,
+                            std,
+                        });
+                    }
+                }
+            }
+        }
+        if let (Some(b), Some(s)) = (&point.load, &point.load_std) {
+            for i in 0..6 {
+                // Heave: the constant the model and the truth put in heave
+                // together with −(W − B): compare b − (W − B) with its truth.
+                let (est, truth) = if i == 2 {
+                    (b[i] - wb_est, lin.bias[i] - vessel.w_minus_b)
+                } else {
+                    (b[i], lin.bias[i])
+                };
+                z.push(ZScore {
+                    name: format!("b[{}]@{:.2}", Dof::ALL[i].name(), point.speed_mps),
+                    estimate: est,
+                    truth,
+                    std: s[i],
+                });
+            }
+        }
+    }
+    if let Some(r) = &doc.restoring {
+        for p in &r.parameters {
+            let truth = match p.symbol.as_str() {
+                "W−B" => vessel.w_minus_b,
+                "z_G·W − z_B·B" => vessel.zg_w_minus_zb_b(),
+                _ => continue,
+            };
+            if let Some(std) = p.std {
+                z.push(ZScore {
+                    name: p.symbol.clone(),
+                    estimate: p.value,
+                    truth,
+                    std,
+                });
+            }
+        }
+    }
+
+    // Fits on the validation run: the service's report against the true
+    // model through the same metric, and the affine baseline.
+    let estimation: Vec<&Run> = campaign
+        .runs
+        .iter()
+        .filter(|r| r.meta.role != Role::Validation)
+        .collect();
+    let affine = Affine::fit(&estimation);
+    let val_run = campaign.validation_runs()[0];
+    let report = &out
+        .validation
+        .iter()
+        .find(|v| v.run_id == val_run.meta.name)
+        .expect("validated on the held-out run")
+        .report;
+    let truth_pred = true_predictions(&vessel, &val_run.log);
+    let aff = affine.one_step(val_run);
+    let fits = report
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(j, c)| ChannelFit {
+            channel: c.output.clone(),
+            one_step: c.fit_one_step,
+            one_step_true: column_fit(&val_run.log.nu, &truth_pred.one_step, j, 1),
+            free_run: c.fit_simulation,
+            free_run_true: column_fit(&val_run.log.nu, &truth_pred.free_run, j, 0),
+            one_step_affine: column_fit(&val_run.log.nu, &aff, j, 1),
+        })
+        .collect();
+    let physical = lpv
+        .points
+        .iter()
+        .map(|p| {
+            let m = DMatrix::from_fn(6, 6, |i, j| p.m[i][j]);
+            let d = DMatrix::from_fn(6, 6, |i, j| p.d_bar[i][j]);
+            (p.speed_mps, physical(&m, &d, p.speed_mps))
+        })
+        .map(|(s, (ok, why))| (s, ok, why))
+        .collect();
+    SeedReport {
+        seed,
+        z,
+        fits,
+        physical,
+        findings: doc.structure_findings.clone(),
+        notes: doc.notes.clone(),
+    }
+}
+
+/// M symmetric positive definite and D = D̄ − J_C(M, u₀) dissipative, with
+/// J_C the linearization of C(ν)ν (from the model's own M) at ν₀ = (u₀, 0…).
+fn physical(m: &DMatrix<f64>, d_bar: &DMatrix<f64>, u0: f64) -> (bool, String) {
+    let f = |nu: &DVector<f64>| coriolis(m, nu).expect("6-DOF") * nu;
+    let mut jc = DMatrix::zeros(6, 6);
+    for c in 0..6 {
+        let mut e = DVector::zeros(6);
+        e[0] = u0;
+        let (mut p, mut q) = (e.clone(), e.clone());
+        p[c] += 1.0;
+        q[c] -= 1.0;
+        jc.set_column(c, &((f(&p) - f(&q)) / 2.0));
+    }
+    let asym = (m - m.transpose()).norm() / m.norm();
+    let proj = project_physical(m, &(d_bar - &jc));
+    let ok = asym < 1e-9 && proj.m_raised == 0 && proj.d_removed == 0;
+    (
+        ok,
+        format!(
+            "M asymmetry {asym:.2e}, {} non-positive M eigenvalue(s), {} energy-producing D direction(s)",
+            proj.m_raised, proj.d_removed
+        ),
+    )
+}
+
+/// The default settings, or one structure.
+pub fn settings(structure: Option<StructureChoice>) -> LambdaCampaignSettings {
+    let mut s = LambdaCampaignSettings::default();
+    if let Some(st) = structure {
+        s.structure = st;
+    }
+    s
+}

@@ -1,0 +1,217 @@
+//! Flying runs: the plant under the 20 Hz autopilot, the 10 Hz logger (every
+//! second command, thesis eq. 5.2: τ_obs(k) = τ_real(2k)), and the nav
+//! computer sampling on its own clock.
+
+use nalgebra::{DMatrix, Vector6};
+
+use super::plan::{RunPlan, plan_campaign};
+use super::{Campaign, CampaignSpec, Log, NavLog, NoiseSpec, Run, RunMeta, TruthRecord};
+use crate::controller::{CONTROL_DT, Controller, ControllerConfig};
+use crate::kinematics::wrap_pi;
+use crate::plant::{Plant, State};
+use crate::rng::{Rng, derive_seed};
+use crate::vessel::Vessel;
+
+/// Log every second controller sample: 10 Hz.
+const LOG_EVERY: i64 = 2;
+
+fn to_matrix(rows: &[Vector6<f64>]) -> DMatrix<f64> {
+    DMatrix::from_fn(rows.len(), 6, |i, j| rows[i][j])
+}
+
+fn measure(x: &State, noise: &NoiseSpec, rng: &mut Rng) -> (Vector6<f64>, Vector6<f64>) {
+    let nu = Vector6::from_fn(|i, _| x.nu[i] + noise.nu_std(i) * rng.normal());
+    let mut eta = Vector6::from_fn(|i, _| x.eta[i] + noise.eta_std(i) * rng.normal());
+    eta[5] = wrap_pi(eta[5]);
+    (nu, eta)
+}
+
+/// Everything one run needs besides its plan.
+struct Flight<'a> {
+    plant: &'a Plant,
+    cfg: &'a ControllerConfig,
+    spec: &'a CampaignSpec,
+    offset: f64,
+}
+
+impl Flight<'_> {
+    /// Flies `plan` with its first log stamp at control time `t0`.
+    fn fly(&self, plan: &RunPlan, t0: f64, seed: u64) -> Run {
+        let spec = self.spec;
+        let mut meas_rng = Rng::new(derive_seed(seed, 1));
+        let mut nav_rng = Rng::new(derive_seed(seed, 2));
+        let mut init_rng = Rng::new(derive_seed(seed, 3));
+        let substeps = (spec.integration_rate_hz * CONTROL_DT).round().max(1.0) as i64;
+        let h = CONTROL_DT / substeps as f64;
+
+        // Start in trim at the program's first set-point, loops preset.
+        let r0 = plan.program.reference(0.0);
+        let eta0 = Vector6::new(
+            0.0,
+            0.0,
+            init_rng.range(20.0, 80.0),
+            0.0,
+            0.0,
+            init_rng.range(-std::f64::consts::PI, std::f64::consts::PI),
+        );
+        let nu0 = Vector6::new(r0.nu[0], 0.0, 0.0, 0.0, 0.0, 0.0);
+        let mut x = State::new(eta0, nu0);
+        let v = self.plant.vessel();
+        let mut ctrl = Controller::new(self.cfg.clone());
+        let trim = v.hydrodynamic_force(&nu0) + v.restoring(&eta0)
+            - self.cfg.nominal_restoring(0.0, 0.0)
+            - v.tether;
+        ctrl.preset(&trim);
+        x.tau_act = trim + self.cfg.nominal_restoring(0.0, 0.0);
+
+        let rows = (plan.duration_s * 10.0).round() as i64;
+        let ticks = rows * LOG_EVERY;
+        let pre = (spec.preroll_s / CONTROL_DT).round() as i64;
+        let tick_time = |j: i64| t0 + j as f64 * CONTROL_DT;
+
+        // Nav samples n/rate on the nav clock, at control time n/rate + offset.
+        let rate = spec.nav_rate_hz;
+        let last_log = tick_time(ticks - LOG_EVERY);
+        let mut n_nav = ((t0 - self.offset) * rate).ceil() as i64;
+        let n_last = ((last_log - self.offset) * rate).floor() as i64;
+
+        let mut log_t = Vec::with_capacity(rows as usize);
+        let (mut log_tau, mut log_nu, mut log_eta) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut true_nu, mut true_eta, mut applied) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut cmd20, mut t20) = (Vec::new(), Vec::new());
+        let (mut nav_t, mut nav_nu, mut nav_eta) = (Vec::new(), Vec::new(), Vec::new());
+        let mut saturated = 0usize;
+
+        for j in -pre..ticks {
+            let (y_nu, y_eta) = measure(&x, &spec.noise, &mut meas_rng);
+            let run_t = j as f64 * CONTROL_DT;
+            let (tau, sat) = ctrl.update(&y_nu, &y_eta, &plan.program.reference(run_t));
+            if j >= 0 {
+                saturated += usize::from(sat.iter().any(|s| *s));
+                cmd20.push(tau);
+                t20.push(tick_time(j));
+                if j % LOG_EVERY == 0 {
+                    log_t.push(tick_time(j));
+                    log_tau.push(tau);
+                    log_nu.push(y_nu);
+                    log_eta.push(y_eta);
+                    true_nu.push(x.nu);
+                    true_eta.push(x.eta);
+                    applied.push(self.plant.applied_force(&x, &tau));
+                }
+            }
+            for s in 0..substeps {
+                let ts = tick_time(j) + s as f64 * h;
+                if j >= 0 {
+                    // nav instants inside [ts, ts + h): a partial RK4 step
+                    while n_nav <= n_last {
+                        let tc = n_nav as f64 / rate + self.offset;
+                        if tc >= ts + h {
+                            break;
+                        }
+                        let xn = self.plant.rk4_step(&x, &tau, (tc - ts).max(0.0));
+                        let (m_nu, m_eta) = measure(&xn, &spec.nav_noise, &mut nav_rng);
+                        nav_t.push(n_nav as f64 / rate);
+                        nav_nu.push(m_nu);
+                        nav_eta.push(m_eta);
+                        n_nav += 1;
+                    }
+                }
+                x = self.plant.rk4_step(&x, &tau, h);
+            }
+        }
+
+        Run {
+            meta: RunMeta {
+                name: plan.name.clone(),
+                role: plan.role,
+                grid_speed: plan.grid_speed,
+                excited: plan.excited.clone(),
+                signal: plan.signal,
+                amplitude: plan.amplitude,
+                switch_time_s: plan.switch_time_s,
+                speeds: plan.speeds.clone(),
+                start_s: t0,
+                duration_s: rows as f64 / 10.0,
+                clock_offset_s: self.offset,
+                saturated_fraction: saturated as f64 / ticks.max(1) as f64,
+            },
+            log: Log {
+                t: log_t,
+                tau: to_matrix(&log_tau),
+                nu: to_matrix(&log_nu),
+                eta: to_matrix(&log_eta),
+            },
+            nav: NavLog {
+                t: nav_t,
+                nu: to_matrix(&nav_nu),
+                eta: to_matrix(&nav_eta),
+            },
+            truth: TruthRecord {
+                nu: to_matrix(&true_nu),
+                eta: to_matrix(&true_eta),
+                tau_applied: to_matrix(&applied),
+                tau_cmd_20hz: to_matrix(&cmd20),
+                t_20hz: t20,
+            },
+        }
+    }
+}
+
+/// Flies the campaign `spec` with `vessel`, everything drawn from `seed`:
+/// the team's controller (nominal inertia and ĝ), the clock offset, run
+/// durations and signals, initial depth and heading, and all noise. Runs
+/// follow each other on the control clock with 30–180 s gaps.
+pub fn fly_campaign(vessel: &Vessel, spec: &CampaignSpec, seed: u64) -> Campaign {
+    let mut rng = Rng::new(derive_seed(seed, 0xCA3B));
+    let cfg = ControllerConfig::tune(vessel, &spec.envelope(), &mut rng);
+    let (lo, hi) = spec.clock_offset_range_s;
+    let offset = rng.range(lo, hi);
+    let plans = plan_campaign(spec, &mut rng);
+    let plant = Plant::new(vessel);
+    let flight = Flight {
+        plant: &plant,
+        cfg: &cfg,
+        spec,
+        offset,
+    };
+    let mut t0 = (rng.range(100.0, 1000.0) * 10.0).round() / 10.0;
+    let mut starts = Vec::with_capacity(plans.len());
+    for p in &plans {
+        starts.push(t0);
+        t0 += p.duration_s + (rng.range(30.0, 180.0) * 10.0).round() / 10.0;
+    }
+    // Runs are independent (own seeds), so flying them on a few threads
+    // changes nothing in the result.
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(4));
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut done: Vec<(usize, Run)> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                s.spawn(|| {
+                    let mut out = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(p) = plans.get(i) else { break out };
+                        let run_seed = derive_seed(seed, 1000 + i as u64);
+                        out.push((i, flight.fly(p, starts[i], run_seed)));
+                    }
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("a run panicked"))
+            .collect()
+    });
+    done.sort_by_key(|(i, _)| *i);
+    let runs = done.into_iter().map(|(_, r)| r).collect();
+    Campaign {
+        vessel: vessel.clone(),
+        spec: spec.clone(),
+        seed,
+        clock_offset_s: offset,
+        controller: cfg,
+        runs,
+    }
+}
