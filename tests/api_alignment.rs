@@ -195,6 +195,14 @@ async fn weak_runs_take_the_pooled_offset_and_jobs_use_it() {
     let e = view_of(&c.json, &id(&early));
     assert_eq!(e["at_upload"]["source"], "weak_own", "{e}");
     assert_eq!(e["now"]["source"], "pooled", "{e}");
+    // The strong runs were merged with their own estimates; the pool holds
+    // both, so they are read with it now.
+    for s in [&s1, &s2] {
+        let v = view_of(&c.json, &id(s));
+        assert_eq!(v["at_upload"]["source"], "own", "{v}");
+        assert_eq!(v["now"]["source"], "pooled", "{v}");
+        assert_eq!(v["now"]["offset_s"], pooled["offset_s"], "{v}");
+    }
 
     // Identification reads the early weak run with the pooled offset.
     let job = json!({
@@ -212,6 +220,7 @@ async fn weak_runs_take_the_pooled_offset_and_jobs_use_it() {
         .find(|c| c["run_id"] == id(&early))
         .unwrap_or_else(|| panic!("{done}"));
     assert_eq!(early_clock["source"], "pooled", "{early_clock}");
+    assert!(clocks.iter().all(|c| c["source"] == "pooled"), "{clocks:?}");
     assert!((early_clock["offset_s"].as_f64().unwrap() - TRUTH).abs() < 0.05);
     let mid = done["result"]["model_id"].as_str().unwrap();
     let m = app.call("GET", "/api/models/{id}", &[mid], None).await;

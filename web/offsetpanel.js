@@ -125,7 +125,7 @@ export function campaignOffsetPanel(campaignId) {
     const save = async (value) => render(await api.setCampaignClockOffset(campaignId, value));
     fill(box,
       h('h2', { class: 'section-title' }, 'Clock offset of two-file runs'),
-      h('p', { class: 'hint' }, 'Navigation time + offset = control time. Runs whose own estimate is not informative use the offset pooled from the informative ones; one set by hand for the campaign overrides both in jobs from now on (stored run reports are not recomputed).'),
+      h('p', { class: 'hint' }, 'Navigation time + offset = control time. Every run consistent with the campaign uses the offset pooled from the informative runs (its own estimate included), a run left out of the pool its own estimate; one set by hand for the campaign overrides both in jobs from now on (stored run reports are not recomputed).'),
       h('div', { class: 'offset-line' },
         h('span', { class: 'offset', 'data-testid': 'campaign-offset-pooled', 'data-offset-s': p ? String(p.offset_s) : '' },
           p ? `pooled ${offsetText(p.offset_s, p.std_s)}` : 'no informative run yet'),

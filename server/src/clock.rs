@@ -4,11 +4,13 @@
 //!
 //! When they are computed: at upload, from the campaign's runs stored
 //! before (a weak run uploaded first keeps the source it had — its quality
-//! report is not recomputed when an informative run arrives later; the
-//! `GET /api/campaigns/{id}/clock-offset` view shows what it would use
-//! now); at job time, from every accepted two-file run of the campaign as
-//! they are then, with the offsets set by hand at that moment — so a job
-//! always uses the current pooled offset.
+//! report is not recomputed when an informative run arrives later; an
+//! informative run is merged with its own estimate, which joins the pool
+//! only once stored; the `GET /api/campaigns/{id}/clock-offset` view shows
+//! what each would use now); at job time, from every accepted two-file run
+//! of the campaign as they are then, with the offsets set by hand at that
+//! moment — so a job always uses the current pooled offset, also for the
+//! informative runs whose estimates it holds.
 
 use std::collections::HashMap;
 
@@ -72,7 +74,8 @@ impl CampaignClocks {
     }
 
     /// The priors run `run_id` is read with (its own hand-set offset, if
-    /// any, the campaign's, the pooled one).
+    /// any, the campaign's, the pooled one and whether it pools the run's
+    /// own estimate — then the pool is used rather than the estimate).
     pub fn priors_for(&self, run_id: Option<&str>) -> OffsetPriors {
         OffsetPriors {
             user_run_s: run_id.and_then(|id| self.user_runs.get(id).copied()),
@@ -81,6 +84,7 @@ impl CampaignClocks {
                 offset_s: p.offset_s,
                 std_s: p.std_s,
                 runs: p.runs_used.len(),
+                includes_own: run_id.is_some_and(|id| p.runs_used.iter().any(|u| u == id)),
             }),
         }
     }

@@ -131,9 +131,14 @@ pub(crate) fn offset_warnings(c: &Context) -> Vec<String> {
                     p.offset_s, p.std_s, p.runs
                 )
             });
-            let own = c
-                .own
-                .map_or_else(|| "it has no own estimate".to_owned(), own_words);
+            let own = match (c.own, c.pooled) {
+                (Some(o), Some(q)) if q.includes_own => format!(
+                    "it combines this run's own informative estimate {} with the consistent runs' of the campaign",
+                    offset_words(o.offset_s, Some(o.std_error_s))
+                ),
+                (Some(o), _) => own_words(o),
+                (None, _) => "it has no own estimate".to_owned(),
+            };
             w.push(format!(
                 "the campaign's pooled clock offset is used{p}: {own}"
             ));

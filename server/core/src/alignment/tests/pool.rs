@@ -3,6 +3,7 @@
 
 use super::super::test_support::{Case, RunKind, make_run, table};
 use super::super::*;
+use crate::timeseries::LogTable;
 
 /// The campaign's true offset (s) and an outlier run's (its navigation
 /// computer rebooted).
@@ -48,6 +49,24 @@ fn estimate(c: &Case) -> OffsetEstimate {
     .unwrap()
 }
 
+/// The control and navigation logs of a run of `kind`: the shared depth.
+fn shared_depth(kind: RunKind, seed: u64) -> (LogTable, LogTable) {
+    let c = make_run(kind, seed, TRUTH);
+    (
+        table(c.control.0, vec![("z", c.control.1)]),
+        table(c.nav.0, vec![("z", c.nav.1)]),
+    )
+}
+
+/// Asserts that one of `rep`'s warnings contains `words`.
+fn assert_warns(rep: &AlignmentReport, words: &str) {
+    assert!(
+        rep.warnings.iter().any(|w| w.contains(words)),
+        "{words:?} not in {:?}",
+        rep.warnings
+    );
+}
+
 // Measured (release build) over campaigns 1–8: worst pooled error and worst
 // per-run error as printed; the README quotes them.
 #[test]
@@ -79,16 +98,27 @@ fn every_run_of_a_campaign_gets_within_50_ms_through_the_pool() {
             "campaign {seed}: the outlier is pooled: {pooled:?}"
         );
         assert!(!pooled.runs_used.contains(&outlier));
-        let priors = OffsetPriors {
-            pooled: Some(PooledValue {
-                offset_s: pooled.offset_s,
-                std_s: pooled.std_s,
-                runs: pooled.runs_used.len(),
-            }),
-            ..OffsetPriors::default()
-        };
-        for ((c, shares), e) in runs.iter().zip(&estimates) {
+        for (i, ((c, shares), e)) in runs.iter().zip(&estimates).enumerate() {
+            // As the service reads a stored run: the pool says whether it
+            // holds this run's own estimate.
+            let includes_own = pooled.runs_used.contains(&format!("r{i}"));
+            let priors = OffsetPriors {
+                pooled: Some(PooledValue {
+                    offset_s: pooled.offset_s,
+                    std_s: pooled.std_s,
+                    runs: pooled.runs_used.len(),
+                    includes_own,
+                }),
+                ..OffsetPriors::default()
+            };
             let chosen = choose_offset(Some(e), &priors).unwrap().unwrap();
+            // A pooled run takes the pool; the outlier keeps its own.
+            let expected = if includes_own || !e.informative {
+                OffsetSource::Pooled
+            } else {
+                OffsetSource::Own
+            };
+            assert_eq!(chosen.source, expected, "campaign {seed} run {i}: {e:?}");
             let err = (chosen.offset_s - c.offset).abs();
             assert!(
                 err < 0.05,
@@ -114,9 +144,7 @@ fn every_run_of_a_campaign_gets_within_50_ms_through_the_pool() {
 
 #[test]
 fn a_weak_run_is_merged_with_the_pooled_offset_and_says_so() {
-    let c = make_run(RunKind::StaticHold, 7, TRUTH);
-    let control = table(c.control.0.clone(), vec![("z", c.control.1.clone())]);
-    let nav = table(c.nav.0.clone(), vec![("z", c.nav.1.clone())]);
+    let (control, nav) = shared_depth(RunKind::StaticHold, 7);
     let opts = OffsetOptions::default();
     // Alone, the run is merged with its weak estimate and warns loudly.
     let (_, rep) = align_logs(&control, &nav, "z", None, &opts).unwrap();
@@ -134,6 +162,7 @@ fn a_weak_run_is_merged_with_the_pooled_offset_and_says_so() {
         offset_s: 7.4301,
         std_s: 0.0008,
         runs: 5,
+        includes_own: false,
     };
     let priors = OffsetPriors {
         pooled: Some(pooled),
@@ -145,13 +174,7 @@ fn a_weak_run_is_merged_with_the_pooled_offset_and_says_so() {
     assert_eq!(rep.offset_used_std_s, Some(0.0008));
     assert_eq!(rep.pooled, Some(pooled));
     assert!(rep.offset.is_some());
-    assert!(
-        rep.warnings
-            .iter()
-            .any(|w| w.contains("pooled clock offset is used")),
-        "{:?}",
-        rep.warnings
-    );
+    assert_warns(&rep, "pooled clock offset is used");
     assert!(rec.len() > 100);
     // A hand-set run offset wins over everything; a hand-set campaign offset
     // over the own and pooled ones.
@@ -213,4 +236,34 @@ fn a_flat_shared_channel_is_merged_with_a_prior_offset() {
             .any(|w| w.starts_with("no own estimate"))
     );
     assert!((rec.t0 - 0.0).abs() < 1e-9 && rec.len() > 500);
+}
+
+#[test]
+fn an_informative_run_takes_the_pool_that_holds_its_estimate() {
+    let (control, nav) = shared_depth(RunKind::Lively, 5);
+    let opts = OffsetOptions::default();
+    let pooled = |runs, includes_own| OffsetPriors {
+        pooled: Some(PooledValue {
+            offset_s: 7.4301,
+            std_s: 0.0008,
+            runs,
+            includes_own,
+        }),
+        ..OffsetPriors::default()
+    };
+    // A pool of other runs (at upload, or one that left this run out):
+    // the run's own informative estimate.
+    let (_, rep) = align_logs_with(&control, &nav, "z", None, &opts, &pooled(4, false)).unwrap();
+    assert!(rep.offset.as_ref().unwrap().informative);
+    assert_eq!(rep.offset_source, OffsetSource::Own);
+    // A pool of itself alone adds nothing.
+    let (_, rep) = align_logs_with(&control, &nav, "z", None, &opts, &pooled(1, true)).unwrap();
+    assert_eq!(rep.offset_source, OffsetSource::Own);
+    // A pool that holds its estimate and others': the pool, and it says so.
+    let (_, rep) = align_logs_with(&control, &nav, "z", None, &opts, &pooled(5, true)).unwrap();
+    assert_eq!(
+        (rep.offset_source, rep.offset_used_s, rep.offset_used_std_s),
+        (OffsetSource::Pooled, 7.4301, Some(0.0008))
+    );
+    assert_warns(&rep, "combines this run's own informative estimate");
 }
