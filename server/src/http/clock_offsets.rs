@@ -14,12 +14,12 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use super::json::ApiJson;
-use super::{AppState, blocking, found};
+use super::{AppState, blocking, campaign_and_vessel, found};
 use crate::clock::{CampaignClocks, own_estimate};
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::processing::{self, RunMeta};
 use crate::storage::runs::{self, Run};
-use crate::storage::{campaigns, clock_offsets, plans, vessels};
+use crate::storage::{campaigns, clock_offsets, plans};
 
 /// A clock offset to set by hand, or `null` to clear it.
 #[derive(Debug, Deserialize, utoipa::ToSchema)]
@@ -271,16 +271,7 @@ pub async fn put_run_clock_offset(
     let run = found(runs::get(&s.db, &id).await?, "run", &id)?;
     let offset = requested_offset(&body)?;
     two_file(&run, "clock_offset_s")?;
-    let campaign = found(
-        campaigns::get(&s.db, &run.campaign_id).await?,
-        "campaign",
-        &run.campaign_id,
-    )?;
-    let vessel = found(
-        vessels::get(&s.db, &campaign.vessel_id).await?,
-        "vessel",
-        &campaign.vessel_id,
-    )?;
+    let (campaign, vessel) = campaign_and_vessel(&s.db, &run).await?;
     let planned = match &run.experiment_id {
         Some(eid) => plans::experiment(&s.db, &campaign.id, eid).await?,
         None => None,

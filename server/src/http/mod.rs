@@ -182,6 +182,31 @@ pub(crate) fn found<T>(v: Option<T>, what: &str, id: &str) -> Result<T, ApiError
     v.ok_or_else(|| ApiError::NotFound(format!("no {what} with id '{id}'")))
 }
 
+/// The campaign and the vessel stored run `run` belongs to; a 404 names
+/// the one that is gone.
+pub(crate) async fn campaign_and_vessel(
+    db: &Db,
+    run: &crate::storage::runs::Run,
+) -> Result<
+    (
+        crate::storage::campaigns::Campaign,
+        crate::storage::vessels::Vessel,
+    ),
+    ApiError,
+> {
+    let campaign = found(
+        crate::storage::campaigns::get(db, &run.campaign_id).await?,
+        "campaign",
+        &run.campaign_id,
+    )?;
+    let vessel = found(
+        crate::storage::vessels::get(db, &campaign.vessel_id).await?,
+        "vessel",
+        &campaign.vessel_id,
+    )?;
+    Ok((campaign, vessel))
+}
+
 /// Runs CPU-bound work off the async runtime.
 pub(crate) async fn blocking<T: Send + 'static>(
     f: impl FnOnce() -> T + Send + 'static,

@@ -11,13 +11,13 @@ use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv}
 use serde::{Deserialize, Serialize};
 
 use super::query::ApiQuery;
-use super::{AppState, blocking, found};
+use super::{AppState, blocking, campaign_and_vessel, found};
 use crate::clock::CampaignClocks;
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::jobs::run_inputs::StoredRun;
 use crate::processing::{self, RunSummary};
 use crate::storage::models::{self, ModelSummary, StoredModel};
-use crate::storage::{campaigns, runs, vessels};
+use crate::storage::runs;
 use seatrial_core::identification::predictor::validate_on_run_with;
 use seatrial_core::validation::ValidationSettings;
 
@@ -257,11 +257,7 @@ pub async fn compare_models(
             format!("run '{}' was {}", run.id, run.status),
         ));
     }
-    let campaign = found(
-        campaigns::get(&s.db, &run.campaign_id).await?,
-        "campaign",
-        &run.campaign_id,
-    )?;
+    let (campaign, vessel) = campaign_and_vessel(&s.db, &run).await?;
     for (field, m) in [("a", &stored[0]), ("b", &stored[1])] {
         if m.summary.vessel_id != campaign.vessel_id {
             return Err(ApiError::invalid(
@@ -270,11 +266,6 @@ pub async fn compare_models(
             ));
         }
     }
-    let vessel = found(
-        vessels::get(&s.db, &campaign.vessel_id).await?,
-        "vessel",
-        &campaign.vessel_id,
-    )?;
     let clocks = CampaignClocks::load(&s.db, &run.campaign_id).await?;
     let stored_run = StoredRun::of(&s.job_context(), run.clone(), &clocks);
     let k = q.k.unwrap_or(10).max(1);

@@ -14,11 +14,10 @@ use serde::{Deserialize, Deserializer};
 use serde_json::Value;
 
 use super::json::ApiJson;
-use super::{AppState, found};
+use super::{AppState, campaign_and_vessel, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::processing::RunMeta;
 use crate::storage::runs::{self, DescriptionField, Run};
-use crate::storage::{campaigns, vessels};
 
 /// Longest notes (characters).
 pub const MAX_NOTES_CHARS: usize = 2000;
@@ -247,16 +246,7 @@ pub async fn describe_run(
 ) -> ApiResult<Json<Run>> {
     let run = found(runs::get(&s.db, &id).await?, "run", &id)?;
     let change: DescriptionChange = from_value(body, "")?;
-    let campaign = found(
-        campaigns::get(&s.db, &run.campaign_id).await?,
-        "campaign",
-        &run.campaign_id,
-    )?;
-    let vessel = found(
-        vessels::get(&s.db, &campaign.vessel_id).await?,
-        "vessel",
-        &campaign.vessel_id,
-    )?;
+    let (_, vessel) = campaign_and_vessel(&s.db, &run).await?;
     let mut user = UserDescription::default();
     let touched = change.apply(&mut user, &vessel.profile, "")?;
     runs::set_description(&s.db, &id, &user, &touched).await?;
