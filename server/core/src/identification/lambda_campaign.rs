@@ -6,6 +6,7 @@
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 
+use super::attitude_loop::AttitudeLoop;
 use super::dataset::{RunInput, segments};
 use super::document::{
     LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, to_rows,
@@ -433,6 +434,11 @@ pub fn identify_lambda_campaign(
         input_names: input_names.clone(),
         ..ValidationSettings::default()
     };
+    let attitude_loop = g.and_then(|g| AttitudeLoop::new(lpv.clone(), *g));
+    let loop_settings = ValidationSettings {
+        input_names: AttitudeLoop::input_names(&cols[..n]),
+        ..vsettings.clone()
+    };
     let mut validation = Vec::new();
     for r in &roles.validation {
         let segs = segments(r, &cols, &outputs, 50)
@@ -441,14 +447,28 @@ pub fn identify_lambda_campaign(
             .iter()
             .max_by_key(|s| s.y.nrows())
             .expect("segments is non-empty");
-        let e = experiment(longest, n, g, None)?;
-        let rec = ValidationRecord {
-            h: longest.h,
-            u: &e.gamma,
-            y: &e.nu,
-        };
-        let report = validate(&lpv, &rec, &vsettings)
-            .map_err(|e| IdentifyError::invalid(format!("runs[{}]", r.run_id), e.to_string()))?;
+        let report = match &attitude_loop {
+            // g(η) of the simulated attitude in the loop: record [τ | η].
+            Some(model) => validate(
+                model,
+                &ValidationRecord {
+                    h: longest.h,
+                    u: &longest.u.columns(0, 12).into_owned(),
+                    y: &longest.y,
+                },
+                &loop_settings,
+            ),
+            None => {
+                let e = experiment(longest, n, g, None)?;
+                let rec = ValidationRecord {
+                    h: longest.h,
+                    u: &e.gamma,
+                    y: &e.nu,
+                };
+                validate(&lpv, &rec, &vsettings)
+            }
+        }
+        .map_err(|e| IdentifyError::invalid(format!("runs[{}]", r.run_id), e.to_string()))?;
         validation.push(RunValidation {
             run_id: r.run_id.clone(),
             run_name: r.name.clone(),

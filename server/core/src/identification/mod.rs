@@ -4,6 +4,8 @@
 //!
 //! - [`discover_campaign`]: missing-physics discovery on a stored LPV model,
 //!   per grid speed, and the augmented model as its next version.
+//! - [`attitude_loop`]: a 6-DOF LPV model with g(η) of its own attitude in
+//!   the loop (free runs keep the restoring spring).
 //! - [`augmented`]: an LPV model with discovered terms as a predictor.
 //! - [`dataset`]: runs → segments (one per valid block, never concatenated).
 //! - [`describe`]: what a run is (role, grid speed, excited DOFs, signal),
@@ -21,6 +23,7 @@
 //!   predictor state.
 //! - [`outcome`], [`error`]: what an identification returns.
 
+pub mod attitude_loop;
 pub mod augmented;
 pub mod bis;
 pub mod dataset;

@@ -5,8 +5,6 @@ use super::ValidationError;
 use super::correlation::autocorrelation;
 use super::residuals::*;
 use crate::rng::SplitMix64;
-use crate::validation::ValidationError;
-use crate::validation::correlation::autocorrelation;
 
 fn white(seed: u64, n: usize) -> Vec<f64> {
     let mut rng = SplitMix64::new(seed);
