@@ -90,7 +90,7 @@ impl AttitudeLoop {
     /// when it does not fit the model.
     fn parts(&self, rec: &ValidationRecord<'_>) -> Option<(DMatrix<f64>, Vec<Attitude>)> {
         let n = rec.y.nrows();
-        if rec.y.ncols() != 6 || rec.u.shape() != (n, 12) || !(rec.h > 0.0) {
+        if rec.y.ncols() != 6 || rec.u.shape() != (n, 12) || rec.h.is_nan() || rec.h <= 0.0 {
             return None;
         }
         if rec.u.iter().chain(rec.y.iter()).any(|v| !v.is_finite()) {
