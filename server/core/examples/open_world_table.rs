@@ -2,7 +2,10 @@
 //! the λ-filter identification's parameter errors in σ and its validation
 //! fits against the true model and an affine least-squares baseline.
 //!
-//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto]`
+//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid]`
+//!
+//! `--in-grid` flies the validation staircase at speeds inside the grid
+//! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it.
 
 #[path = "../tests/support/open_world.rs"]
 mod open_world;
@@ -13,6 +16,7 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut seeds = Vec::new();
     let mut structure = None;
+    let mut spec = seatrial_truth::CampaignSpec::default();
     let mut it = args.iter();
     while let Some(a) = it.next() {
         if a == "--structure" {
@@ -22,6 +26,8 @@ fn main() {
                 "symmetric" => StructureChoice::Symmetric,
                 _ => StructureChoice::Auto,
             });
+        } else if a == "--in-grid" {
+            spec.validation_speeds = Some(vec![0.5, 0.75, 1.25, 1.75, 2.0]);
         } else if let Ok(s) = a.parse::<u64>() {
             seeds.push(s);
         }
@@ -32,7 +38,7 @@ fn main() {
     let settings = open_world::settings(structure);
     for seed in seeds {
         let t = std::time::Instant::now();
-        let r = open_world::evaluate(seed, true, &settings);
+        let r = open_world::evaluate_with(seed, true, &settings, &spec);
         let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
         println!(
             "\n## seed {seed}: {within}/{} parameters within ±3σ ({:.0} %), {:.1} s",
@@ -57,17 +63,18 @@ fn main() {
                 z.z()
             );
         }
-        println!("  channel | 1-step  true   affine | free run  true");
+        println!("  channel | 1-step  true   affine | free run  true   oracle");
         let f = |x: Option<f64>| x.map_or("   —  ".into(), |v| format!("{v:6.3}"));
         for c in &r.fits {
             println!(
-                "  {:<7} | {} {} {} | {} {}",
+                "  {:<7} | {} {} {} | {} {} {}",
                 c.channel,
                 f(c.one_step),
                 f(c.one_step_true),
                 f(c.one_step_affine),
                 f(c.free_run),
-                f(c.free_run_true)
+                f(c.free_run_true),
+                f(c.free_run_oracle)
             );
         }
         for s in r.findings.iter().chain(&r.notes) {

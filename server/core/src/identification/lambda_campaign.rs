@@ -469,6 +469,23 @@ pub fn identify_lambda_campaign(
             }
         }
         .map_err(|e| IdentifyError::invalid(format!("runs[{}]", r.run_id), e.to_string()))?;
+        if let Some(j) = dofs.iter().position(|d| *d == Dof::Surge) {
+            let u: Vec<f64> = longest.y.column(j).iter().copied().collect();
+            let grid: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
+            let (below, above) = super::roles::beyond_grid(&u, &grid);
+            for (share, side, end) in [
+                (below, "below", grid[0]),
+                (above, "above", grid[grid.len() - 1]),
+            ] {
+                if share >= 0.05 {
+                    notes.push(format!(
+                        "validation run {}: {:.0} % of it was flown {side} the identified speeds, where the model holds its {end:.2} m/s sub-model; its fits there measure extrapolation, and a grid point at that speed would model it",
+                        r.name,
+                        100.0 * share
+                    ));
+                }
+            }
+        }
         validation.push(RunValidation {
             run_id: r.run_id.clone(),
             run_name: r.name.clone(),
