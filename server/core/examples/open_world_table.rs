@@ -2,10 +2,12 @@
 //! the λ-filter identification's parameter errors in σ and its validation
 //! fits against the true model and an affine least-squares baseline.
 //!
-//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid]`
+//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--controller-hz 20]`
 //!
 //! `--in-grid` flies the validation staircase at speeds inside the grid
-//! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it.
+//! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it;
+//! `--controller-hz` tells the identification the controller's rate (the
+//! truth's loop runs at 20 Hz, logged at 10 Hz).
 
 #[path = "../tests/support/open_world.rs"]
 mod open_world;
@@ -16,6 +18,7 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut seeds = Vec::new();
     let mut structure = None;
+    let mut controller_hz = None;
     let mut spec = seatrial_truth::CampaignSpec::default();
     let mut it = args.iter();
     while let Some(a) = it.next() {
@@ -26,6 +29,8 @@ fn main() {
                 "symmetric" => StructureChoice::Symmetric,
                 _ => StructureChoice::Auto,
             });
+        } else if a == "--controller-hz" {
+            controller_hz = it.next().and_then(|v| v.parse::<f64>().ok());
         } else if a == "--in-grid" {
             spec.validation_speeds = Some(vec![0.5, 0.75, 1.25, 1.75, 2.0]);
         } else if let Ok(s) = a.parse::<u64>() {
@@ -35,7 +40,8 @@ fn main() {
     if seeds.is_empty() {
         seeds = vec![1, 2, 3, 4, 5];
     }
-    let settings = open_world::settings(structure);
+    let mut settings = open_world::settings(structure);
+    settings.controller_rate_hz = controller_hz;
     for seed in seeds {
         let t = std::time::Instant::now();
         let r = open_world::evaluate_with(seed, true, &settings, &spec);

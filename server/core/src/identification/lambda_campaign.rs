@@ -7,11 +7,12 @@ use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 
 use super::attitude_loop::AttitudeLoop;
-use super::dataset::{RunInput, segments};
+use super::dataset::{RunInput, Segment, segments};
 use super::document::{
     LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, to_rows,
 };
 use super::error::IdentifyError;
+use super::intersample::{MIN_R2, controller_gains, corrected, hidden_share};
 use super::joint_restoring::{Functions, PooledRestoring, load, specification};
 use super::lambda_coriolis::fit_points;
 use super::lambda_data::{experiment, per_point, static_holds};
@@ -103,6 +104,13 @@ pub struct LambdaCampaignSettings {
     /// structure constrains the damping D and D̄ = D + J_C(M, u₀).
     #[serde(default = "default_true")]
     pub coriolis_from_m: bool,
+    /// Rate of the vehicle's feedback controller (Hz); default: the vessel
+    /// profile's `controller_rate_hz`. When it runs faster than the log
+    /// (e.g. a 20 Hz loop logged at 10 Hz), M and D̄ are corrected for the
+    /// commands the log does not show, with the controller's gains read
+    /// from the log (see `intersample`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller_rate_hz: Option<f64>,
 }
 
 fn default_threshold() -> f64 {
@@ -128,6 +136,7 @@ impl Default for LambdaCampaignSettings {
             estimate_restoring: true,
             constant_loads: true,
             coriolis_from_m: true,
+            controller_rate_hz: None,
         }
     }
 }
@@ -198,6 +207,14 @@ pub fn identify_lambda_campaign(
         return Err(IdentifyError::invalid(
             "settings.coupling_threshold",
             format!("must be in (0, 1), got {}", settings.coupling_threshold),
+        ));
+    }
+    if let Some(rate) = settings.controller_rate_hz
+        && !(rate.is_finite() && rate > 0.0)
+    {
+        return Err(IdentifyError::invalid(
+            "settings.controller_rate_hz",
+            format!("must be a positive rate in Hz, got {rate}"),
         ));
     }
     if settings.k == 0 {
@@ -341,6 +358,21 @@ pub fn identify_lambda_campaign(
             &mut notes,
         )
         .map_err(lambda_error)?
+    };
+
+    let estimates = match settings
+        .controller_rate_hz
+        .or(Some(profile.controller_rate_hz))
+    {
+        Some(rate) => correct_intersample(
+            estimates,
+            &data.segments.iter().flatten().collect::<Vec<_>>(),
+            &dofs,
+            with_restoring,
+            rate * h,
+            &mut notes,
+        ),
+        None => estimates,
     };
 
     // 3. Sub-models, physical structure enforced, parameters.
@@ -579,4 +611,51 @@ fn restoring_doc(
         evidence,
         params: pooled.params(),
     }
+}
+
+/// M and D̄ of every sub-model corrected for a controller `ratio` times
+/// faster than the log (see [`super::intersample`]); said in `notes`.
+fn correct_intersample(
+    estimates: Vec<(f64, LambdaEstimate)>,
+    segments: &[&Segment],
+    dofs: &[Dof],
+    with_attitude: bool,
+    ratio: f64,
+    notes: &mut Vec<String>,
+) -> Vec<(f64, LambdaEstimate)> {
+    if ratio < 1.0 + 1e-6 {
+        return estimates;
+    }
+    let Some(gains) = controller_gains(segments, dofs, with_attitude) else {
+        notes.push("the controller's gains could not be read from the log (too few samples): M and D̄ are not corrected for its faster rate".into());
+        return estimates;
+    };
+    let h = segments.first().map_or(0.0, |s| s.h);
+    let c = hidden_share(h, ratio);
+    let diag: Vec<String> = dofs
+        .iter()
+        .enumerate()
+        .map(|(i, d)| match gains.r2[i] >= MIN_R2 {
+            true => format!("{} {}", d.name(), crate::numbers::sig3(gains.k_nu[(i, i)])),
+            false => format!("{} not corrected (R² {:.2})", d.name(), gains.r2[i]),
+        })
+        .collect();
+    notes.push(format!(
+        "controller at {ratio:.2}× the log rate: the commands between log samples were rebuilt from its gains, read from the log (∂τ/∂ν diagonal, N·s/m and N·m·s/rad: {}; least squares on Δτ, switches trimmed, R² {:.2}–{:.2}); M changed by c·K_ν and D̄ by c·K_η with c = {:.4} s",
+        diag.join(", "),
+        gains.r2.iter().copied().fold(f64::INFINITY, f64::min),
+        gains.r2.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        c
+    ));
+    estimates
+        .into_iter()
+        .map(|(speed, mut est)| {
+            // D̄ as a whole is what the data determine (its C(ν) part from M
+            // included), so only c·K_η J moves it.
+            let (m, d) = corrected(&est.m, &est.d_bar, &gains, dofs, c);
+            est.m = m;
+            est.d_bar = d;
+            (speed, est)
+        })
+        .collect()
 }

@@ -12,7 +12,8 @@
 //!   inferred from its data; [`description`]: that, the plan and the
 //!   supervisor's word merged, each value with its source.
 //! - [`roles`]: static, estimation and held-out validation runs.
-//! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method.
+//! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method;
+//!   [`intersample`]: M and D̄ corrected for a controller faster than its log.
 //! - [`n4sid_campaign`]: black-box LTI comparison model by N4SID.
 //! - [`ekf_campaign`]: DP ship by the staged parallel EKF (Bis units: [`bis`]).
 //! - [`document`]: the stored/served model: matrices, parameters with std.
@@ -35,6 +36,7 @@ pub mod document;
 pub mod ekf_campaign;
 pub mod error;
 pub mod export;
+pub mod intersample;
 mod joint_restoring;
 pub mod lambda_campaign;
 mod lambda_coriolis;
