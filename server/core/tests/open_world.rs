@@ -99,11 +99,55 @@ fn one_step_fits_beat_the_affine_baseline_and_approach_the_truth() {
     }
 }
 
+/// Reported σ are honest enough to bet on: with the 20 Hz controller's
+/// unlogged commands corrected and σ of M inflated by its spread across the
+/// grid, at least 80 % of the parameters lie within ±3σ of the truth's
+/// best linear fit on every vessel (85–96 % measured; 69–79 % before).
+#[test]
+fn most_parameters_lie_within_three_reported_sigma() {
+    for r in reports() {
+        let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
+        assert!(
+            within as f64 >= 0.8 * r.z.len() as f64,
+            "seed {}: {within}/{} within ±3σ",
+            r.seed,
+            r.z.len()
+        );
+    }
+}
+
+/// Free runs keep the restoring spring (g(η) of the simulated attitude),
+/// never the open-loop drift of a γ taken from the measured attitude (roll
+/// −6.0…0.08 before): roll comes within 0.1 of the best linear model of the
+/// truth (the oracle) on every vessel, pitch stays above 0.4 (0.52–0.84
+/// measured; the oracle's 0.80–0.86).
+#[test]
+fn roll_and_pitch_free_runs_keep_their_restoring_spring() {
+    for r in reports() {
+        for c in &r.fits {
+            let (est, oracle) = (
+                c.free_run.expect("a free-run fit"),
+                c.free_run_oracle.expect("the oracle's fit"),
+            );
+            let ok = match c.channel.as_str() {
+                "p" => est >= oracle - 0.1,
+                "q" => est >= 0.4,
+                _ => true,
+            };
+            assert!(
+                ok,
+                "seed {} {}: free run {est:.3} (oracle {oracle:.3})",
+                r.seed, c.channel
+            );
+        }
+    }
+}
+
 /// The issue's full criteria, not met yet (see the README's identification
 /// section): ≥ 95 % of parameters within ±3σ, 1-step within 0.02 and free
 /// run within 0.05 of the true model in every channel.
 #[test]
-#[ignore = "known gap: roll/pitch inertia biased 5–13 %, free runs of roll and pitch far below the true model's"]
+#[ignore = "known gap: 85–96 % within ±3σ; free runs below the true model's on the staircase legs outside the grid, where any linear LPV model (the oracle too) falls short"]
 fn the_issue_criteria_on_five_vessels() {
     for r in reports() {
         let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();

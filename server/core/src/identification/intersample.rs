@@ -20,6 +20,8 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::dataset::Segment;
+use crate::estimation::lambda::LambdaEstimate;
+use crate::numbers::sig3;
 use crate::planning::dof::Dof;
 
 /// The controller's gains as seen in the log.
@@ -184,6 +186,53 @@ pub fn corrected(
         }
     }
     (m, d)
+}
+
+/// M and D̄ of every sub-model corrected for a controller `ratio` times
+/// faster than the log (see the module docs); said in `notes`.
+pub(crate) fn correct_estimates(
+    estimates: Vec<(f64, LambdaEstimate)>,
+    segments: &[&Segment],
+    dofs: &[Dof],
+    with_attitude: bool,
+    ratio: f64,
+    notes: &mut Vec<String>,
+) -> Vec<(f64, LambdaEstimate)> {
+    if ratio < 1.0 + 1e-6 {
+        return estimates;
+    }
+    let Some(gains) = controller_gains(segments, dofs, with_attitude) else {
+        notes.push("the controller's gains could not be read from the log (too few samples): M and D̄ are not corrected for its faster rate".into());
+        return estimates;
+    };
+    let h = segments.first().map_or(0.0, |s| s.h);
+    let c = hidden_share(h, ratio);
+    let diag: Vec<String> = dofs
+        .iter()
+        .enumerate()
+        .map(|(i, d)| match gains.r2[i] >= MIN_R2 {
+            true => format!("{} {}", d.name(), sig3(gains.k_nu[(i, i)])),
+            false => format!("{} not corrected (R² {:.2})", d.name(), gains.r2[i]),
+        })
+        .collect();
+    notes.push(format!(
+        "controller at {ratio:.2}× the log rate: the commands between log samples were rebuilt from its gains, read from the log (∂τ/∂ν diagonal, N·s/m and N·m·s/rad: {}; least squares on Δτ, switches trimmed, R² {:.2}–{:.2}); M changed by c·K_ν and D̄ by c·K_η with c = {:.4} s",
+        diag.join(", "),
+        gains.r2.iter().copied().fold(f64::INFINITY, f64::min),
+        gains.r2.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        c
+    ));
+    estimates
+        .into_iter()
+        .map(|(speed, mut est)| {
+            // D̄ as a whole is what the data determine (its C(ν) part from M
+            // included), so only c·K_η J moves it.
+            let (m, d) = corrected(&est.m, &est.d_bar, &gains, dofs, c);
+            est.m = m;
+            est.d_bar = d;
+            (speed, est)
+        })
+        .collect()
 }
 
 #[cfg(test)]

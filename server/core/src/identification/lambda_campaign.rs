@@ -7,13 +7,14 @@ use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 
 use super::attitude_loop::AttitudeLoop;
-use super::dataset::{RunInput, Segment, segments};
+use super::dataset::{RunInput, segments};
 use super::document::{
     LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, to_rows,
 };
 use super::error::IdentifyError;
-use super::intersample::{MIN_R2, controller_gains, corrected, hidden_share};
+use super::intersample::correct_estimates;
 use super::joint_restoring::{Functions, PooledRestoring, load, specification};
+use super::lambda_consistency::inflate_inertia_std;
 use super::lambda_coriolis::fit_points;
 use super::lambda_data::{experiment, per_point, static_holds};
 use super::lambda_physical::enforce;
@@ -360,11 +361,11 @@ pub fn identify_lambda_campaign(
         .map_err(lambda_error)?
     };
 
-    let estimates = match settings
+    let mut estimates = match settings
         .controller_rate_hz
         .or(Some(profile.controller_rate_hz))
     {
-        Some(rate) => correct_intersample(
+        Some(rate) => correct_estimates(
             estimates,
             &data.segments.iter().flatten().collect::<Vec<_>>(),
             &dofs,
@@ -374,6 +375,8 @@ pub fn identify_lambda_campaign(
         ),
         None => estimates,
     };
+
+    inflate_inertia_std(&mut estimates, &dofs, &mut notes);
 
     // 3. Sub-models, physical structure enforced, parameters.
     let mut models = Vec::new();
@@ -611,51 +614,4 @@ fn restoring_doc(
         evidence,
         params: pooled.params(),
     }
-}
-
-/// M and D̄ of every sub-model corrected for a controller `ratio` times
-/// faster than the log (see [`super::intersample`]); said in `notes`.
-fn correct_intersample(
-    estimates: Vec<(f64, LambdaEstimate)>,
-    segments: &[&Segment],
-    dofs: &[Dof],
-    with_attitude: bool,
-    ratio: f64,
-    notes: &mut Vec<String>,
-) -> Vec<(f64, LambdaEstimate)> {
-    if ratio < 1.0 + 1e-6 {
-        return estimates;
-    }
-    let Some(gains) = controller_gains(segments, dofs, with_attitude) else {
-        notes.push("the controller's gains could not be read from the log (too few samples): M and D̄ are not corrected for its faster rate".into());
-        return estimates;
-    };
-    let h = segments.first().map_or(0.0, |s| s.h);
-    let c = hidden_share(h, ratio);
-    let diag: Vec<String> = dofs
-        .iter()
-        .enumerate()
-        .map(|(i, d)| match gains.r2[i] >= MIN_R2 {
-            true => format!("{} {}", d.name(), crate::numbers::sig3(gains.k_nu[(i, i)])),
-            false => format!("{} not corrected (R² {:.2})", d.name(), gains.r2[i]),
-        })
-        .collect();
-    notes.push(format!(
-        "controller at {ratio:.2}× the log rate: the commands between log samples were rebuilt from its gains, read from the log (∂τ/∂ν diagonal, N·s/m and N·m·s/rad: {}; least squares on Δτ, switches trimmed, R² {:.2}–{:.2}); M changed by c·K_ν and D̄ by c·K_η with c = {:.4} s",
-        diag.join(", "),
-        gains.r2.iter().copied().fold(f64::INFINITY, f64::min),
-        gains.r2.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        c
-    ));
-    estimates
-        .into_iter()
-        .map(|(speed, mut est)| {
-            // D̄ as a whole is what the data determine (its C(ν) part from M
-            // included), so only c·K_η J moves it.
-            let (m, d) = corrected(&est.m, &est.d_bar, &gains, dofs, c);
-            est.m = m;
-            est.d_bar = d;
-            (speed, est)
-        })
-        .collect()
 }

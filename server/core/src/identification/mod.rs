@@ -39,6 +39,7 @@ pub mod export;
 pub mod intersample;
 mod joint_restoring;
 pub mod lambda_campaign;
+mod lambda_consistency;
 mod lambda_coriolis;
 mod lambda_data;
 mod lambda_physical;
