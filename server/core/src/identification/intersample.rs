@@ -20,6 +20,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::dataset::Segment;
+use super::document::{LoggedController, from_rows, to_rows};
 use crate::estimation::lambda::LambdaEstimate;
 use crate::numbers::sig3;
 use crate::planning::dof::Dof;
@@ -195,17 +196,18 @@ pub(crate) fn correct_estimates(
     segments: &[&Segment],
     dofs: &[Dof],
     with_attitude: bool,
-    ratio: f64,
+    rate_hz: f64,
     notes: &mut Vec<String>,
-) -> Vec<(f64, LambdaEstimate)> {
+) -> (Vec<(f64, LambdaEstimate)>, Option<LoggedController>) {
+    let h = segments.first().map_or(0.0, |s| s.h);
+    let ratio = rate_hz * h;
     if ratio < 1.0 + 1e-6 {
-        return estimates;
+        return (estimates, None);
     }
     let Some(gains) = controller_gains(segments, dofs, with_attitude) else {
         notes.push("the controller's gains could not be read from the log (too few samples): M and D̄ are not corrected for its faster rate".into());
-        return estimates;
+        return (estimates, None);
     };
-    let h = segments.first().map_or(0.0, |s| s.h);
     let c = hidden_share(h, ratio);
     let diag: Vec<String> = dofs
         .iter()
@@ -216,13 +218,29 @@ pub(crate) fn correct_estimates(
         })
         .collect();
     notes.push(format!(
-        "controller at {ratio:.2}× the log rate: the commands between log samples were rebuilt from its gains, read from the log (∂τ/∂ν diagonal, N·s/m and N·m·s/rad: {}; least squares on Δτ, switches trimmed, R² {:.2}–{:.2}); M changed by c·K_ν and D̄ by c·K_η with c = {:.4} s",
+        "controller at {ratio:.2}× the log rate: the commands between log samples were rebuilt from its gains, read from the log (∂τ/∂ν diagonal, N·s/m and N·m·s/rad: {}; least squares on Δτ, switches trimmed, R² {:.2}–{:.2}); M changed by c·K_ν and D̄ by c·K_η with c = {:.4} s; predictions on these logs add the unlogged commands back",
         diag.join(", "),
         gains.r2.iter().copied().fold(f64::INFINITY, f64::min),
         gains.r2.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         c
     ));
-    estimates
+    let applied = |k: &DMatrix<f64>| {
+        DMatrix::from_fn(k.nrows(), k.ncols(), |i, j| {
+            if gains.r2[i] >= MIN_R2 {
+                k[(i, j)]
+            } else {
+                0.0
+            }
+        })
+    };
+    let controller = LoggedController {
+        rate_hz,
+        log_h_s: h,
+        c_s: c,
+        k_nu: to_rows(&applied(&gains.k_nu)),
+        k_attitude: to_rows(&applied(&gains.k_attitude)),
+    };
+    let corrected = estimates
         .into_iter()
         .map(|(speed, mut est)| {
             // D̄ as a whole is what the data determine (its C(ν) part from M
@@ -232,7 +250,28 @@ pub(crate) fn correct_estimates(
             est.d_bar = d;
             (speed, est)
         })
-        .collect()
+        .collect();
+    (corrected, Some(controller))
+}
+
+/// M and D̄ as a log of `controller` sees them (M − c K_ν, D̄ − c K_η J):
+/// the model that predicts ν from the logged τ held over each interval.
+pub fn logged_equivalent(
+    m: &DMatrix<f64>,
+    d_bar: &DMatrix<f64>,
+    controller: &LoggedController,
+    dofs: &[Dof],
+) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+    let n = dofs.len();
+    let k_nu = from_rows(&controller.k_nu).filter(|k| k.shape() == (n, n))?;
+    let k_attitude = from_rows(&controller.k_attitude).filter(|k| k.shape() == (n, 2))?;
+    let gains = ControllerGains {
+        k_nu,
+        k_attitude,
+        r2: vec![1.0; n],
+        samples: vec![0; n],
+    };
+    Some(corrected(m, d_bar, &gains, dofs, -controller.c_s))
 }
 
 #[cfg(test)]
@@ -310,9 +349,25 @@ mod tests {
         // A pitch law that explains little of Δτ leaves pitch as fitted.
         let weak = ControllerGains {
             r2: vec![1.0, 0.2],
-            ..g
+            ..g.clone()
         };
         let (m, d) = corrected(&m_hat, &d_hat, &weak, &dofs, c);
         assert!((m[(0, 0)] - 40.0).abs() < 1e-12 && m[(1, 1)] == 90.0 && d[(1, 1)] == 27.5);
+        // What the log sees is the fitted pair again.
+        let lc = LoggedController {
+            rate_hz: 20.0,
+            log_h_s: 0.1,
+            c_s: c,
+            k_nu: to_rows(&g.k_nu),
+            k_attitude: to_rows(&g.k_attitude),
+        };
+        let (m_phys, d_phys) = corrected(&m_hat, &d_hat, &g, &dofs, c);
+        let (m_log, d_log) = logged_equivalent(&m_phys, &d_phys, &lc, &dofs).unwrap();
+        assert!((m_log - &m_hat).abs().max() < 1e-12 && (d_log - &d_hat).abs().max() < 1e-12);
+        let bad = LoggedController {
+            k_nu: vec![vec![1.0]],
+            ..lc
+        };
+        assert!(logged_equivalent(&m_phys, &d_phys, &bad, &dofs).is_none());
     }
 }

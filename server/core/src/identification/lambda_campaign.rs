@@ -12,7 +12,7 @@ use super::document::{
     LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, to_rows,
 };
 use super::error::IdentifyError;
-use super::intersample::correct_estimates;
+use super::intersample::{correct_estimates, logged_equivalent};
 use super::joint_restoring::{Functions, PooledRestoring, load, specification};
 use super::lambda_consistency::inflate_inertia_std;
 use super::lambda_coriolis::fit_points;
@@ -25,7 +25,7 @@ use crate::estimation::lambda::{Experiment, LambdaEstimate, LambdaSettings, MIN_
 use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
 use crate::estimation::{Progress, SubProgress};
 use crate::logs::schema::pose_column;
-use crate::models::{LpvModel, Scheduling};
+use crate::models::{LinearVesselModel, LpvModel, Scheduling};
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
 use crate::validation::{ValidationRecord, ValidationSettings, validate};
@@ -361,21 +361,16 @@ pub fn identify_lambda_campaign(
         .map_err(lambda_error)?
     };
 
-    let mut estimates = match settings
-        .controller_rate_hz
-        .or(Some(profile.controller_rate_hz))
-    {
-        Some(rate) => correct_estimates(
-            estimates,
-            &data.segments.iter().flatten().collect::<Vec<_>>(),
-            &dofs,
-            with_restoring,
-            rate * h,
-            &mut notes,
-        ),
-        None => estimates,
-    };
-
+    let (mut estimates, logged_controller) = correct_estimates(
+        estimates,
+        &data.segments.iter().flatten().collect::<Vec<_>>(),
+        &dofs,
+        with_restoring,
+        settings
+            .controller_rate_hz
+            .unwrap_or(profile.controller_rate_hz),
+        &mut notes,
+    );
     inflate_inertia_std(&mut estimates, &dofs, &mut notes);
 
     // 3. Sub-models, physical structure enforced, parameters.
@@ -445,7 +440,19 @@ pub fn identify_lambda_campaign(
             run_ids: data.run_ids[idx].clone(),
             augmentation: None,
         });
-        models.push(model);
+        // Validation predicts the logs: with the controller's unlogged
+        // commands added back when it ran faster than the log.
+        let for_logs = match &logged_controller {
+            Some(lc) => logged_equivalent(model.m(), model.d_bar(), lc, &dofs)
+                .and_then(|(m, d)| {
+                    LinearVesselModel::new(dofs.clone(), m, d)
+                        .and_then(|x| x.with_load(model.load().clone()))
+                        .ok()
+                })
+                .unwrap_or(model),
+            None => model,
+        };
+        models.push(for_logs);
     }
     if let Some((_, doc)) = &restoring {
         parameters.extend(doc.parameters.iter().cloned());
@@ -544,6 +551,7 @@ pub fn identify_lambda_campaign(
             structure: chosen.name.into(),
             coupling,
             points: lpv_points,
+            logged_controller,
         }),
         dp_ship: None,
         state_space: None,

@@ -10,6 +10,7 @@ use super::bis::{BisScale, SiDpShip, unwrap_heading};
 use super::dataset::{RunInput, segments};
 use super::document::{ModelDocument, ModelKind, from_rows};
 use super::error::IdentifyError;
+use super::intersample::logged_equivalent;
 use super::state_space::StateSpacePredictor;
 use crate::estimation::ekf::IdentifiedDpShip;
 use crate::estimation::n4sid::{N4sidModel, NoiseCovariances, Weighting};
@@ -47,14 +48,22 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                 .ok_or_else(|| IdentifyError::invalid("document.lpv", "missing"))?;
             let mut models = Vec::new();
             for p in &lpv.points {
+                let (m, d_bar) = (matrix(&p.m, "M")?, matrix(&p.d_bar, "D̄")?);
+                // Predictions on logs of a controller faster than the log
+                // add its unlogged commands back.
+                let (m, d_bar) = match &lpv.logged_controller {
+                    Some(lc) => logged_equivalent(&m, &d_bar, lc, &doc.dofs).ok_or_else(|| {
+                        IdentifyError::invalid(
+                            "document.lpv.logged_controller",
+                            "K_ν must be n × n and K_η n × 2",
+                        )
+                    })?,
+                    None => (m, d_bar),
+                };
                 models.push(
-                    LinearVesselModel::new(
-                        doc.dofs.clone(),
-                        matrix(&p.m, "M")?,
-                        matrix(&p.d_bar, "D̄")?,
-                    )
-                    .and_then(|m| m.with_load(super::augmented::load_of(doc, p)))
-                    .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?,
+                    LinearVesselModel::new(doc.dofs.clone(), m, d_bar)
+                        .and_then(|m| m.with_load(super::augmented::load_of(doc, p)))
+                        .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?,
                 );
             }
             let speeds = lpv.points.iter().map(|p| p.speed_mps).collect();
