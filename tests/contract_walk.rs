@@ -57,6 +57,7 @@ async fn stored_model(app: &TestApp, cid: &str, vid: &str) -> String {
                 run_ids: vec![],
                 augmentation: None,
             }],
+            logged_controller: None,
         }),
         dp_ship: None,
         state_space: None,

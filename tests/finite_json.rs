@@ -13,20 +13,12 @@
 mod common;
 
 use common::TestApp;
-use common::finite::{assert_clean_text, assert_finite_csv, assert_finite_json};
+use common::finite::{assert_clean_text, assert_finite_csv, assert_finite_json, get_finite as get};
 use common::flights::flown_campaign;
 use common::{identified, run_job};
 use seatrial::jobs::{JobRegistry, JobsConfig};
 use seatrial_core::simulation::rov::RovTruth;
-use serde_json::{Value, json};
-
-/// GET `template` with `args`: 200 and every number finite; the JSON.
-async fn get(app: &TestApp, template: &str, args: &[&str]) -> Value {
-    let r = app.call("GET", template, args, None).await;
-    assert_eq!(r.status, 200, "GET {template} {args:?}: {}", r.text);
-    assert_finite_json(&r.json, template);
-    r.json
-}
+use serde_json::json;
 
 /// A copy of λ model `mid` whose pitch damping D̄[pitch,pitch] has the
 /// wrong sign at every grid speed: A[pitch,pitch] > 0, an unstable model.
@@ -189,6 +181,9 @@ fn the_text_checks_catch_what_they_are_for() {
         "fit 87.3 %",
         "inferred from the data",
         "2.5e7 N",
+        "campaign '01a215ca-7615-72d5-88e5-42a41279e875' has no plan yet",
+        "campaign '01a215cc-40d0-744c-9e87-317c86220b83' has no plan yet",
+        "pid28215-f36e72ac/0",
     ] {
         assert_clean_text(s, "text");
     }

@@ -76,6 +76,8 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
   const structSel = h('select', { 'data-field': 'settings.structure', 'data-testid': 'identify-structure', onChange: (e) => { m.structure = e.target.value; } },
     STRUCTURES.map(([k, label]) => h('option', { value: k, selected: k === m.structure }, label)));
   const structFld = labelled('Structure', structSel, 'coupling of A and B between DOFs');
+  const ctrlIn = h('input', { type: 'number', min: '0', step: 'any', placeholder: 'log rate', class: 'short', 'data-field': 'settings.controller_rate_hz', 'data-testid': 'identify-controller-rate' });
+  const ctrlFld = labelled('Controller rate (Hz)', ctrlIn, 'if faster than the log: M and D̄ corrected for the unlogged commands');
   const runsBox = h('div', { class: 'identify-runs', 'data-field': 'run_ids', 'data-error-host': '' });
   const rolesNote = h('p', { class: 'hint', 'data-testid': 'identify-roles', 'data-field': 'settings.validation_run_ids', 'aria-live': 'polite' });
   const startBtn = h('button', { type: 'submit', class: 'btn primary', 'data-testid': 'identify-start' }, 'Start identification');
@@ -83,7 +85,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
 
   fill(form,
     h('h3', null, 'Identify ', h('span', { class: 'hint' }, 'estimate a model from the accepted runs and validate it on held-out runs')),
-    h('div', { class: 'row' }, labelled('Method', methodSel), structFld, sweepsFld),
+    h('div', { class: 'row' }, labelled('Method', methodSel), structFld, ctrlFld, sweepsFld),
     methodHelp,
     runsBox,
     rolesNote,
@@ -92,6 +94,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
 
   function renderStructure() {
     structFld.hidden = m.method !== 'lambda_kf';
+    ctrlFld.hidden = m.method !== 'lambda_kf';
     sweepsFld.hidden = m.method !== 'parallel_ekf';
     methodHelp.textContent = METHOD_HELP[m.method] || '';
   }
@@ -180,7 +183,11 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
     fill(errBox);
     const { used, explicit } = roles();
     const settings = {};
-    if (m.method === 'lambda_kf') settings.structure = m.structure;
+    if (m.method === 'lambda_kf') {
+      settings.structure = m.structure;
+      const rate = ctrlIn.value.trim();
+      if (rate !== '') settings.controller_rate_hz = Number.isFinite(Number(rate)) ? Number(rate) : rate;
+    }
     if (m.method === 'parallel_ekf') {
       const sw = Number(sweepsIn.value);
       settings.sweeps = sweepsIn.value.trim() === '' || !Number.isFinite(sw) ? sweepsIn.value : sw;

@@ -5,8 +5,18 @@
 
 use serde_json::Value;
 
+use super::TestApp;
+
 /// Largest magnitude a served number may have.
 pub const MAX_ABS: f64 = 1e15;
+
+/// GET `template` with `args`: 200 and every number finite; the JSON.
+pub async fn get_finite(app: &TestApp, template: &str, args: &[&str]) -> Value {
+    let r = app.call("GET", template, args, None).await;
+    assert_eq!(r.status, 200, "GET {template} {args:?}: {}", r.text);
+    assert_finite_json(&r.json, template);
+    r.json
+}
 
 /// Walks `v`: every number finite with |x| ≤ [`MAX_ABS`], every string clean
 /// (see [`assert_clean_text`]); identifiers and hashes are not text.
@@ -31,7 +41,8 @@ pub fn assert_finite_json(v: &Value, path: &str) {
     }
 }
 
-/// Ids, hashes and timestamps hold hex and digits that are not numbers.
+/// Ids, hashes, worker names (`pid123-f36e72ac/0`) and timestamps hold hex
+/// and digits that are not numbers.
 fn is_identifier(path: &str) -> bool {
     let key = path
         .rsplit('.')
@@ -40,11 +51,17 @@ fn is_identifier(path: &str) -> bool {
         .split('[')
         .next()
         .unwrap_or("");
-    key == "sha256" || key.ends_with("id") || key.ends_with("_ids") || key.ends_with("_at")
+    key == "sha256"
+        || key == "worker"
+        || key.ends_with("id")
+        || key.ends_with("_ids")
+        || key.ends_with("_at")
 }
 
 /// No `inf`, `NaN` or `infinity` word, and no number written with an
-/// exponent of 16 or more (`7.3e35`, `1E+142`).
+/// exponent of 16 or more (`7.3e35`, `1E+142`). A number is a token (of
+/// letters, digits, '.', '+' and '-') that parses as one: the hex groups of
+/// an id or hash (`…-9e87-…`, `f36e72ac`) are not numbers.
 pub fn assert_clean_text(s: &str, what: &str) {
     for word in s.split(|c: char| !c.is_ascii_alphanumeric()) {
         let w = word.to_ascii_lowercase();
@@ -53,23 +70,23 @@ pub fn assert_clean_text(s: &str, what: &str) {
             "{what}: '{word}' in {s:?}"
         );
     }
-    let b = s.as_bytes();
-    for i in 1..b.len() {
-        if (b[i] == b'e' || b[i] == b'E') && b[i - 1].is_ascii_digit() {
-            let rest = &s[i + 1..];
-            let digits: String = rest
-                .trim_start_matches(['+', '-'])
-                .chars()
-                .take_while(char::is_ascii_digit)
-                .collect();
-            let negative = rest.starts_with('-');
-            if let Ok(e) = digits.parse::<u32>() {
-                assert!(
-                    negative || e < 16,
-                    "{what}: absurd magnitude (exponent {e}) in {s:?}"
-                );
-            }
+    let tokens = s.split(|c: char| !(c.is_ascii_alphanumeric() || matches!(c, '.' | '+' | '-')));
+    for token in tokens.map(|t| t.trim_end_matches('.')) {
+        let Some(at) = token.find(['e', 'E']) else {
+            continue;
+        };
+        if token.parse::<f64>().is_err() {
+            continue;
         }
+        let exponent = &token[at + 1..];
+        let e: u32 = exponent
+            .trim_start_matches(['+', '-'])
+            .parse()
+            .unwrap_or(u32::MAX);
+        assert!(
+            exponent.starts_with('-') || e < 16,
+            "{what}: absurd magnitude (exponent {e}) in {s:?}"
+        );
     }
 }
 

@@ -103,6 +103,8 @@ test('an inferred role is corrected on the run page, and identification uses it'
     assert.match(await mine.locator(tid('identify-role')).textContent(), /validation \(user\)/);
     assert.match(await page.textContent(tid('identify-roles')), /2 held out for validation/);
 
+    // The log is 10 Hz; its controller ran at 20 Hz.
+    await page.fill(tid('identify-controller-rate'), '20');
     await page.getByRole('button', { name: 'Start identification' }).click();
     await page.locator(`${tid('job-row')}[data-state="succeeded"]`).waitFor({ timeout: 180000 });
     const jobs = (await H.api('GET', `/api/jobs?campaign_id=${cid}`)).json;
@@ -111,6 +113,8 @@ test('an inferred role is corrected on the run page, and identification uses it'
     assert.ok(model.validation_run_ids.includes(rid), `held out: ${model.validation_run_ids}`);
     assert.ok(!model.run_ids.includes(rid), 'not fitted to');
     assert.ok(model.run_ids.length > 0, 'estimation runs');
+    assert.equal(model.settings.controller_rate_hz, 20);
+    assert.ok(model.document.notes.some((n) => /controller at 2\.00× the log rate/.test(n)), model.document.notes.join('\n'));
     assert.ok(code, 'the source run');
   });
 });

@@ -2,7 +2,12 @@
 //! the λ-filter identification's parameter errors in σ and its validation
 //! fits against the true model and an affine least-squares baseline.
 //!
-//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto]`
+//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--controller-hz 20]`
+//!
+//! `--in-grid` flies the validation staircase at speeds inside the grid
+//! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it;
+//! `--controller-hz` tells the identification the controller's rate (the
+//! truth's loop runs at 20 Hz, logged at 10 Hz).
 
 #[path = "../tests/support/open_world.rs"]
 mod open_world;
@@ -13,6 +18,8 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut seeds = Vec::new();
     let mut structure = None;
+    let mut controller_hz = None;
+    let mut spec = seatrial_truth::CampaignSpec::default();
     let mut it = args.iter();
     while let Some(a) = it.next() {
         if a == "--structure" {
@@ -22,6 +29,10 @@ fn main() {
                 "symmetric" => StructureChoice::Symmetric,
                 _ => StructureChoice::Auto,
             });
+        } else if a == "--controller-hz" {
+            controller_hz = it.next().and_then(|v| v.parse::<f64>().ok());
+        } else if a == "--in-grid" {
+            spec.validation_speeds = Some(vec![0.5, 0.75, 1.25, 1.75, 2.0]);
         } else if let Ok(s) = a.parse::<u64>() {
             seeds.push(s);
         }
@@ -29,10 +40,11 @@ fn main() {
     if seeds.is_empty() {
         seeds = vec![1, 2, 3, 4, 5];
     }
-    let settings = open_world::settings(structure);
+    let mut settings = open_world::settings(structure);
+    settings.controller_rate_hz = controller_hz;
     for seed in seeds {
         let t = std::time::Instant::now();
-        let r = open_world::evaluate(seed, true, &settings);
+        let r = open_world::evaluate_with(seed, true, &settings, &spec);
         let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
         println!(
             "\n## seed {seed}: {within}/{} parameters within ±3σ ({:.0} %), {:.1} s",
@@ -57,17 +69,18 @@ fn main() {
                 z.z()
             );
         }
-        println!("  channel | 1-step  true   affine | free run  true");
+        println!("  channel | 1-step  true   affine | free run  true   oracle");
         let f = |x: Option<f64>| x.map_or("   —  ".into(), |v| format!("{v:6.3}"));
         for c in &r.fits {
             println!(
-                "  {:<7} | {} {} {} | {} {}",
+                "  {:<7} | {} {} {} | {} {} {}",
                 c.channel,
                 f(c.one_step),
                 f(c.one_step_true),
                 f(c.one_step_affine),
                 f(c.free_run),
-                f(c.free_run_true)
+                f(c.free_run_true),
+                f(c.free_run_oracle)
             );
         }
         for s in r.findings.iter().chain(&r.notes) {

@@ -99,11 +99,55 @@ fn one_step_fits_beat_the_affine_baseline_and_approach_the_truth() {
     }
 }
 
+/// Reported σ are honest enough to bet on: with the 20 Hz controller's
+/// unlogged commands corrected and σ of M inflated by its spread across the
+/// grid, at least 80 % of the parameters lie within ±3σ of the truth's
+/// best linear fit on every vessel (85–96 % measured; 69–79 % before).
+#[test]
+fn most_parameters_lie_within_three_reported_sigma() {
+    for r in reports() {
+        let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
+        assert!(
+            within as f64 >= 0.8 * r.z.len() as f64,
+            "seed {}: {within}/{} within ±3σ",
+            r.seed,
+            r.z.len()
+        );
+    }
+}
+
+/// Free runs keep the restoring spring (g(η) of the simulated attitude),
+/// never the open-loop drift of a γ taken from the measured attitude (roll
+/// −6.0…0.08 before): roll and pitch free runs stay above 0.25 on every
+/// vessel and above 0.7 on four of the five (0.30–0.86 measured; the small,
+/// fast vessel 5 is the weak one).
+#[test]
+fn roll_and_pitch_free_runs_keep_their_restoring_spring() {
+    let mut good = 0;
+    for r in reports() {
+        let attitude: Vec<f64> = r
+            .fits
+            .iter()
+            .filter(|c| ["p", "q"].contains(&c.channel.as_str()))
+            .map(|c| c.free_run.expect("a free-run fit"))
+            .collect();
+        assert_eq!(attitude.len(), 2);
+        let worst = attitude.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!(
+            worst > 0.25,
+            "seed {}: roll/pitch free run {worst:.3}",
+            r.seed
+        );
+        good += usize::from(worst > 0.7);
+    }
+    assert!(good >= 4, "{good} of 5 vessels above 0.7");
+}
+
 /// The issue's full criteria, not met yet (see the README's identification
 /// section): ≥ 95 % of parameters within ±3σ, 1-step within 0.02 and free
 /// run within 0.05 of the true model in every channel.
 #[test]
-#[ignore = "known gap: roll/pitch inertia biased 5–13 %, free runs of roll and pitch far below the true model's"]
+#[ignore = "known gap: 85–96 % within ±3σ; free runs below the true model's on the staircase legs outside the grid, where any linear LPV model (the oracle too) falls short"]
 fn the_issue_criteria_on_five_vessels() {
     for r in reports() {
         let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();

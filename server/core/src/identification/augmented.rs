@@ -248,6 +248,7 @@ mod tests {
                 structure: "diagonal".into(),
                 coupling: vec![],
                 points: vec![point(0.5, 50.0), point(1.5, d_fast)],
+                logged_controller: None,
             }),
             dp_ship: None,
             state_space: None,

@@ -127,6 +127,7 @@ mod tests {
                 structure: "diagonal".into(),
                 coupling: vec![vec![true]],
                 points: vec![point(0.5, d), point(1.0, 2.0 * d)],
+                logged_controller: None,
             }),
             dp_ship: None,
             state_space: None,

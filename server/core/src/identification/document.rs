@@ -167,6 +167,30 @@ pub struct LpvDoc {
     pub coupling: Vec<Vec<bool>>,
     /// Sub-models by ascending speed.
     pub points: Vec<LpvPoint>,
+    /// The controller behind the logs when it ran faster than the log: M
+    /// and D̄ of the points are the vehicle's, and predictions on such logs
+    /// add the commands the log does not show (see `intersample`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub logged_controller: Option<LoggedController>,
+}
+
+/// A feedback controller r times faster than its log, as read from the log:
+/// between log samples it adds c·(K_ν ν̇ + K_η η̇) on average,
+/// c = h (r − 1)/(2r).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct LoggedController {
+    /// Controller rate (Hz).
+    pub rate_hz: f64,
+    /// Log sample time h (s).
+    pub log_h_s: f64,
+    /// c = h (r − 1)/(2r) (s).
+    pub c_s: f64,
+    /// K_ν = ∂τ/∂ν (n × n, rows: forces in DOF order); rows the law did not
+    /// explain are zero.
+    pub k_nu: Matrix,
+    /// K_η on (φ, θ) (n × 2), likewise.
+    pub k_attitude: Matrix,
 }
 
 /// A DP ship's low-frequency model in momentum form (Fossen et al. 1995,

@@ -176,6 +176,7 @@ mod tests {
                     run_ids: vec![],
                     augmentation: None,
                 }],
+                logged_controller: None,
             }),
             dp_ship: None,
             state_space: None,

@@ -6,12 +6,15 @@
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 
+use super::attitude_loop::AttitudeLoop;
 use super::dataset::{RunInput, segments};
 use super::document::{
     LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, to_rows,
 };
 use super::error::IdentifyError;
+use super::intersample::{correct_estimates, logged_equivalent};
 use super::joint_restoring::{Functions, PooledRestoring, load, specification};
+use super::lambda_consistency::inflate_inertia_std;
 use super::lambda_coriolis::fit_points;
 use super::lambda_data::{experiment, per_point, static_holds};
 use super::lambda_physical::enforce;
@@ -22,7 +25,7 @@ use crate::estimation::lambda::{Experiment, LambdaEstimate, LambdaSettings, MIN_
 use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
 use crate::estimation::{Progress, SubProgress};
 use crate::logs::schema::pose_column;
-use crate::models::{LpvModel, Scheduling};
+use crate::models::{LinearVesselModel, LpvModel, Scheduling};
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
 use crate::validation::{ValidationRecord, ValidationSettings, validate};
@@ -102,6 +105,13 @@ pub struct LambdaCampaignSettings {
     /// structure constrains the damping D and D̄ = D + J_C(M, u₀).
     #[serde(default = "default_true")]
     pub coriolis_from_m: bool,
+    /// Rate of the vehicle's feedback controller (Hz); default: the vessel
+    /// profile's `controller_rate_hz`. When it runs faster than the log
+    /// (e.g. a 20 Hz loop logged at 10 Hz), M and D̄ are corrected for the
+    /// commands the log does not show, with the controller's gains read
+    /// from the log (see `intersample`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller_rate_hz: Option<f64>,
 }
 
 fn default_threshold() -> f64 {
@@ -127,6 +137,7 @@ impl Default for LambdaCampaignSettings {
             estimate_restoring: true,
             constant_loads: true,
             coriolis_from_m: true,
+            controller_rate_hz: None,
         }
     }
 }
@@ -197,6 +208,14 @@ pub fn identify_lambda_campaign(
         return Err(IdentifyError::invalid(
             "settings.coupling_threshold",
             format!("must be in (0, 1), got {}", settings.coupling_threshold),
+        ));
+    }
+    if let Some(rate) = settings.controller_rate_hz
+        && !(rate.is_finite() && rate > 0.0)
+    {
+        return Err(IdentifyError::invalid(
+            "settings.controller_rate_hz",
+            format!("must be a positive rate in Hz, got {rate}"),
         ));
     }
     if settings.k == 0 {
@@ -342,6 +361,18 @@ pub fn identify_lambda_campaign(
         .map_err(lambda_error)?
     };
 
+    let (mut estimates, logged_controller) = correct_estimates(
+        estimates,
+        &data.segments.iter().flatten().collect::<Vec<_>>(),
+        &dofs,
+        with_restoring,
+        settings
+            .controller_rate_hz
+            .unwrap_or(profile.controller_rate_hz),
+        &mut notes,
+    );
+    inflate_inertia_std(&mut estimates, &dofs, &mut notes);
+
     // 3. Sub-models, physical structure enforced, parameters.
     let mut models = Vec::new();
     let mut lpv_points = Vec::new();
@@ -409,7 +440,19 @@ pub fn identify_lambda_campaign(
             run_ids: data.run_ids[idx].clone(),
             augmentation: None,
         });
-        models.push(model);
+        // Validation predicts the logs: with the controller's unlogged
+        // commands added back when it ran faster than the log.
+        let for_logs = match &logged_controller {
+            Some(lc) => logged_equivalent(model.m(), model.d_bar(), lc, &dofs)
+                .and_then(|(m, d)| {
+                    LinearVesselModel::new(dofs.clone(), m, d)
+                        .and_then(|x| x.with_load(model.load().clone()))
+                        .ok()
+                })
+                .unwrap_or(model),
+            None => model,
+        };
+        models.push(for_logs);
     }
     if let Some((_, doc)) = &restoring {
         parameters.extend(doc.parameters.iter().cloned());
@@ -433,6 +476,11 @@ pub fn identify_lambda_campaign(
         input_names: input_names.clone(),
         ..ValidationSettings::default()
     };
+    let attitude_loop = g.and_then(|g| AttitudeLoop::new(lpv.clone(), *g));
+    let loop_settings = ValidationSettings {
+        input_names: AttitudeLoop::input_names(&cols[..n]),
+        ..vsettings.clone()
+    };
     let mut validation = Vec::new();
     for r in &roles.validation {
         let segs = segments(r, &cols, &outputs, 50)
@@ -441,14 +489,45 @@ pub fn identify_lambda_campaign(
             .iter()
             .max_by_key(|s| s.y.nrows())
             .expect("segments is non-empty");
-        let e = experiment(longest, n, g, None)?;
-        let rec = ValidationRecord {
-            h: longest.h,
-            u: &e.gamma,
-            y: &e.nu,
-        };
-        let report = validate(&lpv, &rec, &vsettings)
-            .map_err(|e| IdentifyError::invalid(format!("runs[{}]", r.run_id), e.to_string()))?;
+        let report = match &attitude_loop {
+            // g(η) of the simulated attitude in the loop: record [τ | η].
+            Some(model) => validate(
+                model,
+                &ValidationRecord {
+                    h: longest.h,
+                    u: &longest.u.columns(0, 12).into_owned(),
+                    y: &longest.y,
+                },
+                &loop_settings,
+            ),
+            None => {
+                let e = experiment(longest, n, g, None)?;
+                let rec = ValidationRecord {
+                    h: longest.h,
+                    u: &e.gamma,
+                    y: &e.nu,
+                };
+                validate(&lpv, &rec, &vsettings)
+            }
+        }
+        .map_err(|e| IdentifyError::invalid(format!("runs[{}]", r.run_id), e.to_string()))?;
+        if let Some(j) = dofs.iter().position(|d| *d == Dof::Surge) {
+            let u: Vec<f64> = longest.y.column(j).iter().copied().collect();
+            let grid: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
+            let (below, above) = super::roles::beyond_grid(&u, &grid);
+            for (share, side, end) in [
+                (below, "below", grid[0]),
+                (above, "above", grid[grid.len() - 1]),
+            ] {
+                if share >= 0.05 {
+                    notes.push(format!(
+                        "validation run {}: {:.0} % of it was flown {side} the identified speeds, where the model holds its {end:.2} m/s sub-model; its fits there measure extrapolation, and a grid point at that speed would model it",
+                        r.name,
+                        100.0 * share
+                    ));
+                }
+            }
+        }
         validation.push(RunValidation {
             run_id: r.run_id.clone(),
             run_name: r.name.clone(),
@@ -472,6 +551,7 @@ pub fn identify_lambda_campaign(
             structure: chosen.name.into(),
             coupling,
             points: lpv_points,
+            logged_controller,
         }),
         dp_ship: None,
         state_space: None,

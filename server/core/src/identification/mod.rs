@@ -4,13 +4,16 @@
 //!
 //! - [`discover_campaign`]: missing-physics discovery on a stored LPV model,
 //!   per grid speed, and the augmented model as its next version.
+//! - [`attitude_loop`]: a 6-DOF LPV model with g(η) of its own attitude in
+//!   the loop (free runs keep the restoring spring).
 //! - [`augmented`]: an LPV model with discovered terms as a predictor.
 //! - [`dataset`]: runs → segments (one per valid block, never concatenated).
 //! - [`describe`]: what a run is (role, grid speed, excited DOFs, signal),
 //!   inferred from its data; [`description`]: that, the plan and the
 //!   supervisor's word merged, each value with its source.
 //! - [`roles`]: static, estimation and held-out validation runs.
-//! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method.
+//! - [`lambda_campaign`]: LPV model by the λ-filter Kalman method;
+//!   [`intersample`]: M and D̄ corrected for a controller faster than its log.
 //! - [`n4sid_campaign`]: black-box LTI comparison model by N4SID.
 //! - [`ekf_campaign`]: DP ship by the staged parallel EKF (Bis units: [`bis`]).
 //! - [`document`]: the stored/served model: matrices, parameters with std.
@@ -21,6 +24,7 @@
 //!   predictor state.
 //! - [`outcome`], [`error`]: what an identification returns.
 
+pub mod attitude_loop;
 pub mod augmented;
 pub mod bis;
 pub mod dataset;
@@ -32,8 +36,10 @@ pub mod document;
 pub mod ekf_campaign;
 pub mod error;
 pub mod export;
+pub mod intersample;
 mod joint_restoring;
 pub mod lambda_campaign;
+mod lambda_consistency;
 mod lambda_coriolis;
 mod lambda_data;
 mod lambda_physical;

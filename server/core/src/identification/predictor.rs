@@ -4,14 +4,17 @@
 
 use nalgebra::{DMatrix, Matrix3, Vector6};
 
+use super::attitude_loop::AttitudeLoop;
 use super::augmented::{AugmentedLpv, is_augmented};
 use super::bis::{BisScale, SiDpShip, unwrap_heading};
 use super::dataset::{RunInput, segments};
 use super::document::{ModelDocument, ModelKind, from_rows};
 use super::error::IdentifyError;
+use super::intersample::logged_equivalent;
 use super::state_space::StateSpacePredictor;
 use crate::estimation::ekf::IdentifiedDpShip;
 use crate::estimation::n4sid::{N4sidModel, NoiseCovariances, Weighting};
+use crate::estimation::restoring::RestoringParams;
 use crate::logs::schema::pose_column;
 use crate::models::{LinearVesselModel, LpvModel};
 use crate::planning::dof::Dof;
@@ -22,6 +25,16 @@ use crate::validation::{
 
 fn matrix(rows: &super::document::Matrix, what: &str) -> Result<DMatrix<f64>, IdentifyError> {
     from_rows(rows).ok_or_else(|| IdentifyError::invalid("document", format!("{what} is ragged")))
+}
+
+/// g(η) when a stored model simulates its own attitude ([`AttitudeLoop`]):
+/// a 6-DOF LPV model with estimated restoring and no discovered terms.
+fn attitude_in_loop(doc: &ModelDocument) -> Option<RestoringParams> {
+    let eligible = doc.kind == ModelKind::Lpv && !is_augmented(doc) && doc.dofs == Dof::ALL;
+    doc.restoring
+        .as_ref()
+        .filter(|_| eligible)
+        .map(|r| r.params)
 }
 
 /// The predictor of a stored model.
@@ -35,20 +48,33 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                 .ok_or_else(|| IdentifyError::invalid("document.lpv", "missing"))?;
             let mut models = Vec::new();
             for p in &lpv.points {
+                let (m, d_bar) = (matrix(&p.m, "M")?, matrix(&p.d_bar, "D̄")?);
+                // Predictions on logs of a controller faster than the log
+                // add its unlogged commands back.
+                let (m, d_bar) = match &lpv.logged_controller {
+                    Some(lc) => logged_equivalent(&m, &d_bar, lc, &doc.dofs).ok_or_else(|| {
+                        IdentifyError::invalid(
+                            "document.lpv.logged_controller",
+                            "K_ν must be n × n and K_η n × 2",
+                        )
+                    })?,
+                    None => (m, d_bar),
+                };
                 models.push(
-                    LinearVesselModel::new(
-                        doc.dofs.clone(),
-                        matrix(&p.m, "M")?,
-                        matrix(&p.d_bar, "D̄")?,
-                    )
-                    .and_then(|m| m.with_load(super::augmented::load_of(doc, p)))
-                    .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?,
+                    LinearVesselModel::new(doc.dofs.clone(), m, d_bar)
+                        .and_then(|m| m.with_load(super::augmented::load_of(doc, p)))
+                        .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?,
                 );
             }
             let speeds = lpv.points.iter().map(|p| p.speed_mps).collect();
-            Ok(Box::new(LpvModel::new(speeds, models).map_err(|e| {
-                IdentifyError::invalid("document.lpv", e.to_string())
-            })?))
+            let model = LpvModel::new(speeds, models)
+                .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?;
+            match attitude_in_loop(doc) {
+                Some(g) => Ok(Box::new(
+                    AttitudeLoop::new(model, g).expect("attitude_in_loop checked the DOFs"),
+                )),
+                None => Ok(Box::new(model)),
+            }
         }
         ModelKind::StateSpace => {
             let s = doc
@@ -171,7 +197,7 @@ pub fn validation_data(
         .max_by_key(|s| s.y.nrows())
         .expect("segments is non-empty");
     let tau = seg.u.columns(0, n).into_owned();
-    if augmented {
+    if augmented || attitude_in_loop(doc).is_some() {
         return Ok((seg.h, seg.u.columns(0, n + 6).into_owned(), seg.y.clone()));
     }
     match doc.kind {
@@ -223,8 +249,12 @@ pub fn validate_on_run_with(
 ) -> Result<ValidationReport, IdentifyError> {
     let model = predictor(doc)?;
     let (h, u, y) = validation_data(doc, run, inputs)?;
+    let input_names = match attitude_in_loop(doc) {
+        Some(_) => AttitudeLoop::input_names(inputs),
+        None => doc.inputs.clone(),
+    };
     let settings = ValidationSettings {
-        input_names: doc.inputs.clone(),
+        input_names,
         ..settings
     };
     validate(

@@ -75,6 +75,36 @@ pub fn nearest_grid_index(grid: &[f64], speed: f64) -> usize {
         .map_or(0, |(i, _)| i)
 }
 
+/// Shares of the forward speeds `u` (m/s, non-finite samples ignored)
+/// below and above the grid by more than a tenth of the end spacing (a
+/// tenth of the speed for a one-point grid): there an LPV model holds its
+/// end sub-model (thesis eq. 2.18), and the speed-dependent part of its
+/// damping and Coriolis linearization is frozen.
+pub fn beyond_grid(u: &[f64], grid: &[f64]) -> (f64, f64) {
+    let (Some(&lo), Some(&hi)) = (grid.first(), grid.last()) else {
+        return (0.0, 0.0);
+    };
+    let margin = |a: f64, b: f64| {
+        0.1 * if grid.len() > 1 {
+            (a - b).abs()
+        } else {
+            a.abs()
+        }
+    };
+    let (below_by, above_by) = match grid.len() {
+        1 => (margin(lo, lo), margin(hi, hi)),
+        n => (margin(grid[1], lo), margin(hi, grid[n - 2])),
+    };
+    let finite: Vec<f64> = u.iter().copied().filter(|v| v.is_finite()).collect();
+    if finite.is_empty() {
+        return (0.0, 0.0);
+    }
+    let share = |f: &dyn Fn(f64) -> bool| {
+        finite.iter().filter(|v| f(**v)).count() as f64 / finite.len() as f64
+    };
+    (share(&|v| v < lo - below_by), share(&|v| v > hi + above_by))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -152,5 +182,17 @@ mod tests {
         assert_eq!(nearest_grid_index(&g, 0.0), 0);
         assert_eq!(nearest_grid_index(&g, 0.8), 2);
         assert_eq!(nearest_grid_index(&g, 0.6), 1);
+    }
+
+    #[test]
+    fn speeds_beyond_the_grid_are_counted_past_a_tenth_of_the_end_spacing() {
+        let grid = [0.5, 1.0, 1.5, 2.0];
+        let u = [0.3, 0.46, 0.5, 1.2, 2.04, 2.06, 2.25, f64::NAN];
+        let (below, above) = beyond_grid(&u, &grid);
+        assert!((below - 1.0 / 7.0).abs() < 1e-12, "{below}");
+        assert!((above - 2.0 / 7.0).abs() < 1e-12, "{above}");
+        assert_eq!(beyond_grid(&[1.0, 1.05], &[1.0]), (0.0, 0.0));
+        assert_eq!(beyond_grid(&[0.8, 1.2], &[1.0]), (0.5, 0.5));
+        assert_eq!(beyond_grid(&[], &grid), (0.0, 0.0));
     }
 }

@@ -10,6 +10,7 @@
 use nalgebra::DMatrix;
 use nalgebra::DVector;
 use seatrial_core::estimation::NoProgress;
+use seatrial_core::identification::predictor::validate_on_run_with;
 use seatrial_core::identification::{
     LambdaCampaignSettings, RunInput, identify_lambda_campaign, lambda_campaign::StructureChoice,
 };
@@ -19,7 +20,7 @@ use seatrial_core::planning::campaign::ExperimentFamily;
 use seatrial_core::planning::dof::Dof;
 use seatrial_core::planning::examples::surveyor_rov;
 use seatrial_core::planning::vessel::VesselProfile;
-use seatrial_core::validation::nrmse_fit;
+use seatrial_core::validation::{ValidationSettings, nrmse_fit};
 use seatrial_truth::{
     Campaign, CampaignSpec, Role, Run, Vessel, effective_linearization, fly_campaign,
     true_predictions,
@@ -49,6 +50,10 @@ pub struct ChannelFit {
     pub one_step_true: Option<f64>,
     pub free_run: Option<f64>,
     pub free_run_true: Option<f64>,
+    /// Free run of the best model of the identified class: each grid
+    /// point's effective linearization of the truth over its runs, with
+    /// the true g(η) — what the estimator could reach at best.
+    pub free_run_oracle: Option<f64>,
     pub one_step_affine: Option<f64>,
 }
 
@@ -169,10 +174,33 @@ fn column_fit(
 /// Flies seed `seed`'s vessel, identifies it with the default settings and
 /// grades the result. `described`: the runs carry their role and grid
 /// speed (else the service must infer them).
+/// The truth's best linear-affine model over the runs named `run_ids`.
+fn fitted_linearization(
+    vessel: &Vessel,
+    campaign: &Campaign,
+    run_ids: &[String],
+) -> seatrial_truth::Linearization {
+    let runs: Vec<&Run> = campaign
+        .runs
+        .iter()
+        .filter(|r| run_ids.contains(&r.meta.name))
+        .collect();
+    effective_linearization(vessel, &runs)
+}
+
 pub fn evaluate(seed: u64, described: bool, settings: &LambdaCampaignSettings) -> SeedReport {
+    evaluate_with(seed, described, settings, &CampaignSpec::default())
+}
+
+/// [`evaluate`] on a campaign flown to `spec`.
+pub fn evaluate_with(
+    seed: u64,
+    described: bool,
+    settings: &LambdaCampaignSettings,
+    spec: &CampaignSpec,
+) -> SeedReport {
     let vessel = Vessel::draw(seed);
-    let spec = CampaignSpec::default();
-    let campaign = fly_campaign(&vessel, &spec, seed);
+    let campaign = fly_campaign(&vessel, spec, seed);
     let profile = profile_for(&campaign);
     let inputs: Vec<RunInput> = campaign
         .runs
@@ -203,12 +231,7 @@ pub fn evaluate(seed: u64, described: bool, settings: &LambdaCampaignSettings) -
     let restoring = doc.restoring.as_ref().map(|r| r.params);
     let wb_est = restoring.map_or(0.0, |r| r.weight_minus_buoyancy_n);
     for point in &lpv.points {
-        let runs: Vec<&Run> = campaign
-            .runs
-            .iter()
-            .filter(|r| point.run_ids.contains(&r.meta.name))
-            .collect();
-        let lin = effective_linearization(&vessel, &runs);
+        let lin = fitted_linearization(&vessel, &campaign, &point.run_ids);
         let name = |g: &str, i: usize, j: usize| {
             format!(
                 "{g}[{},{}]@{:.2}",
@@ -291,6 +314,28 @@ pub fn evaluate(seed: u64, described: bool, settings: &LambdaCampaignSettings) -
         .expect("validated on the held-out run")
         .report;
     let truth_pred = true_predictions(&vessel, &val_run.log);
+    let oracle = {
+        let mut doc = doc.clone();
+        if let Some(r) = doc.restoring.as_mut() {
+            r.params.weight_minus_buoyancy_n = vessel.w_minus_b;
+            r.params.zg_weight_minus_zb_buoyancy_nm = vessel.zg_w_minus_zb_b();
+        }
+        for point in doc.lpv.as_mut().expect("an LPV model").points.iter_mut() {
+            let lin = fitted_linearization(&vessel, &campaign, &point.run_ids);
+            point.m = (0..6)
+                .map(|i| (0..6).map(|j| lin.m[(i, j)]).collect())
+                .collect();
+            point.d_bar = (0..6)
+                .map(|i| (0..6).map(|j| lin.d_bar[(i, j)]).collect())
+                .collect();
+            point.load = Some(lin.bias.iter().copied().collect());
+        }
+        let val_input = inputs
+            .iter()
+            .find(|r| r.run_id == val_run.meta.name)
+            .expect("the validation run is an input");
+        validate_on_run_with(&doc, val_input, &columns, ValidationSettings::default()).ok()
+    };
     let aff = affine.one_step(val_run);
     let fits = report
         .channels
@@ -302,6 +347,10 @@ pub fn evaluate(seed: u64, described: bool, settings: &LambdaCampaignSettings) -
             one_step_true: column_fit(&val_run.log.nu, &truth_pred.one_step, j, 1),
             free_run: c.fit_simulation,
             free_run_true: column_fit(&val_run.log.nu, &truth_pred.free_run, j, 0),
+            free_run_oracle: oracle
+                .as_ref()
+                .and_then(|o| o.channels.get(j))
+                .and_then(|c| c.fit_simulation),
             one_step_affine: column_fit(&val_run.log.nu, &aff, j, 1),
         })
         .collect();

@@ -7,13 +7,29 @@
 //!   velocity limit, surge: [`SURGE_SCALE_MPS`]; force: the force limit, or
 //!   Σ|T_ji|·max command for thruster commands). The score is the geometric
 //!   mean of the two: an excited DOF moves both its input and its velocity,
-//!   while a controller holding a DOF against coupling moves only τ and an
-//!   open-loop neighbour only ν. A DOF is *active* when its score is above
-//!   the noise floor [`NOISE_FLOOR`] and at least [`RELATIVE_LEVEL`] of the
-//!   run's largest score; it is *excited dynamically* when its velocity also
+//!   while an open-loop neighbour moves only ν. A DOF is *active* when its
+//!   score is above the noise floor [`NOISE_FLOOR`] and it is not *held
+//!   against coupling*; it is *excited dynamically* when its velocity also
 //!   switches at least twice (Schmitt trigger at mean ± σ/2) and one step
 //!   explains less than [`STEP_MAX_SHARE`] of its variance, otherwise it was
 //!   *stepped* once and held (a static run).
+//! - **Held against coupling.** A closed loop holding a DOF against the
+//!   coupling from an excited neighbour moves its input as much as the
+//!   excitation moves the neighbour's (more, on a small vehicle), and need
+//!   not stop the motion. What tells them apart is the sign of the work the
+//!   actuators do: they push an excited DOF along its motion (its input and
+//!   velocity correlate positively: they supply what damping dissipates)
+//!   and push a held DOF against it (negatively: the controller opposes the
+//!   motion the coupling causes). The correlation is taken after a moving
+//!   average over [`WORK_WINDOW_S`], which removes the measurement noise a
+//!   controller feeds straight back into its input; for roll and pitch, the
+//!   part of the input that follows the attitude (holding it against the
+//!   restoring moment, which does no net work) is removed first. When
+//!   exactly one DOF above the noise floor is pushed along, every other one
+//!   (pushed against, or not measurably at all) is held against its
+//!   coupling, not excited; when several are pushed along (a recursive or
+//!   validation run), a DOF's own excitation and the coupling it resists mix
+//!   and the sign decides nothing; when none is, nothing is held.
 //! - **Grid speed.** The grid point nearest the mean forward speed u, and
 //!   how far the mean was from it.
 //! - **Role.** Forward speed (moving average over [`SPEED_WINDOW_TIME_CONSTANTS`]
@@ -56,9 +72,16 @@ pub const SURGE_SCALE_MPS: f64 = 0.6 * KNOT;
 /// the limits, and a controller holding the DOF against them moves τ less.
 pub const NOISE_FLOOR: f64 = 0.03;
 
-/// An active DOF's score is at least this fraction of the run's largest:
-/// coupling leaking into a neighbouring DOF stays below it.
-pub const RELATIVE_LEVEL: f64 = 0.25;
+/// Moving-average window (s) over which the input and the velocity are
+/// averaged before their correlation (the sign of the actuators' work) is
+/// taken: longer than the 10–20 Hz noise a controller feeds back into its
+/// input, shorter than an excitation's switching time (≥ 2 s).
+pub const WORK_WINDOW_S: f64 = 1.0;
+
+/// A driven thruster's command spread is at least this fraction of the
+/// run's largest (DP vessels): a thruster trimming against the manoeuvre of
+/// another kind stays below it.
+pub const THRUSTER_RELATIVE_LEVEL: f64 = 0.25;
 
 /// A ROV run exciting at least this many DOFs at once is a recursive run
 /// (thesis Table 3.1); fewer make a dynamic run.
@@ -87,7 +110,13 @@ pub struct DofActivity {
     /// Share of the velocity's variance explained by one step (the best
     /// single breakpoint between two constant levels).
     pub step_share: f64,
-    /// Active: above the noise floor and comparable with the run's most active DOF.
+    /// Correlation of the input with the velocity, both averaged over 1 s
+    /// (roll, pitch: the input beyond what holds the attitude against the
+    /// restoring moment): the sign of the work the actuators do in the DOF
+    /// (> 0 pushed along its motion, < 0 held against it).
+    pub input_work: f64,
+    /// Active: above the noise floor and not held against the coupling of
+    /// the one DOF pushed along.
     pub active: bool,
     /// Active, switching at least twice and not mostly one step: a dynamic
     /// excitation (else the DOF was stepped once and held).
@@ -217,6 +246,81 @@ fn step_share(rec: &UniformRecord, col: &[f64]) -> f64 {
     best / ss
 }
 
+/// The attitude a DOF's input holds against the restoring moment: φ for
+/// roll, θ for pitch (log column names).
+fn restored_attitude(d: Dof) -> Option<&'static str> {
+    match d {
+        Dof::Roll => Some("phi"),
+        Dof::Pitch => Some("theta"),
+        _ => None,
+    }
+}
+
+/// A centred moving average of `w` samples.
+fn moving_average(x: &[f64], w: usize) -> Vec<f64> {
+    let half = w / 2;
+    let mut prefix = vec![0.0; x.len() + 1];
+    for (k, v) in x.iter().enumerate() {
+        prefix[k + 1] = prefix[k] + v;
+    }
+    (0..x.len())
+        .map(|k| {
+            let (lo, hi) = (k.saturating_sub(half), (k + half + 1).min(x.len()));
+            (prefix[hi] - prefix[lo]) / (hi - lo) as f64
+        })
+        .collect()
+}
+
+/// Covariance of two equally long series.
+fn covariance(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - ma) * (y - mb))
+        .sum::<f64>()
+        / n
+}
+
+/// The sign of the actuators' work in one DOF: the correlation of its input
+/// `tau` with its velocity `nu` over the valid samples, each averaged over
+/// `w` samples within its block. With `attitude` (roll, pitch), the part of
+/// the input proportional to the attitude — holding it against the
+/// restoring moment, which does no net work — is removed first. 0 when
+/// either is constant.
+fn input_work(
+    rec: &UniformRecord,
+    tau: &[f64],
+    nu: &[f64],
+    attitude: Option<&[f64]>,
+    w: usize,
+) -> f64 {
+    let pooled = |col: &[f64]| -> Vec<f64> {
+        blocks(rec, col)
+            .flat_map(|b| moving_average(b, w))
+            .collect()
+    };
+    let (mut t, v) = (pooled(tau), pooled(nu));
+    if v.len() < 2 || t.len() != v.len() {
+        return 0.0;
+    }
+    if let Some(a) = attitude.map(pooled).filter(|a| a.len() == t.len()) {
+        let var = covariance(&a, &a);
+        if var > 0.0 {
+            let k = covariance(&t, &a) / var;
+            for (x, y) in t.iter_mut().zip(&a) {
+                *x -= k * y;
+            }
+        }
+    }
+    let (tt, vv) = (covariance(&t, &t), covariance(&v, &v));
+    if tt > 0.0 && vv > 0.0 {
+        covariance(&t, &v) / (tt * vv).sqrt()
+    } else {
+        0.0
+    }
+}
+
 /// The force scale of each modelled DOF for the input columns.
 fn force_scales(profile: &VesselProfile) -> Vec<f64> {
     match &profile.inputs {
@@ -257,13 +361,15 @@ fn activity(
     inputs: &[String],
 ) -> Result<Vec<DofActivity>, DescribeError> {
     let scales = force_scales(profile);
+    let window = ((WORK_WINDOW_S * rec.sample_rate_hz).round() as usize).max(1);
     let column = |name: &str| {
         rec.column(name)
             .ok_or_else(|| DescribeError(format!("the record has no column '{name}'")))
     };
     let mut out = Vec::new();
     for ((&d, input), &f) in profile.dofs.iter().zip(inputs).zip(&scales) {
-        let (_, s_tau) = mean_std(rec, column(input)?);
+        let tau = column(input)?;
+        let (_, s_tau) = mean_std(rec, tau);
         let nu = column(d.velocity_symbol())?;
         let (m_nu, s_nu) = mean_std(rec, nu);
         let input_level = if f > 0.0 { s_tau / f } else { 0.0 };
@@ -279,16 +385,36 @@ fn activity(
             score: (input_level * velocity_level).sqrt(),
             switches,
             step_share: step_share(rec, nu),
+            input_work: input_work(
+                rec,
+                tau,
+                nu,
+                restored_attitude(d).and_then(|c| rec.column(c)),
+                window,
+            ),
             active: false,
             excited: false,
         });
     }
-    let top = out.iter().map(|a| a.score).fold(0.0, f64::max);
+    let moving = |a: &DofActivity| a.score >= NOISE_FLOOR;
+    let pushed_along = out
+        .iter()
+        .filter(|a| moving(a) && a.input_work > 0.0)
+        .count();
     for a in &mut out {
-        a.active = a.score >= NOISE_FLOOR && a.score >= RELATIVE_LEVEL * top;
+        let held = pushed_along == 1 && a.input_work <= 0.0;
+        a.active = moving(a) && !held;
         a.excited = a.active && a.switches >= 2 && a.step_share < STEP_MAX_SHARE;
     }
     Ok(out)
+}
+
+/// DOFs above the noise floor that are held against the coupling of the
+/// one DOF pushed along (see [`activity`]).
+fn held_against_coupling(acts: &[DofActivity]) -> Vec<&DofActivity> {
+    acts.iter()
+        .filter(|a| a.score >= NOISE_FLOOR && !a.active)
+        .collect()
 }
 
 /// "sway 42 %, yaw 3 %" — the scores as percentages of the DOFs' scales.
@@ -303,7 +429,8 @@ fn score_words(acts: &[&DofActivity]) -> String {
 fn excited_dofs(acts: &[DofActivity]) -> (Vec<Dof>, String) {
     let active: Vec<&DofActivity> = acts.iter().filter(|a| a.active).collect();
     let dofs: Vec<Dof> = active.iter().map(|a| a.dof).collect();
-    let quiet: Vec<&DofActivity> = acts.iter().filter(|a| !a.active).collect();
+    let held = held_against_coupling(acts);
+    let quiet: Vec<&DofActivity> = acts.iter().filter(|a| a.score < NOISE_FLOOR).collect();
     let reason = if active.is_empty() {
         format!(
             "no DOF moves above the noise floor of {:.0} % of its scale (largest: {})",
@@ -328,11 +455,30 @@ fn excited_dofs(acts: &[DofActivity]) -> (Vec<Dof>, String) {
                 if stepped.len() == 1 { "s" } else { "" }
             ));
         }
+        if !held.is_empty() {
+            let work = held
+                .iter()
+                .map(|a| {
+                    format!(
+                        "{} {:.0} % ({:+.2})",
+                        a.dof.name(),
+                        100.0 * a.score,
+                        a.input_work
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(", ");
+            s.push_str(&format!(
+                "; {} held against {}'s coupling: the actuators push against {} motion (input–velocity correlation, 1 s averages: {work})",
+                dof_words(&held.iter().map(|a| a.dof).collect::<Vec<_>>()),
+                dof_words(&dofs),
+                if held.len() == 1 { "its" } else { "their" },
+            ));
+        }
         if !quiet.is_empty() {
             s.push_str(&format!(
-                "; the others stay below {:.0} % (noise floor) or {:.0} % of the largest ({})",
+                "; the others stay below the noise floor of {:.0} % ({})",
                 100.0 * NOISE_FLOOR,
-                100.0 * RELATIVE_LEVEL,
                 score_words(&quiet)
             ));
         }
@@ -341,8 +487,9 @@ fn excited_dofs(acts: &[DofActivity]) -> (Vec<Dof>, String) {
     (dofs, reason)
 }
 
-/// Thruster kinds driven in a run (DP vessels): those whose commands are
-/// active in the sense of [`activity`] (scores are command std / max command).
+/// Thruster kinds driven in a run (DP vessels): those whose command std
+/// (over the max command) is above the noise floor and at least
+/// [`THRUSTER_RELATIVE_LEVEL`] of the largest.
 fn driven_kinds(rec: &UniformRecord, profile: &VesselProfile) -> Vec<ThrusterKind> {
     let thr = profile.thrusters();
     let levels: Vec<f64> = thr
@@ -357,7 +504,7 @@ fn driven_kinds(rec: &UniformRecord, profile: &VesselProfile) -> Vec<ThrusterKin
     let top = levels.iter().copied().fold(0.0, f64::max);
     let mut kinds = Vec::new();
     for (t, &l) in thr.iter().zip(&levels) {
-        if l >= NOISE_FLOOR && l >= RELATIVE_LEVEL * top && !kinds.contains(&t.kind) {
+        if l >= NOISE_FLOOR && l >= THRUSTER_RELATIVE_LEVEL * top && !kinds.contains(&t.kind) {
             kinds.push(t.kind);
         }
     }
