@@ -4,6 +4,7 @@
 //! layer of storage (SQLite via sqlx) and HTTP (axum).
 
 pub mod clock;
+pub mod coverage;
 pub mod demo;
 pub mod error;
 pub mod http;

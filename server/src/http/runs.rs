@@ -15,8 +15,9 @@ use super::{AppState, blocking, found};
 use seatrial_core::alignment::{OffsetPriors, check_user_offset};
 
 use crate::clock::CampaignClocks;
+use crate::coverage::{self, Coverage};
 use crate::error::{ApiError, ApiResult, ErrorBody};
-use crate::processing::{self, Coverage, RunMeta};
+use crate::processing::{self, RunMeta};
 use crate::storage::blobs::BlobWriter;
 use crate::storage::runs::{self, NewFile, Outcome, Run};
 use crate::storage::{campaigns, clock_offsets, plans, vessels};
@@ -419,5 +420,5 @@ pub async fn coverage(
         .await?
         .ok_or_else(|| ApiError::NotFound(format!("campaign '{id}' has no plan yet")))?;
     let runs = runs::list(&s.db, &id).await?;
-    Ok(Json(processing::coverage(&plan, &runs)))
+    Ok(Json(coverage::coverage(&plan, &runs)))
 }
