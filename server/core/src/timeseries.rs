@@ -84,6 +84,18 @@ pub fn median_dt(t: &[f64]) -> Option<f64> {
     Some(d[mid])
 }
 
+/// Median of `v` (reordered in place); the mean of the two middle values
+/// for an even count, NaN when `v` is empty.
+pub fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let m = v.len() / 2;
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[m],
+        _ => 0.5 * (v[m - 1] + v[m]),
+    }
+}
+
 /// Linear interpolation of (t, x) at the times `at` (t strictly increasing).
 /// Times outside [t₀, t_end] take the end values.
 pub fn interp_linear(t: &[f64], x: &[f64], at: &[f64]) -> Vec<f64> {
@@ -128,6 +140,13 @@ mod tests {
         for (a, b) in y.iter().zip(want) {
             assert!((a - b).abs() < 1e-12, "{a} vs {b}");
         }
+    }
+
+    #[test]
+    fn median_of_odd_even_and_empty_sets() {
+        assert_eq!(median(&mut [3.0, -1.0, 2.0]), 2.0);
+        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert!(median(&mut []).is_nan());
     }
 
     #[test]

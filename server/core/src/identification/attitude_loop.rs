@@ -18,6 +18,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::estimation::restoring::RestoringParams;
+use crate::models::predict::no_prediction;
 use crate::models::{DiscreteLpv, LpvModel};
 use crate::planning::dof::Dof;
 use crate::validation::{Predictor, ValidationRecord};
@@ -100,11 +101,6 @@ impl AttitudeLoop {
         let att = (0..n).map(|k| (rec.u[(k, 9)], rec.u[(k, 10)])).collect();
         Some((tau, att))
     }
-}
-
-/// No prediction: every entry NaN (the record does not fit the model).
-fn no_prediction(rec: &ValidationRecord<'_>, p: usize) -> DMatrix<f64> {
-    DMatrix::from_element(rec.y.nrows(), p, f64::NAN)
 }
 
 /// (φ̇, θ̇) from ν = [u v w p q r] (Fossen 2011, eq. 2.29).

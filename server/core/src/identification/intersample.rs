@@ -24,6 +24,7 @@ use super::document::{LoggedController, from_rows, to_rows};
 use crate::estimation::lambda::LambdaEstimate;
 use crate::numbers::sig3;
 use crate::planning::dof::Dof;
+use crate::timeseries::median;
 
 /// The controller's gains as seen in the log.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,15 +60,15 @@ fn trimmed_fit(x: &DMatrix<f64>, y: &DVector<f64>) -> Option<(DVector<f64>, f64,
         }
         let xs = DMatrix::from_fn(keep.len(), x.ncols(), |i, j| x[(keep[i], j)]);
         let ys = DVector::from_fn(keep.len(), |i, _| y[keep[i]]);
-        let theta = xs.clone().svd(true, true).solve(&ys, 1e-12).ok()?;
+        let theta = xs.svd(true, true).solve(&ys, 1e-12).ok()?;
         let resid: Vec<f64> = (0..y.len())
             .map(|i| y[i] - (x.row(i) * &theta)[0])
             .collect();
-        let kept: Vec<f64> = keep.iter().map(|&i| resid[i].abs()).collect();
-        let scale = 1.4826 * median(&kept);
+        let mut kept: Vec<f64> = keep.iter().map(|&i| resid[i].abs()).collect();
+        let ss_res: f64 = kept.iter().map(|v| v * v).sum();
+        let scale = 1.4826 * median(&mut kept);
         let mean = ys.mean();
         let ss_tot: f64 = ys.iter().map(|v| (v - mean).powi(2)).sum();
-        let ss_res: f64 = kept.iter().map(|v| v * v).sum();
         let r2 = if ss_tot > 0.0 {
             1.0 - ss_res / ss_tot
         } else {
@@ -82,16 +83,6 @@ fn trimmed_fit(x: &DMatrix<f64>, y: &DVector<f64>) -> Option<(DVector<f64>, f64,
             .collect();
     }
     result
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    match s.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => s[n / 2],
-        n => 0.5 * (s[n / 2 - 1] + s[n / 2]),
-    }
 }
 
 /// The gains of the controller behind `segments`: each holds τ in its first

@@ -18,7 +18,7 @@
 pub mod coriolis;
 pub mod error;
 pub mod lpv;
-mod predict;
+pub(crate) mod predict;
 pub mod projection;
 pub mod state_space;
 pub mod structure;

@@ -6,6 +6,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::error::RestoringError;
+use crate::timeseries::median;
 
 /// A record of a static run on a uniform grid.
 #[derive(Debug, Clone, Copy)]
@@ -302,14 +303,4 @@ fn noise_tolerance(rec: &StaticRecord<'_>, quiet: &[bool]) -> [f64; 6] {
         };
     }
     tol
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let m = v.len() / 2;
-    if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        0.5 * (v[m - 1] + v[m])
-    }
 }
