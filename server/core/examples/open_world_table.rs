@@ -2,11 +2,11 @@
 //! the λ-filter identification's parameter errors in σ and its validation
 //! fits against the true model and an affine least-squares baseline.
 //!
-//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--controller-hz 20]`
+//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--noise-free] [--controller-hz 20]`
 //!
 //! `--in-grid` flies the validation staircase at speeds inside the grid
 //! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it;
-//! `--controller-hz` tells the identification the controller's rate (the
+//! `--noise-free` flies without measurement noise; `--controller-hz` tells the identification the controller's rate (the
 //! truth's loop runs at 20 Hz, logged at 10 Hz).
 
 #[path = "../tests/support/open_world.rs"]
@@ -31,6 +31,8 @@ fn main() {
             });
         } else if a == "--controller-hz" {
             controller_hz = it.next().and_then(|v| v.parse::<f64>().ok());
+        } else if a == "--noise-free" {
+            spec.noise = seatrial_truth::NoiseSpec::none();
         } else if a == "--in-grid" {
             spec.validation_speeds = Some(vec![0.5, 0.75, 1.25, 1.75, 2.0]);
         } else if let Ok(s) = a.parse::<u64>() {

@@ -156,32 +156,52 @@ pub fn discover(
     baseline.validate()?;
     settings.validate()?;
     let n = baseline.n();
-    let Some(first) = estimation_runs.first() else {
+    if estimation_runs.is_empty() {
         return Err(DiscoveryError::invalid(
             "estimation_runs",
             "at least one run is needed",
         ));
-    };
-    let h = first.h;
+    }
+    let h = estimation_runs
+        .iter()
+        .chain(validation_runs)
+        .map(|r| r.h)
+        .find(|h| h.is_finite() && *h > 0.0)
+        .unwrap_or(estimation_runs[0].h);
     let skip = ((5.0 * settings.svf_time_constant_s / h).ceil() as usize)
         .max((settings.max_delay_s / h).ceil() as usize + 1)
         .max(settings.k_step);
     let min_len = skip + settings.k_step + 64;
-    for (name, runs) in [
-        ("estimation_runs", estimation_runs),
-        ("validation_runs", validation_runs),
-    ] {
+    // One bad or short run is set aside with its reason; only a set with
+    // no usable run fails.
+    let mut set_aside = Vec::new();
+    let mut usable = |name: &str, runs: &[Record]| -> Vec<Record> {
+        let mut kept = Vec::new();
         for (i, r) in runs.iter().enumerate() {
             let f = format!("{name}[{i}]");
-            r.validate(n, min_len, &f)?;
-            if (r.h - h).abs() > 1e-9 * h {
-                return Err(DiscoveryError::invalid(
-                    format!("{f}.h"),
-                    format!("sample time {} differs from the first run's {h}", r.h),
-                ));
+            let why = match r.validate(n, min_len, &f) {
+                Err(e) => Some(e.to_string()),
+                Ok(()) if (r.h - h).abs() > 1e-9 * h => Some(format!(
+                    "`{f}.h`: sample time {} s differs from the campaign's {h} s",
+                    r.h
+                )),
+                Ok(()) => None,
+            };
+            match why {
+                Some(why) => set_aside.push(format!("run '{}' set aside ({why})", r.name)),
+                None => kept.push(r.clone()),
             }
         }
-    }
+        kept
+    };
+    let estimation_runs = usable("estimation_runs", estimation_runs);
+    let validation_runs = usable("validation_runs", validation_runs);
+    let Some(first) = estimation_runs.first() else {
+        return Err(DiscoveryError::invalid(
+            "estimation_runs",
+            format!("no usable run: {}", set_aside.join("; ")),
+        ));
+    };
     // Cross-validation needs two folds: a single run is split in halves.
     let est: Vec<Record> = if estimation_runs.len() == 1 {
         let len = first.len();
@@ -204,7 +224,7 @@ pub fn discover(
     let k = settings.k_step;
     check(progress, 0.0, "locating the misfit")?;
     let base_model = AugmentedModel::from_baseline(baseline);
-    let all_runs: Vec<&Record> = est.iter().chain(validation_runs).collect();
+    let all_runs: Vec<&Record> = est.iter().chain(&validation_runs).collect();
     let location = locate(&base_model, &all_runs, k, settings.segment_s);
 
     check(progress, 0.1, "filtering the runs")?;
@@ -362,18 +382,32 @@ pub fn discover(
                 .map(|&r| baseline.dofs[r])
                 .collect();
             focus.dedup();
-            let experiment = match (&settings.vessel, fit_with(w.spec), fit_with(o.spec)) {
-                (Some(v), Some(ma), Some(mb)) => propose(
-                    v,
-                    &ma,
-                    &mb,
-                    labels.clone(),
-                    &focus,
-                    &noise_sigma,
-                    est[0].eta[(0, 5)],
-                    h,
+            let (experiment, why_none) = match (
+                &settings.vessel,
+                fit_with(w.spec),
+                fit_with(o.spec),
+            ) {
+                (None, _, _) => (
+                    None,
+                    "no vessel profile was given to design the run that separates them.",
                 ),
-                _ => None,
+                (Some(v), Some(ma), Some(mb)) => (
+                    propose(
+                        v,
+                        &ma,
+                        &mb,
+                        labels.clone(),
+                        &focus,
+                        &noise_sigma,
+                        est[0].eta[(0, 5)],
+                        h,
+                    ),
+                    "no run within the vessel profile's force and velocity limits separates them.",
+                ),
+                _ => (
+                    None,
+                    "one of the two could not be fitted on its own, so no run was designed to separate them.",
+                ),
             };
             let og = o.cv_gain.unwrap_or(0.0);
             ambiguities.push(Ambiguity {
@@ -388,7 +422,7 @@ pub fn discover(
                     og,
                     match &experiment {
                         Some(e) => format!("a deciding run: {}", e.instruction),
-                        None => "no vessel profile was given to design the run that separates them.".into(),
+                        None => why_none.into(),
                     }
                 ),
                 experiment,
@@ -490,13 +524,14 @@ pub fn discover(
             f.effect_text = format!("{} {}", f.effect_text, d.text);
         }
     }
-    let summary = summary(
+    let mut summary = summary(
         &location,
         &findings,
         &validation,
         &ambiguities,
         &unexplained,
     );
+    summary.extend(set_aside);
     check(progress, 1.0, "done")?;
     Ok(DiscoveryReport {
         dofs: baseline.dofs.clone(),

@@ -7,6 +7,7 @@ use nalgebra::DMatrix;
 
 use super::document::{LpvPoint, ModelDocument, from_rows};
 use super::error::IdentifyError;
+use super::intersample::logged_equivalent;
 use crate::discrepancy::{AugmentedModel, Baseline, Record, Restoring};
 use crate::planning::dof::Dof;
 use crate::validation::{Predictor, ValidationRecord};
@@ -47,16 +48,33 @@ fn matrix(rows: &super::document::Matrix, what: &str) -> Result<DMatrix<f64>, Id
         .ok_or_else(|| IdentifyError::invalid("document.lpv", format!("{what} is ragged")))
 }
 
-/// The baseline M ν̇ + D̄ ν = τ − g(η) of one LPV sub-model.
+/// M and D̄ as the logs see them: with the unlogged commands of a
+/// controller faster than the log added back (see
+/// [`super::intersample`]); the stored ones otherwise.
+fn logged_view(
+    doc: &ModelDocument,
+    m: DMatrix<f64>,
+    d_bar: DMatrix<f64>,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), IdentifyError> {
+    match doc.lpv.as_ref().and_then(|l| l.logged_controller.as_ref()) {
+        Some(lc) => logged_equivalent(&m, &d_bar, lc, &doc.dofs)
+            .ok_or_else(super::intersample::malformed_controller),
+        None => Ok((m, d_bar)),
+    }
+}
+
+/// The baseline M ν̇ + D̄ ν = τ − g(η) of one LPV sub-model, as the logs
+/// see it.
 pub fn baseline_at(doc: &ModelDocument, point: &LpvPoint) -> Result<Baseline, IdentifyError> {
     let mut restoring = restoring_of(doc);
     for (i, d) in doc.dofs.iter().enumerate() {
         restoring.constant[d.index()] = load_of(doc, point)[i];
     }
+    let (m, d_bar) = logged_view(doc, matrix(&point.m, "M")?, matrix(&point.d_bar, "D̄")?)?;
     Ok(Baseline {
         dofs: doc.dofs.clone(),
-        m: matrix(&point.m, "M")?,
-        d_bar: matrix(&point.d_bar, "D̄")?,
+        m,
+        d_bar,
         restoring,
     })
 }
@@ -294,6 +312,39 @@ mod tests {
         let k = Predictor::predict_k_step(&lpv, &rec, 10);
         let k1 = Predictor::predict_k_step(&lpv.models[0], &rec, 10);
         assert!((k.rows(10, 1990) - k1.rows(10, 1990)).abs().max() < 1e-12);
+    }
+
+    /// Behind a controller twice as fast as the log, discovery's baseline
+    /// is the model the logs see, M − c K_ν (K_ν = ∂τ/∂ν < 0), not the
+    /// vehicle's M the document stores.
+    #[test]
+    fn the_baseline_behind_a_faster_controller_is_the_logged_view() {
+        use crate::identification::document::LoggedController;
+        let mut d = doc(50.0);
+        d.lpv.as_mut().unwrap().logged_controller = Some(LoggedController {
+            rate_hz: 20.0,
+            log_h_s: 0.1,
+            c_s: 0.025,
+            k_nu: vec![vec![-400.0, 0.0], vec![0.0, -60.0]],
+            k_attitude: vec![vec![0.0; 2]; 2],
+        });
+        let point = d.lpv.as_ref().unwrap().points[0].clone();
+        let b = baseline_at(&d, &point).unwrap();
+        assert!((b.m[(0, 0)] - 110.0).abs() < 1e-9, "{}", b.m);
+        assert!((b.m[(1, 1)] - 51.5).abs() < 1e-9, "{}", b.m);
+        assert_eq!(b.d_bar[(0, 0)], 50.0);
+        let plain = baseline_at(&doc(50.0), &point).unwrap();
+        assert_eq!(plain.m[(0, 0)], 100.0);
+        // A malformed controller is a typed error naming the field.
+        d.lpv
+            .as_mut()
+            .unwrap()
+            .logged_controller
+            .as_mut()
+            .unwrap()
+            .k_nu = vec![vec![1.0]];
+        let e = baseline_at(&d, &point).unwrap_err();
+        assert_eq!(e.field(), "document.lpv.logged_controller");
     }
 
     /// Different damping at 1.5 m/s: the second half follows that sub-model

@@ -16,6 +16,7 @@ use super::augmented::{baseline_at, pieces_by_speed};
 use super::dataset::{RunInput, segments};
 use super::document::{Method, ModelDocument, ModelKind, ParameterRow, PointAugmentation, to_rows};
 use super::error::IdentifyError;
+use super::intersample::vehicle_from_logged;
 use super::outcome::{Identified, RunValidation};
 use super::predictor::validate_on_run;
 use super::roles::nearest_grid_index;
@@ -509,6 +510,7 @@ fn augmented_model(
         .chain(Dof::ALL.iter().map(|d| pose_column(*d).to_string()))
         .collect();
     let lpv = out.lpv.as_mut().expect("checked: LPV");
+    let logged_controller = lpv.logged_controller.clone();
     for p in points {
         let Some(pt) = lpv
             .points
@@ -525,6 +527,13 @@ fn augmented_model(
         let d = DMatrix::from_fn(model.d_bar.len(), model.d_bar.len(), |i, j| {
             model.d_bar[i][j]
         });
+        // Discovery fitted the model the logs see; the document keeps the
+        // vehicle's M and D̄ (the logged view is rebuilt when predicting).
+        let (m, d) = match &logged_controller {
+            Some(lc) => vehicle_from_logged(&m, &d, lc, &doc.dofs)
+                .ok_or_else(super::intersample::malformed_controller)?,
+            None => (m, d),
+        };
         let m_inv = m.clone().try_inverse().ok_or_else(|| {
             IdentifyError::invalid(
                 "document.lpv",
@@ -538,8 +547,8 @@ fn augmented_model(
         });
         pt.a = to_rows(&(-&m_inv * &d));
         pt.b = to_rows(&m_inv);
-        pt.m = model.m.clone();
-        pt.d_bar = model.d_bar.clone();
+        pt.m = to_rows(&m);
+        pt.d_bar = to_rows(&d);
         for f in &p.report.findings {
             let estimates = f.coefficients.iter().chain(f.shape.iter());
             for c in estimates {

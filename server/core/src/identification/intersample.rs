@@ -253,6 +253,35 @@ pub fn logged_equivalent(
     controller: &LoggedController,
     dofs: &[Dof],
 ) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+    shifted(m, d_bar, controller, dofs, -controller.c_s)
+}
+
+/// The error for a stored controller whose gains do not fit the model.
+pub(crate) fn malformed_controller() -> super::error::IdentifyError {
+    super::error::IdentifyError::invalid(
+        "document.lpv.logged_controller",
+        "K_ν must be n × n and K_η n × 2",
+    )
+}
+
+/// The vehicle's M and D̄ from those a log of `controller` sees: the
+/// inverse of [`logged_equivalent`].
+pub fn vehicle_from_logged(
+    m: &DMatrix<f64>,
+    d_bar: &DMatrix<f64>,
+    controller: &LoggedController,
+    dofs: &[Dof],
+) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+    shifted(m, d_bar, controller, dofs, controller.c_s)
+}
+
+fn shifted(
+    m: &DMatrix<f64>,
+    d_bar: &DMatrix<f64>,
+    controller: &LoggedController,
+    dofs: &[Dof],
+    c: f64,
+) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
     let n = dofs.len();
     let k_nu = from_rows(&controller.k_nu).filter(|k| k.shape() == (n, n))?;
     let k_attitude = from_rows(&controller.k_attitude).filter(|k| k.shape() == (n, 2))?;
@@ -262,12 +291,37 @@ pub fn logged_equivalent(
         r2: vec![1.0; n],
         samples: vec![0; n],
     };
-    Some(corrected(m, d_bar, &gains, dofs, -controller.c_s))
+    Some(corrected(m, d_bar, &gains, dofs, c))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_vehicle_view_inverts_the_logged_view() {
+        let controller = LoggedController {
+            rate_hz: 20.0,
+            log_h_s: 0.1,
+            c_s: 0.025,
+            k_nu: vec![vec![-400.0, 3.0], vec![-2.0, -60.0]],
+            k_attitude: vec![vec![0.0, 5.0], vec![-7.0, 0.0]],
+        };
+        let dofs = [Dof::Roll, Dof::Pitch];
+        let m = DMatrix::from_row_slice(2, 2, &[30.0, 1.0, 1.0, 40.0]);
+        let d = DMatrix::from_row_slice(2, 2, &[5.0, 0.5, 0.2, 8.0]);
+        let (ml, dl) = logged_equivalent(&m, &d, &controller, &dofs).unwrap();
+        assert!(
+            (ml[(0, 0)] - 40.0).abs() < 1e-12 && (dl[(1, 0)] - (0.2 + 0.025 * 7.0)).abs() < 1e-12
+        );
+        let (mv, dv) = vehicle_from_logged(&ml, &dl, &controller, &dofs).unwrap();
+        assert!((mv - &m).abs().max() < 1e-12 && (dv - &d).abs().max() < 1e-12);
+        let bad = LoggedController {
+            k_nu: vec![vec![1.0]],
+            ..controller
+        };
+        assert!(vehicle_from_logged(&m, &d, &bad, &dofs).is_none());
+    }
     use crate::rng::SplitMix64;
 
     /// Roll of a pendulum-like vehicle, M ṗ + D p + K φ = τ, under a PD

@@ -52,12 +52,8 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                 // Predictions on logs of a controller faster than the log
                 // add its unlogged commands back.
                 let (m, d_bar) = match &lpv.logged_controller {
-                    Some(lc) => logged_equivalent(&m, &d_bar, lc, &doc.dofs).ok_or_else(|| {
-                        IdentifyError::invalid(
-                            "document.lpv.logged_controller",
-                            "K_ν must be n × n and K_η n × 2",
-                        )
-                    })?,
+                    Some(lc) => logged_equivalent(&m, &d_bar, lc, &doc.dofs)
+                        .ok_or_else(super::intersample::malformed_controller)?,
                     None => (m, d_bar),
                 };
                 models.push(

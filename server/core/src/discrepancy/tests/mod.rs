@@ -110,17 +110,10 @@ fn bad_input_is_a_typed_error_naming_the_field() {
         field(&b, &s.est, &s.val, &set).as_deref(),
         Some("baseline.m")
     );
-    let mut e = s.est.clone();
-    e[1].nu[(7, 2)] = f64::NAN;
+    let short = vec![s.est[0].slice(0, 50, "short".into())];
     assert_eq!(
-        field(&s.baseline, &e, &s.val, &set).as_deref(),
-        Some("estimation_runs[1].nu")
-    );
-    let mut v = s.val.clone();
-    v[0].h = 0.2;
-    assert_eq!(
-        field(&s.baseline, &s.est, &v, &set).as_deref(),
-        Some("validation_runs[0].h")
+        field(&s.baseline, &short, &[], &set).as_deref(),
+        Some("estimation_runs")
     );
     assert_eq!(
         field(&s.baseline, &[], &s.val, &set).as_deref(),
@@ -134,11 +127,43 @@ fn bad_input_is_a_typed_error_naming_the_field() {
         field(&s.baseline, &s.est, &s.val, &bad).as_deref(),
         Some("settings.k_step")
     );
-    let short = vec![s.est[0].slice(0, 50, "short".into())];
-    assert_eq!(
-        field(&s.baseline, &short, &[], &set).as_deref(),
-        Some("estimation_runs[0].nu")
-    );
+}
+
+/// One bad run (a NaN, another sample time, too short) is set aside with
+/// its reason in the summary; the others are still examined.
+#[test]
+fn one_bad_run_is_set_aside_and_named_not_fatal() {
+    use crate::discrepancy::discover::{DiscoverySettings, discover};
+    use crate::estimation::NoProgress;
+    let s = scenario(clean_truth(), 3, 3, 1, 60.0);
+    let mut e = s.est.clone();
+    e[1].nu[(7, 2)] = f64::NAN;
+    e[1].name = "nan-run".into();
+    e.push(s.est[0].slice(0, 50, "short-run".into()));
+    let mut v = s.val.clone();
+    let mut odd = v[0].clone();
+    odd.h = 0.2;
+    odd.name = "odd-rate".into();
+    v.push(odd);
+    let r = discover(
+        &s.baseline,
+        &e,
+        &v,
+        &DiscoverySettings::default(),
+        &mut NoProgress,
+    )
+    .expect("the good runs are examined");
+    let said = r.summary.join("\n");
+    for (name, field) in [
+        ("nan-run", "estimation_runs[1].nu"),
+        ("short-run", "estimation_runs[3].nu"),
+        ("odd-rate", "validation_runs[1].h"),
+    ] {
+        assert!(
+            said.contains(&format!("run '{name}' set aside (`{field}`")),
+            "{said}"
+        );
+    }
 }
 
 #[test]
