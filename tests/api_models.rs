@@ -102,6 +102,34 @@ async fn identify_job_stores_a_validated_versioned_lpv_model() {
     assert_eq!(fossen.status, 200, "{}", fossen.text);
     assert_eq!(fossen.json["points"].as_array().unwrap().len(), 2);
     assert_eq!(fossen.json["points"][0]["M"].as_array().unwrap().len(), 6);
+    // The MATLAB script: the stored matrices, read back number for number.
+    let script = app
+        .call(
+            "GET",
+            "/api/models/{id}/export?format=matlab",
+            &[&mid],
+            None,
+        )
+        .await;
+    assert_eq!(script.status, 200, "{}", script.text);
+    let line = script
+        .text
+        .lines()
+        .find(|l| l.starts_with("model.lpv.M(:,:,1) = ["))
+        .expect("M of the first grid point");
+    let inner = &line[line.find('[').unwrap() + 1..line.rfind(']').unwrap()];
+    let read: Vec<Vec<f64>> = inner
+        .split(';')
+        .map(|r| r.split_whitespace().map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let stored: Vec<Vec<f64>> =
+        serde_json::from_value(m.json["document"]["lpv"]["points"][0]["m"].clone()).unwrap();
+    assert_eq!(read, stored);
+    assert!(
+        script
+            .text
+            .contains("model.dofs = {'surge', 'sway', 'heave', 'roll', 'pitch', 'yaw'};")
+    );
     let unknown = app
         .call("GET", "/api/models/{id}/export?format=xlsx", &[&mid], None)
         .await;

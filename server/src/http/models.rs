@@ -8,6 +8,7 @@ use axum::response::{IntoResponse, Response};
 use seatrial_core::identification::discrete::{DiscreteModel, discretize};
 use seatrial_core::identification::document::ModelDocument;
 use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv};
+use seatrial_core::identification::export_matlab::matlab_script;
 use serde::{Deserialize, Serialize};
 
 use super::query::ApiQuery;
@@ -111,8 +112,10 @@ pub async fn get_model(
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
 pub struct ExportQuery {
     /// `json` (default: the whole model with provenance), `csv` (parameter
-    /// table with standard deviations) or `fossen` (M, D, g(η), T, K in Fossen
-    /// form for MSS / PythonVehicleSimulator).
+    /// table with standard deviations), `fossen` (M, D, g(η), T, K in Fossen
+    /// form for MSS / PythonVehicleSimulator) or `matlab` (a `.m` script
+    /// defining the struct `model`: every matrix with its std, g(η), the
+    /// logged controller, the parameter table).
     pub format: Option<String>,
 }
 
@@ -146,9 +149,10 @@ fn attachment(body: String, content_type: &str, filename: String) -> Response {
 #[utoipa::path(get, path = "/api/models/{id}/export", tag = "models",
     params(("id" = String, Path, description = "Model id"), ExportQuery),
     responses(
-        (status = 200, description = "The export: JSON (`json`, `fossen`) or CSV (`csv`)", content(
+        (status = 200, description = "The export: JSON (`json`, `fossen`), CSV (`csv`) or a MATLAB script (`matlab`)", content(
             (JsonExport = "application/json"),
-            (String = "text/csv"))),
+            (String = "text/csv"),
+            (String = "text/x-matlab"))),
         (status = 400, description = "Unknown format", body = ErrorBody),
         (status = 404, description = "No such model", body = ErrorBody),
         (status = 422, description = "No Fossen form for a black-box model", body = ErrorBody)))]
@@ -184,9 +188,17 @@ pub async fn export_model(
                 format!("{stem}-fossen.json"),
             ))
         }
+        "matlab" => Ok(attachment(
+            matlab_script(&v.document, &v.model.name, v.model.version),
+            "text/x-matlab; charset=utf-8",
+            format!(
+                "{}.m",
+                stem.replace(|c: char| !c.is_ascii_alphanumeric(), "_")
+            ),
+        )),
         other => Err(ApiError::bad_field(
             "format",
-            format!("unknown export format '{other}'; use json, csv or fossen"),
+            format!("unknown export format '{other}'; use json, csv, fossen or matlab"),
         )),
     }
 }

@@ -36,6 +36,7 @@ pub mod document;
 pub mod ekf_campaign;
 pub mod error;
 pub mod export;
+pub mod export_matlab;
 pub mod intersample;
 mod joint_restoring;
 pub mod lambda_campaign;
