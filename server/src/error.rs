@@ -82,6 +82,17 @@ pub enum ApiError {
         /// The stored run.
         run_id: String,
     },
+    /// A write from a page of another origin (403).
+    #[error("{message}")]
+    Forbidden {
+        /// Message.
+        message: String,
+        /// The header that decided it (`Origin`).
+        field: String,
+    },
+    /// A Host the service does not answer to: a DNS-rebinding guard (421).
+    #[error("{0}")]
+    Misdirected(String),
     /// Route exists, method does not (405).
     #[error("{0}")]
     MethodNotAllowed(String),
@@ -124,6 +135,19 @@ impl ApiError {
         }
     }
 
+    /// A 403 naming the header that decided it.
+    pub fn forbidden(field: impl Into<String>, message: impl Into<String>) -> Self {
+        ApiError::Forbidden {
+            message: message.into(),
+            field: field.into(),
+        }
+    }
+
+    /// A 421 for a Host header not on the allow-list.
+    pub fn misdirected(message: impl Into<String>) -> Self {
+        ApiError::Misdirected(message.into())
+    }
+
     fn status(&self) -> StatusCode {
         match self {
             ApiError::BadRequest { .. } => StatusCode::BAD_REQUEST,
@@ -132,6 +156,8 @@ impl ApiError {
             | ApiError::InvalidUpload { .. }
             | ApiError::Invalid { .. } => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Conflict(_) => StatusCode::CONFLICT,
+            ApiError::Forbidden { .. } => StatusCode::FORBIDDEN,
+            ApiError::Misdirected(_) => StatusCode::MISDIRECTED_REQUEST,
             ApiError::MethodNotAllowed(_) => StatusCode::METHOD_NOT_ALLOWED,
             ApiError::TooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
             ApiError::UnsupportedMediaType(_) => StatusCode::UNSUPPORTED_MEDIA_TYPE,
@@ -154,9 +180,9 @@ impl IntoResponse for ApiError {
         };
         let (message, field, limit) = match self {
             ApiError::BadRequest { message, field } => (message, field, None),
-            ApiError::Missing { message, field } | ApiError::Invalid { message, field } => {
-                (message, Some(field), None)
-            }
+            ApiError::Missing { message, field }
+            | ApiError::Invalid { message, field }
+            | ApiError::Forbidden { message, field } => (message, Some(field), None),
             ApiError::Unprocessable(e) => (e.message, Some(e.field), e.limit),
             ApiError::InvalidUpload {
                 message,
@@ -182,6 +208,7 @@ impl IntoResponse for ApiError {
                 tracing::error!(error = %e, "internal error");
                 ("internal error; see the server log".to_string(), None, None)
             }
+            ApiError::Misdirected(message) => (message, Some("Host".to_string()), None),
             other => (other.to_string(), None, None),
         };
         body.message = message;

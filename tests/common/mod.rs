@@ -29,6 +29,7 @@ pub struct TestApp {
 /// A response: status, content type, body text and parsed JSON (if any).
 pub struct Resp {
     pub status: StatusCode,
+    pub headers: axum::http::HeaderMap,
     pub content_type: String,
     pub text: String,
     pub json: Value,
@@ -150,7 +151,21 @@ impl TestApp {
 
     /// Sends a request without contract checks (for malformed bodies etc.).
     pub async fn raw(&self, method: &str, path: &str, body: Option<(&str, String)>) -> Resp {
+        self.raw_with(method, path, &[], body).await
+    }
+
+    /// [`raw`](Self::raw) with extra request headers (`Host`, `Origin`, …).
+    pub async fn raw_with(
+        &self,
+        method: &str,
+        path: &str,
+        headers: &[(&str, &str)],
+        body: Option<(&str, String)>,
+    ) -> Resp {
         let mut req = Request::builder().method(method).uri(path);
+        for (k, v) in headers {
+            req = req.header(*k, *v);
+        }
         let body = match body {
             Some((ct, b)) => {
                 req = req.header("content-type", ct);
@@ -165,8 +180,8 @@ impl TestApp {
             .await
             .unwrap();
         let status = resp.status();
-        let content_type = resp
-            .headers()
+        let headers = resp.headers().clone();
+        let content_type = headers
             .get("content-type")
             .map(|v| v.to_str().unwrap().to_string())
             .unwrap_or_default();
@@ -177,6 +192,7 @@ impl TestApp {
         let json = serde_json::from_str(&text).unwrap_or(Value::Null);
         Resp {
             status,
+            headers,
             content_type,
             text,
             json,

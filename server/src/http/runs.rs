@@ -364,10 +364,7 @@ pub async fn raw_run(
         .await
         .map_err(|e| ApiError::Internal(anyhow::anyhow!("blob {} unreadable: {e}", f.sha256)))?;
     let body = Body::from_stream(tokio_util::io::ReaderStream::new(file));
-    let disposition = format!(
-        "attachment; filename=\"{}\"",
-        f.filename.replace(['"', '\\', '\r', '\n'], "_")
-    );
+    let disposition = super::exposure::attachment(&f.filename);
     Ok((
         [
             (header::CONTENT_TYPE, "text/csv".to_string()),
