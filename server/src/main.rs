@@ -109,6 +109,17 @@ async fn main() -> anyhow::Result<()> {
     }
     tracing::info!(hosts = ?exposure.hosts(), "answering to these host names");
     state.exposure = std::sync::Arc::new(exposure);
+    // A stopped server's debris: partial uploads go, runs it left `stored`
+    // are processed in the background (listed now, before any new upload).
+    let debris = seatrial::intake::sweep(&db, &state.blobs).await?;
+    if !debris.stored_runs.is_empty() {
+        tracing::info!(
+            runs = debris.stored_runs.len(),
+            "processing runs a stopped server left stored"
+        );
+        let (db, blobs) = (db.clone(), state.blobs.clone());
+        tokio::spawn(async move { debris.reprocess(&db, &blobs).await });
+    }
     // Recovers jobs a previous server left running, then starts the workers.
     let runner = seatrial::jobs::start(jobs.clone(), state.job_context()).await?;
     let app = seatrial::http::app(state, args.web_dir);

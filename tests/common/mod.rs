@@ -249,6 +249,37 @@ pub fn rov_profile() -> Value {
     serde_json::to_value(seatrial_core::planning::examples::surveyor_rov()).unwrap()
 }
 
+/// A Surveyor ROV and a one-speed dynamic campaign for it; the campaign's id.
+pub async fn rov_campaign_id(app: &TestApp) -> String {
+    let r = app
+        .call("POST", "/api/vessels", &[], Some(rov_profile()))
+        .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let body = json!({
+        "vessel_id": r.json["id"],
+        "name": "trial",
+        "grid": { "unit": "kn", "speeds": [1.0] },
+        "families": ["dynamic"],
+        "seed": 5
+    });
+    let r = app.call("POST", "/api/campaigns", &[], Some(body)).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    r.json["id"].as_str().unwrap().to_string()
+}
+
+/// A valid single-file log of that ROV: 60 s at 10 Hz, every column.
+pub fn rov_log() -> String {
+    let run = sim::simulate(
+        1,
+        10.0,
+        60.0,
+        [400.0, 800.0, 800.0, 0.0, 600.0, 600.0],
+        3.0,
+        1e-4,
+    );
+    sim::csv(&run, &sim::all_columns(), 100.0, 1)
+}
+
 /// Fossen's supply vessel profile as JSON.
 pub fn dp_profile() -> Value {
     serde_json::to_value(seatrial_core::planning::examples::supply_vessel()).unwrap()

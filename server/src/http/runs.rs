@@ -11,16 +11,16 @@ use serde::Deserialize;
 
 use super::json::parse_json;
 use super::run_description::{DescriptionChange, from_value};
-use super::{AppState, blocking, found};
-use seatrial_core::alignment::{OffsetPriors, check_user_offset};
+use super::{AppState, found};
+use seatrial_core::alignment::check_user_offset;
 
-use crate::clock::CampaignClocks;
 use crate::coverage::{self, Coverage};
 use crate::error::{ApiError, ApiResult, ErrorBody};
-use crate::processing::{self, RunMeta};
+use crate::intake;
+use crate::processing::RunMeta;
 use crate::storage::blobs::BlobWriter;
-use crate::storage::runs::{self, NewFile, Outcome, Run};
-use crate::storage::{campaigns, clock_offsets, plans, vessels};
+use crate::storage::runs::{self, NewFile, Run};
+use crate::storage::{campaigns, plans, vessels};
 
 /// The multipart form of an upload (documentation of the parts).
 #[derive(Debug, utoipa::ToSchema)]
@@ -241,6 +241,7 @@ pub async fn upload_run(
         .clone()
         .or_else(|| planned.as_ref().map(|(e, _)| e.experiment.code.clone()))
         .unwrap_or_else(|| files[0].filename.clone());
+    let upload_meta = serde_json::to_value(&meta).map_err(anyhow::Error::from)?;
     let run = runs::insert(
         &s.db,
         &campaign.id,
@@ -249,56 +250,18 @@ pub async fn upload_run(
         layout,
         &files,
         &user,
+        &upload_meta,
     )
     .await?;
-
-    let inputs: Vec<(String, std::path::PathBuf)> = files
-        .iter()
-        .map(|f| (f.role.clone(), s.blobs.path(&f.blob.sha256)))
-        .collect();
-    let priors = OffsetPriors {
-        user_run_s: meta.clock_offset_s,
-        ..CampaignClocks::load(&s.db, &campaign.id)
-            .await?
-            .priors_for(None)
-    };
-    let user_offset = meta.clock_offset_s;
-    let grid = campaign.grid_speeds_mps.clone();
-    let outcome = blocking(move || {
-        processing::process_run(
-            &vessel.profile,
-            &inputs,
-            &meta,
-            &priors,
-            planned.as_ref(),
-            &grid,
-        )
-    })
-    .await?;
-    match outcome {
-        Ok(done) => {
-            if user_offset.is_some() {
-                clock_offsets::set_run_offset(&s.db, &run.id, user_offset).await?;
-            }
-            runs::finish(&s.db, &run.id, "accepted", done.outcome()).await?;
-            let run = found(runs::get(&s.db, &run.id).await?, "run", &run.id)?;
-            Ok((StatusCode::CREATED, Json(run)))
-        }
-        Err(e) => {
-            let detail = serde_json::to_value(&e).map_err(anyhow::Error::from)?;
-            let out = Outcome {
-                error: Some(&detail),
-                ..Outcome::default()
-            };
-            runs::finish(&s.db, &run.id, "rejected", out).await?;
-            Err(ApiError::InvalidUpload {
-                message: e.message,
-                field: e.file,
-                line: e.line,
-                column: e.column,
-                run_id: run.id,
-            })
-        }
+    match intake::process_stored(&s.db, &s.blobs, &run.id).await? {
+        Ok(run) => Ok((StatusCode::CREATED, Json(run))),
+        Err(e) => Err(ApiError::InvalidUpload {
+            message: e.message,
+            field: e.file,
+            line: e.line,
+            column: e.column,
+            run_id: run.id,
+        }),
     }
 }
 
