@@ -46,10 +46,11 @@ const FILE_ROLES: [&str; 3] = ["file", "control", "nav"];
 const MAX_META_BYTES: usize = 64 * 1024;
 
 fn too_large(limit: u64) -> ApiError {
-    ApiError::TooLarge(format!(
-        "the upload exceeds the limit of {} MB (server flag --max-upload-mb)",
-        limit / (1024 * 1024)
-    ))
+    ApiError::too_large(
+        "the upload",
+        limit,
+        " (all files of a run together; server flag --max-upload-mb)",
+    )
 }
 
 async fn stream_field(
@@ -78,6 +79,20 @@ async fn stream_field(
             .await
             .map_err(|e| ApiError::Internal(anyhow::anyhow!("writing the upload: {e}")))?;
     }
+}
+
+/// A run named after its file: control characters escaped, at most
+/// [`seatrial_core::planning::MAX_NAME_LEN`] bytes.
+fn run_name_of_file(filename: &str) -> String {
+    let mut name = seatrial_core::numbers::escape_controls(filename);
+    if name.len() > seatrial_core::planning::MAX_NAME_LEN {
+        let mut end = seatrial_core::planning::MAX_NAME_LEN;
+        while !name.is_char_boundary(end) {
+            end -= 1;
+        }
+        name.truncate(end);
+    }
+    name
 }
 
 /// Upload a run: `multipart/form-data` with an optional `meta` part (JSON)
@@ -153,6 +168,13 @@ pub async fn upload_run(
                 other => other,
             })?;
             meta = from_value(v, "meta.")?;
+            if let Some(n) = &meta.name {
+                seatrial_core::planning::check_name("meta.name", n)?;
+            }
+            if let Some(r) = meta.rate_hz {
+                seatrial_core::logs::check_rate_hz(r)
+                    .map_err(|m| ApiError::invalid("meta.rate_hz", m))?;
+            }
             // Checked at once: a `meta` sent before the files refuses the
             // upload before any byte is stored.
             DescriptionChange::of_meta(&meta).apply(&mut user, &vessel.profile, "meta.")?;
@@ -240,7 +262,7 @@ pub async fn upload_run(
         .name
         .clone()
         .or_else(|| planned.as_ref().map(|(e, _)| e.experiment.code.clone()))
-        .unwrap_or_else(|| files[0].filename.clone());
+        .unwrap_or_else(|| run_name_of_file(&files[0].filename));
     let upload_meta = serde_json::to_value(&meta).map_err(anyhow::Error::from)?;
     let run = runs::insert(
         &s.db,
