@@ -140,8 +140,8 @@ async fn main() -> anyhow::Result<()> {
     axum::serve(listener, app)
         .with_graceful_shutdown(stop.cancelled_owned())
         .await?;
-    // Running jobs are neither cancelled nor failed: they unwind, and the
-    // next start re-queues them (see seatrial::jobs, "Restarts").
+    // Running jobs are neither cancelled nor failed: they unwind and are
+    // queued again at once, no attempt spent (see seatrial::jobs, "Restarts").
     runner.shutdown(Duration::from_secs(10)).await;
     let _ = tokio::time::timeout(Duration::from_secs(5), db.close()).await;
     // A computation that ignored the stop still holds a blocking thread,
