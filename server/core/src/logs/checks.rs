@@ -235,7 +235,7 @@ mod tests {
         assert_eq!(columns(&w), ["t", "u"]);
         assert!(
             w[0].message
-                .starts_with("t looks like milliseconds (median step 100,")
+                .starts_with("t looks like milliseconds (median step 100:")
         );
         assert_eq!(
             w[1].message,
