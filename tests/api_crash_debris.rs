@@ -43,7 +43,7 @@ async fn a_restart_sweeps_partial_uploads_and_processes_runs_left_stored() {
         .await
         .unwrap();
     assert_eq!(debris.partial_uploads, 1);
-    assert_eq!(debris.stored_runs, [id.clone()]);
+    assert_eq!(debris.stored_runs, std::slice::from_ref(&id));
     assert_eq!(std::fs::read_dir(&tmp).unwrap().count(), 0);
     let r = app.call("GET", "/api/runs/{id}", &[&id], None).await;
     assert_eq!(r.json["status"], "accepted", "{}", r.text);
