@@ -17,7 +17,6 @@ use seatrial_core::simulation::dp_ship::{DpFlightSettings, DpShip, fly_dp_campai
 use seatrial_core::simulation::rov::RovTruth;
 use seatrial_core::simulation::trials::{TrialSettings, fly_campaign};
 
-use crate::processing::{self, RunMeta};
 use crate::storage::blobs::BlobStore;
 use crate::storage::runs::{self, NewFile};
 use crate::storage::{Db, campaigns, plans, vessels};
@@ -77,7 +76,7 @@ async fn fly_rov_trials(
     })
     .await??;
     let logs = flown.into_iter().map(|r| (r.code, r.csv)).collect();
-    upload_all(db, blobs, campaign_id, profile, stored, logs).await
+    upload_all(db, blobs, campaign_id, stored, logs).await
 }
 
 /// Flies the DP plan through Fossen's supply vessel (the paper's M″, T″,
@@ -103,7 +102,7 @@ async fn fly_dp_trials(
     })
     .await??;
     let logs = flown.into_iter().map(|r| (r.code, r.csv)).collect();
-    upload_all(db, blobs, campaign_id, profile, stored, logs).await
+    upload_all(db, blobs, campaign_id, stored, logs).await
 }
 
 /// Uploads `(experiment code, csv)` logs as runs of their planned
@@ -112,14 +111,9 @@ pub async fn upload_all(
     db: &Db,
     blobs: &BlobStore,
     campaign_id: &str,
-    profile: &VesselProfile,
     stored: &plans::StoredPlan,
     logs: Vec<(String, String)>,
 ) -> anyhow::Result<()> {
-    let grid = campaigns::get(db, campaign_id)
-        .await?
-        .map(|c| c.grid_speeds_mps)
-        .unwrap_or_default();
     for (code, csv) in logs {
         let Some(eid) = stored
             .experiments
@@ -132,7 +126,6 @@ pub async fn upload_all(
         let mut w = blobs.begin().await?;
         w.write(csv.as_bytes()).await?;
         let blob = w.finish().await?;
-        let path = blobs.path(&blob.sha256);
         let r = runs::insert(
             db,
             campaign_id,
@@ -145,32 +138,11 @@ pub async fn upload_all(
                 blob,
             }],
             &UserDescription::default(),
+            &serde_json::json!({}),
         )
         .await?;
-        let planned = plans::experiment(db, campaign_id, &eid).await?;
-        let (prof, grid) = (profile.clone(), grid.clone());
-        let done = tokio::task::spawn_blocking(move || {
-            processing::process_run(
-                &prof,
-                &[("file".to_string(), path)],
-                &RunMeta::default(),
-                &Default::default(),
-                planned.as_ref(),
-                &grid,
-            )
-        })
-        .await?;
-        match done {
-            Ok(d) => runs::finish(db, &r.id, "accepted", d.outcome()).await?,
-            Err(e) => {
-                let detail = serde_json::to_value(&e)?;
-                let out = runs::Outcome {
-                    error: Some(&detail),
-                    ..runs::Outcome::default()
-                };
-                runs::finish(db, &r.id, "rejected", out).await?
-            }
-        }
+        // A demo log that does not process stays, rejected with its reason.
+        let _ = crate::intake::process_stored(db, blobs, &r.id).await?;
     }
     Ok(())
 }

@@ -82,12 +82,28 @@ pub enum ApiError {
         /// The stored run.
         run_id: String,
     },
+    /// A write from a page of another origin (403).
+    #[error("{message}")]
+    Forbidden {
+        /// Message.
+        message: String,
+        /// The header that decided it (`Origin`).
+        field: String,
+    },
+    /// A Host the service does not answer to: a DNS-rebinding guard (421).
+    #[error("{0}")]
+    Misdirected(String),
     /// Route exists, method does not (405).
     #[error("{0}")]
     MethodNotAllowed(String),
-    /// Request body over the size limit (413).
-    #[error("{0}")]
-    TooLarge(String),
+    /// Request body over the size limit (413); the body's `limit` is in bytes.
+    #[error("{message}")]
+    TooLarge {
+        /// Message, naming the limit.
+        message: String,
+        /// The limit (bytes).
+        limit_bytes: u64,
+    },
     /// Wrong content type (415).
     #[error("{0}")]
     UnsupportedMediaType(String),
@@ -124,6 +140,36 @@ impl ApiError {
         }
     }
 
+    /// A 403 naming the header that decided it.
+    pub fn forbidden(field: impl Into<String>, message: impl Into<String>) -> Self {
+        ApiError::Forbidden {
+            message: message.into(),
+            field: field.into(),
+        }
+    }
+
+    /// A 413 naming the limit in bytes (and MB when that reads better).
+    pub fn too_large(what: &str, limit_bytes: u64, hint: &str) -> Self {
+        let mb = limit_bytes as f64 / (1024.0 * 1024.0);
+        let shown = if limit_bytes >= 1024 * 1024 {
+            format!(
+                "{limit_bytes} bytes ({} MB)",
+                seatrial_core::numbers::echoed(mb)
+            )
+        } else {
+            format!("{limit_bytes} bytes")
+        };
+        ApiError::TooLarge {
+            message: format!("{what} exceeds the limit of {shown}{hint}"),
+            limit_bytes,
+        }
+    }
+
+    /// A 421 for a Host header not on the allow-list.
+    pub fn misdirected(message: impl Into<String>) -> Self {
+        ApiError::Misdirected(message.into())
+    }
+
     fn status(&self) -> StatusCode {
         match self {
             ApiError::BadRequest { .. } => StatusCode::BAD_REQUEST,
@@ -132,8 +178,10 @@ impl ApiError {
             | ApiError::InvalidUpload { .. }
             | ApiError::Invalid { .. } => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Conflict(_) => StatusCode::CONFLICT,
+            ApiError::Forbidden { .. } => StatusCode::FORBIDDEN,
+            ApiError::Misdirected(_) => StatusCode::MISDIRECTED_REQUEST,
             ApiError::MethodNotAllowed(_) => StatusCode::METHOD_NOT_ALLOWED,
-            ApiError::TooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
+            ApiError::TooLarge { .. } => StatusCode::PAYLOAD_TOO_LARGE,
             ApiError::UnsupportedMediaType(_) => StatusCode::UNSUPPORTED_MEDIA_TYPE,
             ApiError::Database(_) | ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
         }
@@ -154,9 +202,9 @@ impl IntoResponse for ApiError {
         };
         let (message, field, limit) = match self {
             ApiError::BadRequest { message, field } => (message, field, None),
-            ApiError::Missing { message, field } | ApiError::Invalid { message, field } => {
-                (message, Some(field), None)
-            }
+            ApiError::Missing { message, field }
+            | ApiError::Invalid { message, field }
+            | ApiError::Forbidden { message, field } => (message, Some(field), None),
             ApiError::Unprocessable(e) => (e.message, Some(e.field), e.limit),
             ApiError::InvalidUpload {
                 message,
@@ -182,10 +230,17 @@ impl IntoResponse for ApiError {
                 tracing::error!(error = %e, "internal error");
                 ("internal error; see the server log".to_string(), None, None)
             }
+            ApiError::Misdirected(message) => (message, Some("Host".to_string()), None),
+            ApiError::TooLarge {
+                message,
+                limit_bytes,
+            } => (message, None, Some(limit_bytes as f64)),
             other => (other.to_string(), None, None),
         };
-        body.message = message;
-        body.field = field;
+        // Messages and fields may quote what a client sent: never raw
+        // control characters (newlines, terminal escapes).
+        body.message = seatrial_core::numbers::escape_controls(&message);
+        body.field = field.map(|f| seatrial_core::numbers::escape_controls(&f));
         body.limit = limit;
         (status, Json(body)).into_response()
     }

@@ -8,6 +8,7 @@ pub mod coverage;
 pub mod demo;
 pub mod error;
 pub mod http;
+pub mod intake;
 pub mod jobs;
 pub mod processing;
 pub mod storage;

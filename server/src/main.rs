@@ -42,6 +42,15 @@ struct Args {
     #[arg(long, env = "SEATRIAL_JOB_LEASE_SECS", default_value_t = 30,
           value_parser = clap::value_parser!(u64).range(2..))]
     job_lease_secs: u64,
+    /// Host names the service answers to besides localhost, 127.0.0.1, [::1]
+    /// and the listen address (comma-separated; ports ignored; `*` = any,
+    /// which gives up the DNS-rebinding guard). Other Host headers get 421.
+    #[arg(long, env = "SEATRIAL_ALLOWED_HOSTS", value_delimiter = ',')]
+    allowed_hosts: Vec<String>,
+    /// Origins (`https://ops.example:8443`) whose pages may write (POST, PUT,
+    /// PATCH, DELETE) besides the service's own; other origins get 403.
+    #[arg(long, env = "SEATRIAL_ALLOWED_ORIGINS", value_delimiter = ',')]
+    allowed_origins: Vec<String>,
 }
 
 #[tokio::main]
@@ -80,13 +89,37 @@ async fn main() -> anyhow::Result<()> {
         ..JobsConfig::default()
     };
     let jobs = Jobs::new(JobRegistry::production(), config);
-    let state = seatrial::http::AppState::with_jobs(
+    let mut state = seatrial::http::AppState::with_jobs(
         db.clone(),
         &blob_dir,
         args.max_upload_mb * 1024 * 1024,
         jobs.clone(),
     )?;
     let listener = tokio::net::TcpListener::bind(args.listen).await?;
+    let exposure = seatrial::http::exposure::Exposure::local(Some(listener.local_addr()?))
+        .allow_hosts(&args.allowed_hosts)
+        .allow_origins(&args.allowed_origins);
+    if exposure.any_host() {
+        tracing::warn!("--allowed-hosts '*': any Host header is answered (no DNS-rebinding guard)");
+    } else if args.listen.ip().is_unspecified() && args.allowed_hosts.is_empty() {
+        tracing::warn!(
+            "listening on every interface, but only localhost names are answered: \
+             add the names clients use with --allowed-hosts"
+        );
+    }
+    tracing::info!(hosts = ?exposure.hosts(), "answering to these host names");
+    state.exposure = std::sync::Arc::new(exposure);
+    // A stopped server's debris: partial uploads go, runs it left `stored`
+    // are processed in the background (listed now, before any new upload).
+    let debris = seatrial::intake::sweep(&db, &state.blobs).await?;
+    if !debris.stored_runs.is_empty() {
+        tracing::info!(
+            runs = debris.stored_runs.len(),
+            "processing runs a stopped server left stored"
+        );
+        let (db, blobs) = (db.clone(), state.blobs.clone());
+        tokio::spawn(async move { debris.reprocess(&db, &blobs).await });
+    }
     // Recovers jobs a previous server left running, then starts the workers.
     let runner = seatrial::jobs::start(jobs.clone(), state.job_context()).await?;
     let app = seatrial::http::app(state, args.web_dir);
@@ -107,8 +140,8 @@ async fn main() -> anyhow::Result<()> {
     axum::serve(listener, app)
         .with_graceful_shutdown(stop.cancelled_owned())
         .await?;
-    // Running jobs are neither cancelled nor failed: they unwind, and the
-    // next start re-queues them (see seatrial::jobs, "Restarts").
+    // Running jobs are neither cancelled nor failed: they unwind and are
+    // queued again at once, no attempt spent (see seatrial::jobs, "Restarts").
     runner.shutdown(Duration::from_secs(10)).await;
     let _ = tokio::time::timeout(Duration::from_secs(5), db.close()).await;
     // A computation that ignored the stop still holds a blocking thread,

@@ -291,13 +291,8 @@ pub fn load_record(
         check_user_offset("meta.clock_offset_s", v)
             .map_err(|e| ProcessError::new("meta.clock_offset_s", e.message()))?;
     }
-    if let Some(r) = meta.rate_hz
-        && !(r.is_finite() && r > 0.0 && r <= 1000.0)
-    {
-        return Err(ProcessError::new(
-            "meta.rate_hz",
-            format!("must be in (0, 1000] Hz, got {r}"),
-        ));
+    if let Some(r) = meta.rate_hz {
+        seatrial_core::logs::check_rate_hz(r).map_err(|m| ProcessError::new("meta.rate_hz", m))?;
     }
     let path = |role: &str| files.iter().find(|(r, _)| r == role).map(|(_, p)| p);
     let note = |file: &str, p: &ParsedLog, summary: &mut RunSummary| {

@@ -29,6 +29,7 @@ pub struct TestApp {
 /// A response: status, content type, body text and parsed JSON (if any).
 pub struct Resp {
     pub status: StatusCode,
+    pub headers: axum::http::HeaderMap,
     pub content_type: String,
     pub text: String,
     pub json: Value,
@@ -150,7 +151,21 @@ impl TestApp {
 
     /// Sends a request without contract checks (for malformed bodies etc.).
     pub async fn raw(&self, method: &str, path: &str, body: Option<(&str, String)>) -> Resp {
+        self.raw_with(method, path, &[], body).await
+    }
+
+    /// [`raw`](Self::raw) with extra request headers (`Host`, `Origin`, …).
+    pub async fn raw_with(
+        &self,
+        method: &str,
+        path: &str,
+        headers: &[(&str, &str)],
+        body: Option<(&str, String)>,
+    ) -> Resp {
         let mut req = Request::builder().method(method).uri(path);
+        for (k, v) in headers {
+            req = req.header(*k, *v);
+        }
         let body = match body {
             Some((ct, b)) => {
                 req = req.header("content-type", ct);
@@ -165,8 +180,8 @@ impl TestApp {
             .await
             .unwrap();
         let status = resp.status();
-        let content_type = resp
-            .headers()
+        let headers = resp.headers().clone();
+        let content_type = headers
             .get("content-type")
             .map(|v| v.to_str().unwrap().to_string())
             .unwrap_or_default();
@@ -177,6 +192,7 @@ impl TestApp {
         let json = serde_json::from_str(&text).unwrap_or(Value::Null);
         Resp {
             status,
+            headers,
             content_type,
             text,
             json,
@@ -231,6 +247,37 @@ impl TestApp {
 /// The Surveyor ROV profile as JSON.
 pub fn rov_profile() -> Value {
     serde_json::to_value(seatrial_core::planning::examples::surveyor_rov()).unwrap()
+}
+
+/// A Surveyor ROV and a one-speed dynamic campaign for it; the campaign's id.
+pub async fn rov_campaign_id(app: &TestApp) -> String {
+    let r = app
+        .call("POST", "/api/vessels", &[], Some(rov_profile()))
+        .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let body = json!({
+        "vessel_id": r.json["id"],
+        "name": "trial",
+        "grid": { "unit": "kn", "speeds": [1.0] },
+        "families": ["dynamic"],
+        "seed": 5
+    });
+    let r = app.call("POST", "/api/campaigns", &[], Some(body)).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    r.json["id"].as_str().unwrap().to_string()
+}
+
+/// A valid single-file log of that ROV: 60 s at 10 Hz, every column.
+pub fn rov_log() -> String {
+    let run = sim::simulate(
+        1,
+        10.0,
+        60.0,
+        [400.0, 800.0, 800.0, 0.0, 600.0, 600.0],
+        3.0,
+        1e-4,
+    );
+    sim::csv(&run, &sim::all_columns(), 100.0, 1)
 }
 
 /// Fossen's supply vessel profile as JSON.

@@ -83,6 +83,55 @@ pub fn p_value(p: f64) -> String {
     }
 }
 
+/// A number someone sent, echoed in a message (`got 1e-308`): at most six
+/// significant digits, ASCII minus (it may be pasted back), `2.5e-7` or
+/// `1.23457e9` outside 10⁻⁴ … 10⁶; `NaN`, `inf` as such.
+pub fn echoed(x: f64) -> String {
+    if !x.is_finite() {
+        return format!("{x}");
+    }
+    if x == 0.0 {
+        return "0".into();
+    }
+    let trim = |m: &str| {
+        if m.contains('.') {
+            m.trim_end_matches('0').trim_end_matches('.').to_owned()
+        } else {
+            m.to_owned()
+        }
+    };
+    // The exponent after rounding to six digits (999999.7 → 1.00000e6).
+    let sci = format!("{x:.5e}");
+    let Some((mantissa, exp)) = sci.split_once('e') else {
+        return sci;
+    };
+    let exp: i32 = exp.parse().unwrap_or(0);
+    if (-4..6).contains(&exp) {
+        let decimals = (5 - exp).max(0) as usize;
+        trim(&format!("{x:.decimals$}"))
+    } else {
+        format!("{}e{exp}", trim(mantissa))
+    }
+}
+
+/// Text someone sent, safe to quote in a message: control characters
+/// (newlines, escapes, NUL, …) shown as escapes (`\n`, `\u{1b}`), the rest
+/// as is.
+pub fn escape_controls(s: &str) -> String {
+    if !s.chars().any(char::is_control) {
+        return s.to_owned();
+    }
+    s.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 fn minus(s: &str) -> String {
     match s.strip_prefix('-') {
         // −0.0 prints as "-0.0": no sign on a zero.
@@ -111,6 +160,38 @@ mod tests {
         assert_eq!(sig3(f64::NEG_INFINITY), "—");
         assert_eq!(quantity(9860.4, "N·m"), "9860 N·m");
         assert_eq!(quantity(0.5, ""), "0.5");
+    }
+
+    #[test]
+    fn echoed_numbers_have_at_most_six_significant_digits() {
+        assert_eq!(echoed(1e-308), "1e-308");
+        assert_eq!(echoed(1.7976931348623157e308), "1.79769e308");
+        assert_eq!(echoed(-35496.16), "-35496.2");
+        assert_eq!(echoed(0.1), "0.1");
+        assert_eq!(echoed(100.0), "100");
+        assert_eq!(echoed(123456.7), "123457");
+        assert_eq!(echoed(0.000123456789), "0.000123457");
+        assert_eq!(echoed(f64::NAN), "NaN");
+        assert_eq!(echoed(999_999.7), "1e6");
+        assert_eq!(echoed(-0.000099999996), "-0.0001");
+        for x in [1e-308, 3.0e9, -2.0 / 3.0, 999_999.7, 1e300, 5e-5] {
+            let s = echoed(x);
+            let digits = s
+                .split('e')
+                .next()
+                .unwrap()
+                .chars()
+                .filter(char::is_ascii_digit)
+                .collect::<String>();
+            assert!(digits.trim_start_matches('0').len() <= 6, "{x}: {s}");
+        }
+    }
+
+    #[test]
+    fn control_characters_are_escaped() {
+        assert_eq!(escape_controls("Surveyor ROV"), "Surveyor ROV");
+        assert_eq!(escape_controls("a\nb\u{1b}[31m"), "a\\nb\\u{1b}[31m");
+        assert_eq!(escape_controls("ø\0"), "ø\\u{0}");
     }
 
     #[test]

@@ -14,12 +14,12 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use super::json::ApiJson;
-use super::{AppState, blocking, campaign_and_vessel, found};
+use super::{AppState, found};
 use crate::clock::{CampaignClocks, own_estimate};
 use crate::error::{ApiError, ApiResult, ErrorBody};
-use crate::processing::{self, RunMeta};
+use crate::processing::RunMeta;
 use crate::storage::runs::{self, Run};
-use crate::storage::{campaigns, clock_offsets, plans};
+use crate::storage::{campaigns, clock_offsets};
 
 /// A clock offset to set by hand, or `null` to clear it.
 #[derive(Debug, Deserialize, utoipa::ToSchema)]
@@ -271,35 +271,14 @@ pub async fn put_run_clock_offset(
     let run = found(runs::get(&s.db, &id).await?, "run", &id)?;
     let offset = requested_offset(&body)?;
     two_file(&run, "clock_offset_s")?;
-    let (campaign, vessel) = campaign_and_vessel(&s.db, &run).await?;
-    let planned = match &run.experiment_id {
-        Some(eid) => plans::experiment(&s.db, &campaign.id, eid).await?,
-        None => None,
-    };
-    let mut clocks = CampaignClocks::load(&s.db, &campaign.id).await?;
+    let mut clocks = CampaignClocks::load(&s.db, &run.campaign_id).await?;
     match offset {
         Some(v) => clocks.user_runs.insert(run.id.clone(), v),
         None => clocks.user_runs.remove(&run.id),
     };
     let priors = clocks.priors_for(Some(&run.id));
     let meta = RunMeta::of_stored(run.summary.as_ref());
-    let files: Vec<_> = run
-        .files
-        .iter()
-        .map(|f| (f.role.clone(), s.blobs.path(&f.sha256)))
-        .collect();
-    let grid = campaign.grid_speeds_mps.clone();
-    let outcome = blocking(move || {
-        processing::process_run(
-            &vessel.profile,
-            &files,
-            &meta,
-            &priors,
-            planned.as_ref(),
-            &grid,
-        )
-    })
-    .await?;
+    let outcome = crate::intake::process(&s.db, &s.blobs, &run, meta, priors).await?;
     let done = outcome.map_err(|e| {
         let field = match e.file.as_str() {
             "meta.clock_offset_s" => "clock_offset_s".to_string(),

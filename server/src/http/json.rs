@@ -31,7 +31,7 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for ApiJson<T> {
         }
         let bytes = Bytes::from_request(req, state).await.map_err(|e| {
             if e.status() == axum::http::StatusCode::PAYLOAD_TOO_LARGE {
-                ApiError::TooLarge(format!("JSON bodies are limited to {MAX_JSON_BODY} bytes"))
+                ApiError::too_large("the JSON body", MAX_JSON_BODY as u64, "")
             } else {
                 ApiError::BadRequest {
                     message: format!("could not read the request body: {e}"),

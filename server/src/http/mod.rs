@@ -7,6 +7,7 @@ pub mod campaigns;
 pub mod clock_offsets;
 pub mod discrepancies;
 pub mod export;
+pub mod exposure;
 pub mod health;
 pub mod jobs;
 pub mod json;
@@ -18,12 +19,12 @@ pub mod runs;
 pub mod vessels;
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use axum::Router;
 use axum::extract::DefaultBodyLimit;
 use axum::http::{Method, Uri};
 use tower_http::compression::CompressionLayer;
-use tower_http::services::ServeDir;
 use tower_http::trace::TraceLayer;
 use utoipa::OpenApi;
 use utoipa_axum::router::OpenApiRouter;
@@ -33,6 +34,7 @@ use crate::error::{ApiError, ErrorBody};
 use crate::jobs::{JobContext, JobEvent, JobRegistry, Jobs, JobsConfig};
 use crate::storage::Db;
 use crate::storage::blobs::BlobStore;
+use exposure::Exposure;
 
 /// Shared state of the handlers.
 #[derive(Clone)]
@@ -45,6 +47,8 @@ pub struct AppState {
     pub max_upload_bytes: u64,
     /// Background jobs: the registered kinds, the running ones, the runner's signals.
     pub jobs: Jobs,
+    /// Host allow-list and allowed origins (default: local names only).
+    pub exposure: Arc<Exposure>,
 }
 
 impl AppState {
@@ -68,6 +72,7 @@ impl AppState {
             blobs: BlobStore::open(blob_dir)?,
             max_upload_bytes,
             jobs,
+            exposure: Arc::new(Exposure::default()),
         })
     }
 
@@ -162,19 +167,25 @@ async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
     ))
 }
 
-/// The whole application: `/api`, and the web UI from `web_dir`
-/// (uPlot from `web_dir/node_modules`, installed by `npm ci`).
+/// The whole application: `/api`, and the web UI's files from `web_dir`
+/// (uPlot from `web_dir/node_modules`, installed by `npm ci`), behind the
+/// Host allow-list, the Origin rule on writes and the security headers
+/// ([`exposure`]).
 pub fn app(state: AppState, web_dir: PathBuf) -> Router {
     let (api, _) = api().split_for_parts();
     let api = api
         .route("/api/{*rest}", axum::routing::any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
         .layer(DefaultBodyLimit::max(json::MAX_JSON_BODY));
-    api.fallback_service(ServeDir::new(web_dir).append_index_html_on_directories(true))
-        // Quality reports run to megabytes of JSON; ships share satellite links.
-        .layer(CompressionLayer::new())
-        .layer(TraceLayer::new_for_http())
-        .with_state(state)
+    let guard = axum::middleware::from_fn_with_state(state.exposure.clone(), exposure::guard);
+    api.fallback(move |uri: Uri, req: axum::extract::Request| {
+        exposure::web_asset(web_dir.clone(), uri, req)
+    })
+    // Quality reports run to megabytes of JSON; ships share satellite links.
+    .layer(CompressionLayer::new())
+    .layer(guard)
+    .layer(TraceLayer::new_for_http())
+    .with_state(state)
 }
 
 /// Maps a missing row to a 404 naming what was looked for.

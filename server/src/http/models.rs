@@ -137,7 +137,7 @@ fn attachment(body: String, content_type: &str, filename: String) -> Response {
             (header::CONTENT_TYPE, content_type.to_string()),
             (
                 header::CONTENT_DISPOSITION,
-                format!("attachment; filename=\"{filename}\""),
+                super::exposure::attachment(&filename),
             ),
         ],
         body,

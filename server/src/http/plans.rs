@@ -178,7 +178,7 @@ pub async fn schedule_csv(
             (header::CONTENT_TYPE, "text/csv; charset=utf-8".to_string()),
             (
                 header::CONTENT_DISPOSITION,
-                format!("attachment; filename=\"{filename}\""),
+                super::exposure::attachment(&filename),
             ),
         ],
         body,

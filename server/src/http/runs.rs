@@ -11,16 +11,16 @@ use serde::Deserialize;
 
 use super::json::parse_json;
 use super::run_description::{DescriptionChange, from_value};
-use super::{AppState, blocking, found};
-use seatrial_core::alignment::{OffsetPriors, check_user_offset};
+use super::{AppState, found};
+use seatrial_core::alignment::check_user_offset;
 
-use crate::clock::CampaignClocks;
 use crate::coverage::{self, Coverage};
 use crate::error::{ApiError, ApiResult, ErrorBody};
-use crate::processing::{self, RunMeta};
+use crate::intake;
+use crate::processing::RunMeta;
 use crate::storage::blobs::BlobWriter;
-use crate::storage::runs::{self, NewFile, Outcome, Run};
-use crate::storage::{campaigns, clock_offsets, plans, vessels};
+use crate::storage::runs::{self, NewFile, Run};
+use crate::storage::{campaigns, plans, vessels};
 
 /// The multipart form of an upload (documentation of the parts).
 #[derive(Debug, utoipa::ToSchema)]
@@ -46,10 +46,11 @@ const FILE_ROLES: [&str; 3] = ["file", "control", "nav"];
 const MAX_META_BYTES: usize = 64 * 1024;
 
 fn too_large(limit: u64) -> ApiError {
-    ApiError::TooLarge(format!(
-        "the upload exceeds the limit of {} MB (server flag --max-upload-mb)",
-        limit / (1024 * 1024)
-    ))
+    ApiError::too_large(
+        "the upload",
+        limit,
+        " (all files of a run together; server flag --max-upload-mb)",
+    )
 }
 
 async fn stream_field(
@@ -78,6 +79,20 @@ async fn stream_field(
             .await
             .map_err(|e| ApiError::Internal(anyhow::anyhow!("writing the upload: {e}")))?;
     }
+}
+
+/// A run named after its file: control characters escaped, at most
+/// [`seatrial_core::planning::MAX_NAME_LEN`] bytes.
+fn run_name_of_file(filename: &str) -> String {
+    let mut name = seatrial_core::numbers::escape_controls(filename);
+    if name.len() > seatrial_core::planning::MAX_NAME_LEN {
+        let mut end = seatrial_core::planning::MAX_NAME_LEN;
+        while !name.is_char_boundary(end) {
+            end -= 1;
+        }
+        name.truncate(end);
+    }
+    name
 }
 
 /// Upload a run: `multipart/form-data` with an optional `meta` part (JSON)
@@ -153,6 +168,13 @@ pub async fn upload_run(
                 other => other,
             })?;
             meta = from_value(v, "meta.")?;
+            if let Some(n) = &meta.name {
+                seatrial_core::planning::check_name("meta.name", n)?;
+            }
+            if let Some(r) = meta.rate_hz {
+                seatrial_core::logs::check_rate_hz(r)
+                    .map_err(|m| ApiError::invalid("meta.rate_hz", m))?;
+            }
             // Checked at once: a `meta` sent before the files refuses the
             // upload before any byte is stored.
             DescriptionChange::of_meta(&meta).apply(&mut user, &vessel.profile, "meta.")?;
@@ -240,7 +262,8 @@ pub async fn upload_run(
         .name
         .clone()
         .or_else(|| planned.as_ref().map(|(e, _)| e.experiment.code.clone()))
-        .unwrap_or_else(|| files[0].filename.clone());
+        .unwrap_or_else(|| run_name_of_file(&files[0].filename));
+    let upload_meta = serde_json::to_value(&meta).map_err(anyhow::Error::from)?;
     let run = runs::insert(
         &s.db,
         &campaign.id,
@@ -249,56 +272,18 @@ pub async fn upload_run(
         layout,
         &files,
         &user,
+        &upload_meta,
     )
     .await?;
-
-    let inputs: Vec<(String, std::path::PathBuf)> = files
-        .iter()
-        .map(|f| (f.role.clone(), s.blobs.path(&f.blob.sha256)))
-        .collect();
-    let priors = OffsetPriors {
-        user_run_s: meta.clock_offset_s,
-        ..CampaignClocks::load(&s.db, &campaign.id)
-            .await?
-            .priors_for(None)
-    };
-    let user_offset = meta.clock_offset_s;
-    let grid = campaign.grid_speeds_mps.clone();
-    let outcome = blocking(move || {
-        processing::process_run(
-            &vessel.profile,
-            &inputs,
-            &meta,
-            &priors,
-            planned.as_ref(),
-            &grid,
-        )
-    })
-    .await?;
-    match outcome {
-        Ok(done) => {
-            if user_offset.is_some() {
-                clock_offsets::set_run_offset(&s.db, &run.id, user_offset).await?;
-            }
-            runs::finish(&s.db, &run.id, "accepted", done.outcome()).await?;
-            let run = found(runs::get(&s.db, &run.id).await?, "run", &run.id)?;
-            Ok((StatusCode::CREATED, Json(run)))
-        }
-        Err(e) => {
-            let detail = serde_json::to_value(&e).map_err(anyhow::Error::from)?;
-            let out = Outcome {
-                error: Some(&detail),
-                ..Outcome::default()
-            };
-            runs::finish(&s.db, &run.id, "rejected", out).await?;
-            Err(ApiError::InvalidUpload {
-                message: e.message,
-                field: e.file,
-                line: e.line,
-                column: e.column,
-                run_id: run.id,
-            })
-        }
+    match intake::process_stored(&s.db, &s.blobs, &run.id).await? {
+        Ok(run) => Ok((StatusCode::CREATED, Json(run))),
+        Err(e) => Err(ApiError::InvalidUpload {
+            message: e.message,
+            field: e.file,
+            line: e.line,
+            column: e.column,
+            run_id: run.id,
+        }),
     }
 }
 
@@ -364,10 +349,7 @@ pub async fn raw_run(
         .await
         .map_err(|e| ApiError::Internal(anyhow::anyhow!("blob {} unreadable: {e}", f.sha256)))?;
     let body = Body::from_stream(tokio_util::io::ReaderStream::new(file));
-    let disposition = format!(
-        "attachment; filename=\"{}\"",
-        f.filename.replace(['"', '\\', '\r', '\n'], "_")
-    );
+    let disposition = super::exposure::attachment(&f.filename);
     Ok((
         [
             (header::CONTENT_TYPE, "text/csv".to_string()),

@@ -8,6 +8,7 @@ use std::sync::atomic::Ordering;
 use std::time::Duration;
 
 use tokio::sync::{Notify, watch};
+use tokio_util::sync::CancellationToken;
 
 use super::progress::{JobEvent, StopFlags};
 use crate::storage::Db;
@@ -28,6 +29,9 @@ pub struct Beat {
     pub every: Duration,
     /// Lease granted at each beat.
     pub lease: Duration,
+    /// The server's stop: no lease is renewed after it (the job is queued
+    /// again by the graceful shutdown, or recovered after the lease).
+    pub stop: CancellationToken,
 }
 
 /// Runs until dropped (the runner drops it when the computation returns).
@@ -43,6 +47,7 @@ pub async fn run(
         worker,
         every,
         lease,
+        stop,
     } = beat;
     let mut tick = tokio::time::interval(every);
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
@@ -50,6 +55,10 @@ pub async fn run(
         tokio::select! {
             _ = tick.tick() => {}
             () = stage_changed.notified() => {}
+            () = stop.cancelled() => return std::future::pending().await,
+        }
+        if stop.is_cancelled() {
+            return std::future::pending().await;
         }
         let e = events.borrow().clone();
         match jobs::heartbeat(&db, &id, &worker, e.progress, &e.stage, lease).await {

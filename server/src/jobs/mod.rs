@@ -95,12 +95,13 @@
 //! # Restarts
 //!
 //! A job survives the server: a row left `running` by a server that died
-//! (or was stopped) is queued again once its lease expires — it restarts
-//! from the beginning, which its `stage` says, and counts one more attempt —
-//! or becomes `interrupted` when its attempts are used up; `retry` queues it
-//! again. A graceful shutdown neither cancels nor fails running jobs: it
-//! stops claiming, lets the computations unwind, records nothing and ends
-//! their leases at once, so the next start re-queues them without waiting.
+//! is queued again once its lease expires — it restarts from the beginning,
+//! which its `stage` says, and counts one more attempt — or becomes
+//! `interrupted` when its attempts are used up; `retry` queues it again. A
+//! graceful shutdown neither cancels nor fails running jobs and spends no
+//! attempt: it stops claiming and renewing leases, lets the computations
+//! unwind, and queues their jobs again at once with the attempt given back
+//! and no lease, so the next start claims them without waiting.
 
 pub mod discover;
 pub mod events;

@@ -73,11 +73,13 @@ pub async fn start(jobs: Jobs, cx: JobContext) -> anyhow::Result<RunnerHandle> {
 }
 
 impl RunnerHandle {
-    /// Graceful stop (SIGTERM, Ctrl-C): stop claiming; running computations
-    /// unwind at their next progress report and record nothing — the job is
-    /// not cancelled (nobody asked) nor failed — and their leases end now, so
-    /// the next start re-queues them at once (from the beginning, one attempt
-    /// more). Waits up to `grace` for the computations to return.
+    /// Graceful stop (SIGTERM, Ctrl-C): stop claiming and renewing leases;
+    /// running computations unwind at their next progress report and
+    /// record nothing — the job is not cancelled (nobody asked) nor failed.
+    /// Waits up to `grace` for them, then queues their jobs again with the
+    /// attempt given back and the lease released, so the next start (or
+    /// another server) claims them at once. A computation that finished
+    /// within `grace` keeps its result.
     pub async fn shutdown(mut self, grace: Duration) {
         self.jobs.shutdown_token().cancel();
         let wait = async {
@@ -87,14 +89,21 @@ impl RunnerHandle {
         };
         if tokio::time::timeout(grace, wait).await.is_err() {
             tracing::warn!(
-                "a computation did not stop within {grace:?}; its job is left for recovery"
+                "a computation did not stop within {grace:?}; its job is queued again anyway"
             );
         }
         for w in &self.workers {
-            match jobs::release(&self.cx.db, w).await {
-                Ok(0) => {}
-                Ok(n) => tracing::info!(worker = %w, jobs = n, "left running jobs for recovery"),
-                Err(e) => tracing::warn!(worker = %w, error = %e, "could not release leases"),
+            match jobs::requeue_at_shutdown(&self.cx.db, w).await {
+                Ok(r) if r == jobs::Shutdown::default() => {}
+                Ok(r) => tracing::info!(
+                    worker = %w,
+                    requeued = r.requeued,
+                    cancelled = r.cancelled,
+                    "queued running jobs again for the next start"
+                ),
+                Err(e) => {
+                    tracing::warn!(worker = %w, error = %e, "could not queue running jobs again")
+                }
             }
         }
     }
@@ -228,6 +237,7 @@ async fn run_one(w: &Worker, job: Job) {
             worker: w.id.clone(),
             every: cfg.heartbeat,
             lease: cfg.lease,
+            stop: w.jobs.shutdown_token().clone(),
         },
         rx,
         flags.clone(),
@@ -246,7 +256,9 @@ async fn run_one(w: &Worker, job: Job) {
                 events.send_replace(JobEvent::from(&done));
             }
         }
-        Ok(false) => tracing::info!(job = %id, "job left for recovery (shutdown or lease lost)"),
+        Ok(false) => {
+            tracing::info!(job = %id, "job not recorded (shutdown: queued again; or lease lost)")
+        }
         // The row stays `running`; its lease expires and recovery re-queues it.
         Err(e) => tracing::error!(job = %id, error = %e, "recording the end of a job failed"),
     }

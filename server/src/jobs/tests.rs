@@ -1,6 +1,6 @@
 //! The runner end to end on a real database: the handler's writes commit
 //! with the job's end or not at all; panics fail the job; a graceful
-//! shutdown records nothing and leaves the job to recovery.
+//! shutdown records nothing and queues the job again, no attempt spent.
 
 use std::time::Duration;
 
@@ -79,7 +79,14 @@ async fn setup() -> (tempfile::TempDir, Jobs, JobContext, RunnerHandle) {
         db,
         blobs: crate::storage::blobs::BlobStore::open(&dir.path().join("blobs")).unwrap(),
     };
-    let jobs = Jobs::new(
+    let jobs = writer_jobs();
+    let runner = start(jobs.clone(), cx.clone()).await.unwrap();
+    (dir, jobs, cx, runner)
+}
+
+/// The `write` kind on one worker, 5 s leases, 50 ms heartbeats, 3 attempts.
+fn writer_jobs() -> Jobs {
+    Jobs::new(
         JobRegistry::new().with("write", Writer),
         JobsConfig {
             workers: 1,
@@ -88,9 +95,7 @@ async fn setup() -> (tempfile::TempDir, Jobs, JobContext, RunnerHandle) {
             max_attempts: 3,
             poll: Duration::from_millis(50),
         },
-    );
-    let runner = start(jobs.clone(), cx.clone()).await.unwrap();
-    (dir, jobs, cx, runner)
+    )
 }
 
 async fn submit_settings(jobs: &Jobs, cx: &JobContext, settings: serde_json::Value) -> Job {
@@ -159,27 +164,71 @@ async fn a_panicking_computation_fails_its_job_and_the_worker_goes_on() {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn graceful_shutdown_records_nothing_and_recovery_requeues_at_once() {
+async fn graceful_shutdown_requeues_at_once_and_spends_no_attempt() {
     let (_d, jobs, cx, runner) = setup().await;
-    let j = submit_settings(&jobs, &cx, json!({ "sha": "s", "wait_ms": 20_000 })).await;
+    let j = submit_settings(&jobs, &cx, json!({ "sha": "s", "wait_ms": 5_000 })).await;
+    let mut runner = runner;
+    // Three graceful restarts while the job runs (max_attempts is 3): it is
+    // never `interrupted` and never waits for a lease.
+    for restart in 1..=3 {
+        let running = wait_until(&cx, &j.id, |j| {
+            j.state == JobState::Running && j.progress > 0.0
+        })
+        .await;
+        assert_eq!(
+            running.attempts, 1,
+            "restart {restart}: one attempt, the current one"
+        );
+        runner.shutdown(Duration::from_secs(5)).await;
+        let left = stored::get(&cx.db, &j.id).await.unwrap().unwrap();
+        assert_eq!(
+            left.state,
+            JobState::Queued,
+            "restart {restart}: queued again at once"
+        );
+        assert_eq!(
+            left.attempts, 0,
+            "restart {restart}: the attempt is given back"
+        );
+        assert!(left.error.is_none() && left.finished_at.is_none());
+        assert!(left.stage.contains("queued again"), "{}", left.stage);
+        assert!(!blob_exists(&cx, "s").await);
+        // Nothing for recovery to do: no lease to wait for.
+        assert_eq!(
+            stored::recover(&cx.db).await.unwrap(),
+            stored::Recovered::default()
+        );
+        runner = restart_runner(&cx).await;
+    }
+    runner.abort();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_computation_that_ignores_the_stop_is_requeued_and_its_lease_not_renewed() {
+    let (_d, jobs, cx, runner) = setup().await;
+    // Progress reports 2 s apart: the stop is noticed long after the grace.
+    let j = submit_settings(&jobs, &cx, json!({ "sha": "slow", "wait_ms": 20_000 })).await;
     wait_until(&cx, &j.id, |j| {
         j.state == JobState::Running && j.progress > 0.0
     })
     .await;
-    runner.shutdown(Duration::from_secs(5)).await;
+    runner.shutdown(Duration::from_millis(100)).await;
     let left = stored::get(&cx.db, &j.id).await.unwrap().unwrap();
-    assert_eq!(
-        left.state,
-        JobState::Running,
-        "neither cancelled nor failed"
-    );
-    assert!(left.error.is_none() && left.finished_at.is_none());
-    assert!(!blob_exists(&cx, "s").await);
-    // The lease was ended: the next start's recovery takes it back at once.
-    let r = stored::recover(&cx.db).await.unwrap();
-    assert_eq!(r.requeued, 1);
-    assert_eq!(
-        stored::get(&cx.db, &j.id).await.unwrap().unwrap().state,
-        JobState::Queued
-    );
+    assert_eq!(left.state, JobState::Queued);
+    assert_eq!(left.attempts, 0);
+    // Heartbeats (every 50 ms) would have revived it by now.
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    let later = stored::get(&cx.db, &j.id).await.unwrap().unwrap();
+    assert_eq!(later.state, JobState::Queued);
+    assert_eq!(later.worker, None);
+    // The next start claims it at once.
+    let next = restart_runner(&cx).await;
+    let again = wait_until(&cx, &j.id, |j| j.state == JobState::Running).await;
+    assert_eq!(again.attempts, 1);
+    next.abort();
+}
+
+/// A new runner over the same database (the process restarted).
+async fn restart_runner(cx: &JobContext) -> RunnerHandle {
+    start(writer_jobs(), cx.clone()).await.unwrap()
 }

@@ -42,6 +42,20 @@ impl BlobStore {
         })
     }
 
+    /// Removes the partial uploads a stopped server left in `tmp/` (call
+    /// it before serving); how many.
+    pub fn sweep_tmp(&self) -> std::io::Result<usize> {
+        let mut n = 0;
+        for entry in std::fs::read_dir(self.dir.join("tmp"))? {
+            let entry = entry?;
+            if entry.file_type()?.is_file() {
+                std::fs::remove_file(entry.path())?;
+                n += 1;
+            }
+        }
+        Ok(n)
+    }
+
     /// Path of a blob.
     pub fn path(&self, sha256: &str) -> PathBuf {
         self.dir.join(sha256)

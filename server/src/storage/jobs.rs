@@ -560,19 +560,48 @@ pub async fn recover(db: &Db) -> anyhow::Result<Recovered> {
     })
 }
 
-/// Ends the leases of `worker`'s running jobs now, so that the next
-/// recovery (after a graceful shutdown: the next start) re-queues them at
-/// once instead of after the lease time. The state stays `running`.
-pub async fn release(db: &Db, worker: &str) -> anyhow::Result<u64> {
-    let past = timestamp(OffsetDateTime::now_utc() - time::Duration::seconds(1));
-    Ok(sqlx::query(
-        "UPDATE job SET lease_until = $1, updated_at = $1 WHERE worker = $2 AND state = 'running'",
+/// A graceful stop of `worker`: its running jobs are queued again at once
+/// with the attempt they were on given back (a restart is not a failure),
+/// their leases released (the next start, or another server, claims them
+/// now); a job whose cancel was asked for is cancelled.
+pub async fn requeue_at_shutdown(db: &Db, worker: &str) -> anyhow::Result<Shutdown> {
+    let now = stamp_now();
+    let mut tx = db.begin().await?;
+    let cancelled = sqlx::query(
+        "UPDATE job SET state = 'cancelled', stage = 'cancelled (the server stopped while it ran)', \
+         worker = NULL, lease_until = NULL, finished_at = $1, updated_at = $1 \
+         WHERE worker = $2 AND state = 'running' AND cancel_requested",
     )
-    .bind(&past)
+    .bind(&now)
     .bind(worker)
-    .execute(db)
+    .execute(&mut *tx)
     .await?
-    .rows_affected())
+    .rows_affected();
+    let requeued = sqlx::query(
+        "UPDATE job SET state = 'queued', progress = 0, attempts = CASE WHEN attempts > 0 THEN attempts - 1 ELSE 0 END, \
+         stage = 'queued again: the server was stopped while it ran; it restarts from the beginning', \
+         worker = NULL, lease_until = NULL, updated_at = $1 \
+         WHERE worker = $2 AND state = 'running'",
+    )
+    .bind(&now)
+    .bind(worker)
+    .execute(&mut *tx)
+    .await?
+    .rows_affected();
+    tx.commit().await?;
+    Ok(Shutdown {
+        requeued,
+        cancelled,
+    })
+}
+
+/// What [`requeue_at_shutdown`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Shutdown {
+    /// Jobs queued again, their attempt given back.
+    pub requeued: u64,
+    /// Jobs whose cancel had been asked for: cancelled.
+    pub cancelled: u64,
 }
 
 #[cfg(test)]

@@ -165,7 +165,9 @@ fn user_columns(
 }
 
 /// Records a run whose files are already stored, with what the supervisor
-/// said it is, in one transaction.
+/// said it is and the `meta` it was uploaded with (JSON, for processing),
+/// in one transaction.
+#[allow(clippy::too_many_arguments)]
 pub async fn insert(
     db: &Db,
     campaign_id: &str,
@@ -174,6 +176,7 @@ pub async fn insert(
     layout: &str,
     files: &[NewFile],
     user: &UserDescription,
+    upload_meta: &serde_json::Value,
 ) -> anyhow::Result<Run> {
     let id = new_id();
     let created_at = now();
@@ -181,8 +184,8 @@ pub async fn insert(
     let mut tx = db.begin().await?;
     sqlx::query(
         "INSERT INTO run (id, campaign_id, experiment_id, name, layout, status, created_at, \
-         role, grid_speed_mps, excited_dofs, signal, notes) \
-         VALUES ($1, $2, $3, $4, $5, 'stored', $6, $7, $8, $9, $10, $11)",
+         role, grid_speed_mps, excited_dofs, signal, notes, upload_meta) \
+         VALUES ($1, $2, $3, $4, $5, 'stored', $6, $7, $8, $9, $10, $11, $12)",
     )
     .bind(&id)
     .bind(campaign_id)
@@ -195,6 +198,7 @@ pub async fn insert(
     .bind(dofs)
     .bind(signal)
     .bind(&user.notes)
+    .bind(upload_meta.to_string())
     .execute(&mut *tx)
     .await?;
     for f in files {
@@ -356,6 +360,24 @@ pub async fn list(db: &Db, campaign_id: &str) -> anyhow::Result<Vec<Run>> {
         out.push(with_files(db, r).await?);
     }
     Ok(out)
+}
+
+/// The `meta` a run was uploaded with (JSON text), if recorded.
+pub async fn upload_meta(db: &Db, id: &str) -> anyhow::Result<Option<String>> {
+    let m: Option<Option<String>> = sqlx::query_scalar("SELECT upload_meta FROM run WHERE id = $1")
+        .bind(id)
+        .fetch_optional(db)
+        .await?;
+    Ok(m.flatten())
+}
+
+/// Runs still `stored` (never processed), oldest first.
+pub async fn stored_ids(db: &Db) -> anyhow::Result<Vec<String>> {
+    Ok(
+        sqlx::query_scalar("SELECT id FROM run WHERE status = 'stored' ORDER BY created_at, id")
+            .fetch_all(db)
+            .await?,
+    )
 }
 
 /// The stored quality report of a run (JSON text), if any.

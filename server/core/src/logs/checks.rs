@@ -2,10 +2,12 @@
 //! that carry no information. Warnings never reject a log; the supervisor
 //! decides. The rules:
 //!
-//! - **time in milliseconds**: the median interval of `t` exceeds
-//!   [`MS_MEDIAN_DT_S`] (5 s; loggers of ROVs and DP ships sample at 1 Hz or
-//!   faster), or `t` spans more than [`MS_SPAN_S`] (one day, longer than
-//!   any trial run) — a millisecond clock at 1 kHz trips the second rule;
+//! - **time in milliseconds**: the median interval of `t` (the sample
+//!   interval) exceeds [`MS_MEDIAN_DT_S`] (5 s; loggers of ROVs and DP ships
+//!   sample at 1 Hz or faster). The span of `t` is not a rule: a valid log
+//!   in seconds may last more than a day, and an epoch clock is large in
+//!   any unit. A millisecond clock at 200 Hz or faster (a step of 5 "s" or
+//!   less) passes unnoticed;
 //! - **roll in degrees**: max |`phi`| > π (+0.001 for rounding);
 //! - **pitch in degrees**: max |`theta`| > π/2 (+0.001): Euler pitch lies in
 //!   [−π/2, π/2];
@@ -28,8 +30,6 @@ use crate::timeseries::LogTable;
 
 /// Median time step (s) above which `t` is suspected to be in milliseconds.
 pub const MS_MEDIAN_DT_S: f64 = 5.0;
-/// Time span (s) above which `t` is suspected to be in milliseconds.
-pub const MS_SPAN_S: f64 = 86_400.0;
 /// Slack on the roll/pitch bounds for values rounded at ±π or ±π/2.
 const ANGLE_SLACK: f64 = 1e-3;
 /// Slack on the heading bounds (unwrapping overshoot).
@@ -111,18 +111,16 @@ pub fn plausibility_warnings(table: &LogTable) -> Vec<LogWarning> {
     out
 }
 
-/// The milliseconds warning on `t`, if either rule trips.
+/// The milliseconds warning on `t`, from its sample interval.
 fn time_warning(t: &[f64]) -> Option<LogWarning> {
     let dt = crate::timeseries::median_dt(t)?;
-    let span = t.last()? - t.first()?;
-    if dt > MS_MEDIAN_DT_S || span > MS_SPAN_S {
+    if dt > MS_MEDIAN_DT_S {
         Some(LogWarning::column(
             "t",
             format!(
-                "t looks like milliseconds (median step {}, span {}); the contract is seconds: \
-                 divide by 1000 if so",
-                short(dt),
-                short(span)
+                "t looks like milliseconds (median step {}: a logger samples at 1 Hz or faster); \
+                 the contract is seconds: divide by 1000 if so",
+                short(dt)
             ),
         ))
     } else {
@@ -139,10 +137,20 @@ fn min_max(x: &[f64]) -> Option<(f64, f64)> {
     )
 }
 
-/// A number with about four significant digits, without trailing zeros.
+/// A number with about four significant digits, without trailing zeros;
+/// outside 10⁻⁴ … 10⁶ in scientific notation (never 309 digits).
 pub(crate) fn short(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
+    }
+    if !(1e-4..1e6).contains(&x.abs()) {
+        let e = format!("{x:.3e}");
+        return match e.split_once('e') {
+            Some((m, exp)) if m.contains('.') => {
+                format!("{}e{exp}", m.trim_end_matches('0').trim_end_matches('.'))
+            }
+            _ => e,
+        };
     }
     let decimals = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
     let s = format!("{x:.decimals$}");
@@ -227,19 +235,21 @@ mod tests {
         assert_eq!(columns(&w), ["t", "u"]);
         assert!(
             w[0].message
-                .starts_with("t looks like milliseconds (median step 100,")
+                .starts_with("t looks like milliseconds (median step 100:")
         );
         assert_eq!(
             w[1].message,
             "u is constant (0) over the whole log: no excitation, or a dead sensor"
         );
-        // 1 kHz in ms over 2 minutes: the span rule.
-        let t: Vec<f64> = (0..120_001).map(|k| k as f64).collect();
+        // A valid 29-hour log in seconds at 1 Hz: no milliseconds warning
+        // (the span of t used to trip it).
+        let t: Vec<f64> = (0..29 * 3600).map(|k| k as f64).collect();
         let u: Vec<f64> = t.iter().map(|v| v.sin()).collect();
-        assert_eq!(
-            columns(&plausibility_warnings(&table(t, &[("u", u)]))),
-            ["t"]
-        );
+        assert!(plausibility_warnings(&table(t, &[("u", u)])).is_empty());
+        // Epoch seconds at 10 Hz: large t, small step: fine.
+        let t: Vec<f64> = (0..600).map(|k| 1.7e9 + k as f64 * 0.1).collect();
+        let u: Vec<f64> = t.iter().map(|v| v.sin()).collect();
+        assert!(plausibility_warnings(&table(t, &[("u", u)])).is_empty());
         // 1 Hz DP log of an hour: fine.
         let t: Vec<f64> = (0..3600).map(|k| k as f64).collect();
         let u: Vec<f64> = t.iter().map(|v| v.sin()).collect();
@@ -253,5 +263,8 @@ mod tests {
         assert_eq!(short(100.0), "100");
         assert_eq!(short(-12.3456), "-12.35");
         assert_eq!(short(123_456.0), "123456");
+        assert_eq!(short(1e308), "1e308");
+        assert_eq!(short(-2.5e-7), "-2.5e-7");
+        assert_eq!(short(1_234_567.0), "1.235e6");
     }
 }

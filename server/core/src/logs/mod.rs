@@ -43,6 +43,6 @@ pub mod uniform;
 pub use checks::LogWarning;
 pub use error::{LogError, LogErrorKind};
 pub use gaps::{Gap, MAX_BRIDGE_SAMPLES};
-pub use parse::{DEFAULT_MAX_ROWS, ParseOptions, ParsedLog, parse_log};
+pub use parse::{DEFAULT_MAX_COLUMNS, DEFAULT_MAX_ROWS, ParseOptions, ParsedLog, parse_log};
 pub use schema::{LogRole, input_columns, output_columns, pose_columns, required_columns};
-pub use uniform::{to_uniform, zoh};
+pub use uniform::{MAX_RATE_HZ, MIN_RATE_HZ, check_rate_hz, to_uniform, zoh};

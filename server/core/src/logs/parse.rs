@@ -1,7 +1,7 @@
 //! Reading one CSV log into a [`LogTable`], with the first defect reported at
 //! its exact line and column.
 //!
-//! Accepted: a UTF-8 BOM, `\n` or `\r\n` line ends, blank lines (also
+//! Accepted: a UTF-8 BOM, `\n`, `\r\n` or bare `\r` (old Mac) line ends, blank lines (also
 //! trailing), spaces around names and numbers, quoted fields, columns in any
 //! order. The header is the first non-blank line. Every column named in
 //! [`ParseOptions::required`] (and `t`) must be present and hold a finite
@@ -20,11 +20,18 @@ use super::checks::{LogWarning, plausibility_warnings};
 use super::error::{LogError, LogErrorKind};
 use super::gaps::{Gap, find_gaps};
 use super::schema::{LogRole, TIME_COLUMN, describe_vessel, required_columns};
+use crate::numbers::{echoed, escape_controls};
 use crate::planning::vessel::VesselProfile;
 use crate::timeseries::LogTable;
 
 /// Default limit on data rows (a 10 Hz log of almost 58 days).
 pub const DEFAULT_MAX_ROWS: usize = 50_000_000;
+
+/// Default limit on header columns; a wider header is [`LogErrorKind::TooLarge`].
+pub const DEFAULT_MAX_COLUMNS: usize = 10_000;
+
+/// Ignored columns warned about one by one; the rest in one warning.
+pub const MAX_COLUMN_WARNINGS: usize = 20;
 
 /// How to read one log.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,6 +43,8 @@ pub struct ParseOptions {
     pub required: Vec<String>,
     /// More data rows than this is [`LogErrorKind::TooLarge`].
     pub max_rows: usize,
+    /// More header columns than this is [`LogErrorKind::TooLarge`].
+    pub max_columns: usize,
     /// Who needs the required columns, for the missing-columns message, e.g.
     /// `the 6-DOF ROV 'Surveyor ROV'`.
     pub needed_by: Option<String>,
@@ -48,6 +57,7 @@ impl ParseOptions {
             file: file.into(),
             required,
             max_rows: DEFAULT_MAX_ROWS,
+            max_columns: DEFAULT_MAX_COLUMNS,
             needed_by: None,
         }
     }
@@ -89,7 +99,9 @@ pub struct ParsedLog {
 /// `WrongDelimiter`, `DuplicateColumn`, `MissingColumns` (all listed),
 /// `RaggedRow`, `NotNumeric` (text or an empty cell in a required column),
 /// `NonFinite`, `NonMonotonicTime`, `DuplicateTime`, `TooFewRows` (fewer
-/// than 2 data rows), `TooLarge` (more than `max_rows`), `Io`.
+/// than 2 data rows), `TooLarge` (more than `max_rows` rows or
+/// `max_columns` columns), `Io`. Header checks cost time linear in the
+/// number of columns.
 pub fn parse_log<R: Read>(reader: R, opts: &ParseOptions) -> Result<ParsedLog, LogError> {
     let file = opts.file.as_str();
     let mut rdr = ReaderBuilder::new()
@@ -112,9 +124,22 @@ pub fn parse_log<R: Read>(reader: R, opts: &ParseOptions) -> Result<ParsedLog, L
             break record_line(&rdr);
         }
     };
+    if rec.len() > opts.max_columns {
+        return Err(LogError::new(
+            file,
+            LogErrorKind::TooLarge,
+            format!(
+                "the header has {} columns, more than the limit of {}",
+                rec.len(),
+                opts.max_columns
+            ),
+        )
+        .at_line(header_line));
+    }
+    // Names are shown in messages and summaries: control characters escaped.
     let names: Vec<String> = rec
         .iter()
-        .map(|b| String::from_utf8_lossy(trim(b)).into_owned())
+        .map(|b| escape_controls(&String::from_utf8_lossy(trim(b))))
         .collect();
     check_header(&names, &rec, header_line, opts)?;
 
@@ -125,11 +150,13 @@ pub fn parse_log<R: Read>(reader: R, opts: &ParseOptions) -> Result<ParsedLog, L
                 .at_line(header_line),
         );
     };
+    let required: std::collections::HashSet<&str> =
+        opts.required.iter().map(String::as_str).collect();
     let mut cols: Vec<Column> = names
         .iter()
         .enumerate()
         .map(|(i, n)| Column {
-            required: i == t_index || opts.required.contains(n),
+            required: i == t_index || required.contains(n.as_str()),
             alive: !n.is_empty(),
             data: Vec::new(),
             dropped: if n.is_empty() {
@@ -197,14 +224,17 @@ pub fn parse_log<R: Read>(reader: R, opts: &ParseOptions) -> Result<ParsedLog, L
                 (
                     LogErrorKind::DuplicateTime,
                     format!(
-                        "t = {t} repeats the previous time stamp (time must strictly increase)"
+                        "t = {} repeats the previous time stamp (time must strictly increase)",
+                        echoed(t)
                     ),
                 )
             } else {
                 (
                     LogErrorKind::NonMonotonicTime,
                     format!(
-                        "t = {t} is not after the previous {prev_t} (time must strictly increase)"
+                        "t = {} is not after the previous {} (time must strictly increase)",
+                        echoed(t),
+                        echoed(prev_t)
                     ),
                 )
             };
@@ -245,13 +275,25 @@ pub fn parse_log<R: Read>(reader: R, opts: &ParseOptions) -> Result<ParsedLog, L
             } else {
                 name
             };
-            let why = col.dropped.unwrap_or_default();
-            warnings.push(LogWarning::column(
-                shown.as_str(),
-                format!("{shown} is ignored: {why}"),
-            ));
+            if ignored_columns.len() < MAX_COLUMN_WARNINGS {
+                let why = col.dropped.unwrap_or_default();
+                warnings.push(LogWarning::column(
+                    shown.as_str(),
+                    format!("{shown} is ignored: {why}"),
+                ));
+            }
             ignored_columns.push(shown);
         }
+    }
+    if ignored_columns.len() > MAX_COLUMN_WARNINGS {
+        warnings.push(LogWarning {
+            column: None,
+            message: format!(
+                "… and {} more columns are ignored (unnamed or not fully numeric; all are listed \
+                 in the ignored columns)",
+                ignored_columns.len() - MAX_COLUMN_WARNINGS
+            ),
+        });
     }
     warnings.extend(plausibility_warnings(&table));
     let gaps = table
@@ -300,18 +342,20 @@ fn check_header(
             .at_line(line));
         }
     }
-    for (i, n) in names.iter().enumerate() {
+    let mut first_at: std::collections::HashMap<&str, usize> =
+        std::collections::HashMap::with_capacity(names.len());
+    for (k, n) in names.iter().enumerate() {
         if n.is_empty() {
             continue;
         }
-        if let Some(j) = names[i + 1..].iter().position(|m| m == n) {
+        if let Some(i) = first_at.insert(n.as_str(), k) {
             return Err(LogError::new(
                 file,
                 LogErrorKind::DuplicateColumn,
                 format!(
                     "column {n} appears twice in the header (columns {} and {})",
                     i + 1,
-                    i + j + 2
+                    k + 1
                 ),
             )
             .at_line(line)
@@ -327,7 +371,7 @@ fn check_header(
     let missing: Vec<&str> = wanted
         .iter()
         .copied()
-        .filter(|w| !names.iter().any(|n| n == w))
+        .filter(|w| !first_at.contains_key(w))
         .collect();
     if missing.is_empty() {
         return Ok(());
@@ -454,7 +498,7 @@ fn cell_error(file: &str, line: u64, column: &str, cell: &[u8], bad: BadCell) ->
 /// A cell in quotes for messages, shortened to 40 characters.
 fn quote(cell: &[u8]) -> String {
     let s = String::from_utf8_lossy(trim(cell));
-    let mut out: String = s.chars().take(40).collect();
+    let mut out: String = escape_controls(&s.chars().take(40).collect::<String>());
     if s.chars().count() > 40 {
         out.push('…');
     }
@@ -502,12 +546,18 @@ fn record_line<R: Read>(rdr: &csv::Reader<Tracked<R>>) -> u64 {
 }
 
 /// A reader that remembers how many bytes it gave, the last one, and whether
-/// it reached the end: enough to tell an unterminated last line.
+/// it reached the end: enough to tell an unterminated last line. It also
+/// turns a bare `\r` (old Mac line end) into `\n`, so such a file reads as
+/// lines, not as one header of every value; `\r\n` passes unchanged (the
+/// `\r` is trimmed with the last field).
 struct Tracked<R> {
     inner: R,
     total: u64,
     last: Option<u8>,
     eof: bool,
+    /// The previous chunk ended in a `\r`, given as `\n`: a `\n` opening
+    /// the next chunk belongs to it and is dropped.
+    cr_pending: bool,
 }
 
 impl<R> Tracked<R> {
@@ -517,20 +567,42 @@ impl<R> Tracked<R> {
             total: 0,
             last: None,
             eof: false,
+            cr_pending: false,
         }
     }
 }
 
 impl<R: Read> Read for Tracked<R> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        let n = self.inner.read(buf)?;
-        if n == 0 {
-            self.eof |= !buf.is_empty();
-        } else if let Some(&b) = buf.get(n - 1) {
+        loop {
+            let mut n = self.inner.read(buf)?;
+            if n == 0 {
+                self.eof |= !buf.is_empty();
+                return Ok(0);
+            }
+            if std::mem::take(&mut self.cr_pending) && buf[0] == b'\n' {
+                buf.copy_within(1..n, 0);
+                n -= 1;
+                if n == 0 {
+                    continue;
+                }
+            }
+            for i in 0..n {
+                if buf[i] == b'\r' {
+                    match buf[..n].get(i + 1) {
+                        Some(b'\n') => {}
+                        Some(_) => buf[i] = b'\n',
+                        None => {
+                            buf[i] = b'\n';
+                            self.cr_pending = true;
+                        }
+                    }
+                }
+            }
             self.total += n as u64;
-            self.last = Some(b);
+            self.last = Some(buf[n - 1]);
+            return Ok(n);
         }
-        Ok(n)
     }
 }
 
@@ -643,6 +715,112 @@ mod tests {
         assert!(err("t|u\n0|1\n", &["u"]).message.contains("uses '|'"));
         // A lone column without separators is a missing-columns error.
         assert_eq!(err("t\n0\n1\n", &["u"]).kind, LogErrorKind::MissingColumns);
+    }
+
+    /// A reader giving `chunk` bytes at a time (chunk boundaries anywhere).
+    struct Chunked<'a>(&'a [u8], usize);
+
+    impl Read for Chunked<'_> {
+        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            let n = self.1.min(buf.len()).min(self.0.len());
+            buf[..n].copy_from_slice(&self.0[..n]);
+            self.0 = &self.0[n..];
+            Ok(n)
+        }
+    }
+
+    #[test]
+    fn bare_cr_line_ends_read_like_lf_at_any_chunk_boundary() {
+        let lf = parse("t,u\n0,1\n0.1,2\n0.2,3\n", &["u"]).unwrap();
+        for csv in [
+            "t,u\r0,1\r0.1,2\r0.2,3\r",
+            "t,u\r\n0,1\r\n0.1,2\r\n0.2,3\r\n",
+            "t,u\r0,1\r\n0.1,2\n0.2,3",
+        ] {
+            for chunk in [1, 2, 3, 7, 1 << 16] {
+                let p = parse_log(Chunked(csv.as_bytes(), chunk), &opts(&["u"]))
+                    .unwrap_or_else(|e| panic!("{csv:?} by {chunk}: {e}"));
+                assert_eq!(p.table, lf.table, "{csv:?} by {chunk}");
+            }
+        }
+        // Line numbers count CR line ends.
+        let e = err("t,u\r0,1\r0.1,x\r0.2,3\r", &["u"]);
+        assert_eq!(at(&e), (LogErrorKind::NotNumeric, Some(3), Some("u")));
+        // The old report: the whole file as one header of numbers.
+        let old_mac = "t,u,v\r-35496.16,1,2\r-35496.06,1,2\r-35495.96,1,2\r";
+        let p = parse(old_mac, &["u"]).unwrap();
+        assert_eq!(p.rows, 3);
+    }
+
+    #[test]
+    fn a_wide_header_is_refused_naming_the_limit_and_read_in_linear_time() {
+        let n = 100_000;
+        let header: Vec<String> = (0..n)
+            .map(|i| if i == 0 { "t".into() } else { format!("c{i}") })
+            .collect();
+        let row = vec!["1"; n].join(",");
+        let csv = format!("{}\n{row}\n{}\n", header.join(","), vec!["2"; n].join(","));
+        let e = err(&csv, &[]);
+        assert_eq!(e.kind, LogErrorKind::TooLarge);
+        assert_eq!(
+            e.message,
+            "the header has 100000 columns, more than the limit of 10000"
+        );
+        // Allowed that wide, it reads in well under a second (quadratic
+        // duplicate detection took 8 s).
+        let wide = ParseOptions {
+            max_columns: 200_000,
+            ..opts(&[])
+        };
+        let started = std::time::Instant::now();
+        let p = parse_log(csv.as_bytes(), &wide).unwrap();
+        assert_eq!(p.table.names.len(), n - 1);
+        assert!(
+            started.elapsed().as_secs_f64() < 3.0,
+            "{:?}",
+            started.elapsed()
+        );
+        // A duplicate at the far end is still found.
+        let dup = format!("{},c1\n", header.join(","));
+        let started = std::time::Instant::now();
+        let e = parse_log(dup.as_bytes(), &wide).unwrap_err();
+        assert!(started.elapsed().as_secs_f64() < 3.0);
+        assert_eq!(
+            e.message,
+            "column c1 appears twice in the header (columns 2 and 100001)"
+        );
+    }
+
+    #[test]
+    fn ignored_column_warnings_are_bounded() {
+        let names: Vec<String> = (0..50).map(|i| format!("note{i}")).collect();
+        let cells = vec!["x"; 50].join(",");
+        let csv = format!("t,u,{}\n0,1,{cells}\n0.1,2,{cells}\n", names.join(","));
+        let p = parse(&csv, &["u"]).unwrap();
+        assert_eq!(p.ignored_columns.len(), 50);
+        let ignored: Vec<&LogWarning> = p
+            .warnings
+            .iter()
+            .filter(|w| w.message.contains("ignored"))
+            .collect();
+        assert_eq!(ignored.len(), MAX_COLUMN_WARNINGS + 1);
+        assert_eq!(
+            ignored[MAX_COLUMN_WARNINGS].message,
+            "… and 30 more columns are ignored (unnamed or not fully numeric; all are listed in the ignored columns)"
+        );
+    }
+
+    #[test]
+    fn control_characters_and_long_numbers_are_not_echoed_raw() {
+        let e = err("t,u\n0,1\n0.1,\u{1b}[31mred\n", &["u"]);
+        assert_eq!(e.message, "'\\u{1b}[31mred' is not a number");
+        let e = err("t,u\n1e300,1\n1e299,2\n", &["u"]);
+        assert_eq!(
+            e.message,
+            "t = 1e299 is not after the previous 1e300 (time must strictly increase)"
+        );
+        let p = parse("t,u,a\u{7}b\n0,1,x\n0.1,2,y\n", &["u"]).unwrap();
+        assert_eq!(p.ignored_columns, ["a\\u{7}b"]);
     }
 
     #[test]

@@ -46,6 +46,24 @@ pub fn nominal_rate(median_dt: f64) -> f64 {
     }
 }
 
+/// Lowest resampling rate that can be requested (Hz): one sample per 100 s.
+pub const MIN_RATE_HZ: f64 = 0.01;
+/// Highest resampling rate that can be requested (Hz).
+pub const MAX_RATE_HZ: f64 = 1000.0;
+
+/// Checks a requested resampling rate: finite and within
+/// [`MIN_RATE_HZ`] … [`MAX_RATE_HZ`]; the reason, without the field name.
+pub fn check_rate_hz(rate_hz: f64) -> Result<(), String> {
+    if rate_hz.is_finite() && (MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate_hz) {
+        Ok(())
+    } else {
+        Err(format!(
+            "the resampling rate must be between {MIN_RATE_HZ} and {MAX_RATE_HZ} Hz (got {})",
+            crate::numbers::echoed(rate_hz)
+        ))
+    }
+}
+
 /// Resamples `table` onto a uniform grid from `t[0]` at `rate_hz` (default
 /// `1/median dt`), and returns it with the gaps of the log (see the module
 /// documentation for the rule).
@@ -65,12 +83,18 @@ pub fn to_uniform(
     let (Some(&t0), Some(&t_end), Some(dt0)) = (t.first(), t.last(), median_dt(t)) else {
         return Err(too_few(t.len()));
     };
+    if let Some(r) = rate_hz {
+        check_rate_hz(r).map_err(|m| LogError::new("file", LogErrorKind::InvalidRate, m))?;
+    }
     let fs = rate_hz.unwrap_or_else(|| nominal_rate(dt0));
     if !(fs.is_finite() && fs > 0.0) {
         return Err(LogError::new(
             "file",
             LogErrorKind::InvalidRate,
-            format!("the resampling rate must be a finite number of Hz above zero (got {fs})"),
+            format!(
+                "the resampling rate must be a finite number of Hz above zero (got {})",
+                crate::numbers::echoed(fs)
+            ),
         ));
     }
     // Number of grid steps; the end is included when it falls on the grid.
@@ -358,13 +382,27 @@ mod tests {
     #[test]
     fn bad_tables_and_rates_are_errors() {
         let tab = table(vec![0.0, 0.1, 0.2], &[("u", &|v| v)]);
-        for r in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        for r in [
+            0.0,
+            -1.0,
+            f64::NAN,
+            f64::INFINITY,
+            1e-308,
+            0.009,
+            1000.1,
+            1e12,
+        ] {
             assert_eq!(
                 to_uniform(&tab, Some(r)).unwrap_err().kind,
                 LogErrorKind::InvalidRate
             );
         }
-        let e = to_uniform(&tab, Some(1e12)).unwrap_err();
+        assert_eq!(
+            to_uniform(&tab, Some(1e-308)).unwrap_err().message,
+            "the resampling rate must be between 0.01 and 1000 Hz (got 1e-308)"
+        );
+        let long = table(vec![0.0, 1e9], &[("u", &|v| v)]);
+        let e = to_uniform(&long, Some(1000.0)).unwrap_err();
         assert_eq!(e.kind, LogErrorKind::TooLarge);
         let one = table(vec![0.0], &[("u", &|v| v)]);
         assert_eq!(

@@ -266,12 +266,7 @@ impl CampaignSpec {
 
     /// Checks the campaign against the vessel; every error names its field.
     pub fn validate(&self, vessel: &VesselProfile) -> Result<(), PlanError> {
-        if self.name.trim().is_empty() {
-            return Err(PlanError::invalid("name", "must not be empty"));
-        }
-        if self.name.len() > 200 {
-            return Err(PlanError::invalid("name", "must be at most 200 characters"));
-        }
+        super::check_name("name", &self.name)?;
         let speeds = &self.grid.speeds;
         if speeds.is_empty() {
             return Err(PlanError::invalid(

@@ -35,6 +35,35 @@ impl PlanError {
     }
 }
 
+/// Longest name (vessel, campaign, run, thruster), in bytes.
+pub const MAX_NAME_LEN: usize = 200;
+
+/// Checks a name people gave: not blank, at most [`MAX_NAME_LEN`] bytes, no
+/// control characters (a newline or escape sequence in a name breaks
+/// headers, files and terminals); the message never quotes the name.
+pub fn check_name(field: &str, name: &str) -> Result<(), PlanError> {
+    if name.trim().is_empty() {
+        return Err(PlanError::invalid(field, "must not be empty"));
+    }
+    if name.len() > MAX_NAME_LEN {
+        return Err(PlanError::invalid(
+            field,
+            format!("must be at most {MAX_NAME_LEN} characters"),
+        ));
+    }
+    if let Some((i, c)) = name.chars().enumerate().find(|(_, c)| c.is_control()) {
+        return Err(PlanError::invalid(
+            field,
+            format!(
+                "must not contain control characters (U+{:04X} at character {})",
+                u32::from(c),
+                i + 1
+            ),
+        ));
+    }
+    Ok(())
+}
+
 impl fmt::Display for PlanError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}: {}", self.field, self.message)

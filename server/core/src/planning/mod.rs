@@ -15,7 +15,7 @@ pub mod waveform;
 
 pub use campaign::{CampaignSpec, ExperimentFamily, Quantity, SignalKind, SpeedGrid, SpeedUnit};
 pub use dof::{Dof, KNOT};
-pub use error::PlanError;
+pub use error::{MAX_NAME_LEN, PlanError, check_name};
 pub use plan::{Experiment, Plan, PlanTotals, PlannedExperiment, Schedule, generate_plan};
 pub use vessel::VesselProfile;
 

@@ -196,12 +196,7 @@ impl VesselProfile {
 
     /// Checks the profile for completeness and physical sense.
     pub fn validate(&self) -> Result<(), PlanError> {
-        if self.name.trim().is_empty() {
-            return Err(PlanError::invalid("name", "must not be empty"));
-        }
-        if self.name.len() > 200 {
-            return Err(PlanError::invalid("name", "must be at most 200 characters"));
-        }
+        super::check_name("name", &self.name)?;
         if self.dofs.is_empty() {
             return Err(PlanError::invalid(
                 "dofs",
@@ -290,12 +285,7 @@ impl VesselProfile {
                 ));
             }
             for (i, t) in thrusters.iter().enumerate() {
-                if t.name.trim().is_empty() {
-                    return Err(PlanError::invalid(
-                        format!("inputs.thrusters[{i}].name"),
-                        "must not be empty",
-                    ));
-                }
+                super::check_name(&format!("inputs.thrusters[{i}].name"), &t.name)?;
                 positive(&format!("inputs.thrusters[{i}].max_command"), t.max_command)?;
                 positive(&format!("inputs.thrusters[{i}].max_rate"), t.max_rate)?;
             }
