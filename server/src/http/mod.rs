@@ -87,7 +87,7 @@ impl AppState {
         description = "Sea-trial system identification of ROVs and dynamically positioned ships: plan trial campaigns, score runs, identify and validate models.",
         license(name = "MIT")
     ),
-    components(schemas(ErrorBody, JobEvent)),
+    components(schemas(ErrorBody, JobEvent, models::ExportFormat, crate::storage::jobs::JobKind, crate::storage::jobs::IdentifyMethod)),
     tags(
         (name = "service", description = "Service health"),
         (name = "planning", description = "Vessels, campaigns, excitation plans and their exports"),

@@ -23,6 +23,7 @@ use seatrial_core::validation::ValidationSettings;
 
 /// Filters of the model list.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct ModelFilter {
     /// Only models of this campaign.
     pub campaign_id: Option<String>,
@@ -66,6 +67,7 @@ pub struct ModelView {
 
 /// Options of one model.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct ModelQuery {
     /// Sample time h (s) at which to add the ZOH-discretized Φ, Γ.
     pub h: Option<f64>,
@@ -109,11 +111,26 @@ pub async fn get_model(
 
 /// Export format.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct ExportQuery {
     /// `json` (default: the whole model with provenance), `csv` (parameter
     /// table with standard deviations) or `fossen` (M, D, g(η), T, K in Fossen
     /// form for MSS / PythonVehicleSimulator).
+    #[param(value_type = Option<ExportFormat>)]
     pub format: Option<String>,
+}
+
+/// The export formats (documentation of `format`; an unknown one is a 400 naming it).
+#[derive(utoipa::ToSchema)]
+#[schema(rename_all = "snake_case")]
+#[allow(dead_code)]
+pub enum ExportFormat {
+    /// The whole model with provenance.
+    Json,
+    /// The parameter table with standard deviations.
+    Csv,
+    /// M, D, g(η), T, K in Fossen form.
+    Fossen,
 }
 
 /// What a JSON export holds: the whole model (`json`) or its Fossen-form
@@ -193,6 +210,7 @@ pub async fn export_model(
 
 /// Which models to compare on which run.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct CompareQuery {
     /// First model.
     pub a: String,

@@ -15,7 +15,13 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequestParts<S> for ApiQuery<T> {
 
     async fn from_request_parts(parts: &mut Parts, _state: &S) -> Result<Self, Self::Rejection> {
         let q = parts.uri.query().unwrap_or("");
-        let de = serde_urlencoded::Deserializer::new(form_urlencoded::parse(q.as_bytes()));
+        // `k=10.0` is the integer 10, as in JSON bodies.
+        let mut rebuilt = form_urlencoded::Serializer::new(String::new());
+        for (k, v) in form_urlencoded::parse(q.as_bytes()) {
+            rebuilt.append_pair(&k, integral(&v).unwrap_or(&v));
+        }
+        let rebuilt = rebuilt.finish();
+        let de = serde_urlencoded::Deserializer::new(form_urlencoded::parse(rebuilt.as_bytes()));
         serde_path_to_error::deserialize(de)
             .map(ApiQuery)
             .map_err(|e| {
@@ -28,5 +34,28 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequestParts<S> for ApiQuery<T> {
                     field: (path != ".").then_some(path),
                 }
             })
+    }
+}
+
+/// The integer part of a decimal written with only zeros after its point
+/// (`7489.0`, `-3.00`, `12.`), so that integer parameters accept it.
+fn integral(v: &str) -> Option<&str> {
+    let (int, frac) = v.split_once('.')?;
+    let digits = int.strip_prefix('-').unwrap_or(int);
+    (!digits.is_empty()
+        && digits.bytes().all(|b| b.is_ascii_digit())
+        && frac.bytes().all(|b| b == b'0'))
+    .then_some(int)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn integral_decimals_lose_their_zeros_only() {
+        assert_eq!(super::integral("7489.0"), Some("7489"));
+        assert_eq!(super::integral("-3.00"), Some("-3"));
+        assert_eq!(super::integral("0.5"), None);
+        assert_eq!(super::integral("abc"), None);
+        assert_eq!(super::integral(".0"), None);
     }
 }

@@ -4,12 +4,13 @@
 use axum::Json;
 use axum::body::Body;
 use axum::extract::multipart::{Field, MultipartRejection};
-use axum::extract::{Multipart, Path, Query, State};
+use axum::extract::{Multipart, Path, State};
 use axum::http::{HeaderMap, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use serde::Deserialize;
 
 use super::json::parse_json;
+use super::query::ApiQuery;
 use super::run_description::{DescriptionChange, from_value};
 use super::{AppState, blocking, found};
 use seatrial_core::alignment::{OffsetPriors, check_user_offset};
@@ -328,6 +329,7 @@ pub async fn get_run(State(s): State<AppState>, Path(id): Path<String>) -> ApiRe
 
 /// Which file of a run.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct RawQuery {
     /// `file` (single-file run, the default), `control` or `nav`.
     pub file: Option<String>,
@@ -342,7 +344,7 @@ pub struct RawQuery {
 pub async fn raw_run(
     State(s): State<AppState>,
     Path(id): Path<String>,
-    Query(q): Query<RawQuery>,
+    ApiQuery(q): ApiQuery<RawQuery>,
 ) -> ApiResult<Response> {
     let run = found(runs::get(&s.db, &id).await?, "run", &id)?;
     let role = match (q.file.as_deref(), run.layout.as_str()) {
