@@ -50,6 +50,10 @@ fn every_fixed_route_of_the_contract_is_documented() {
         ("put", "/api/runs/{id}/clock-offset"),
         ("get", "/api/runs/{id}"),
         ("patch", "/api/runs/{id}"),
+        ("delete", "/api/runs/{id}"),
+        ("patch", "/api/campaigns/{id}"),
+        ("patch", "/api/models/{id}"),
+        ("delete", "/api/models/{id}"),
     ] {
         assert!(
             spec["paths"][path][method].is_object(),
@@ -123,6 +127,12 @@ fn query_parameters_the_handlers_read_are_in_query() {
         ("/api/runs/{id}/raw", "get", "file", false),
         ("/api/models", "get", "campaign_id", false),
         ("/api/models", "get", "lineage_id", false),
+        ("/api/models", "get", "limit", false),
+        ("/api/models", "get", "offset", false),
+        ("/api/campaigns/{id}/runs", "get", "limit", false),
+        ("/api/campaigns/{id}/runs", "get", "offset", false),
+        ("/api/campaigns/{id}/runs", "get", "status", false),
+        ("/api/models/{id}", "delete", "cascade", false),
         ("/api/models/{id}", "get", "h", false),
         ("/api/models/{id}/export", "get", "format", false),
         ("/api/models/compare", "get", "a", true),
@@ -188,6 +198,9 @@ fn examples_and_limits_are_what_the_server_accepts() {
         ("VesselProfile", "name"),
         ("NewCampaign", "name"),
         ("CampaignSpec", "name"),
+        ("RunManage", "name"),
+        ("ModelChange", "name"),
+        ("CampaignChange", "name"),
     ] {
         let p = &schemas[schema]["properties"][field];
         assert_eq!(

@@ -10,6 +10,7 @@ pub mod export;
 pub mod health;
 pub mod jobs;
 pub mod json;
+pub mod manage;
 pub mod models;
 pub mod plans;
 pub mod query;
@@ -109,13 +110,17 @@ pub fn api() -> OpenApiRouter<AppState> {
             campaigns::create_campaign,
             campaigns::list_campaigns
         ))
-        .routes(routes!(campaigns::get_campaign))
+        .routes(routes!(campaigns::get_campaign, manage::patch_campaign))
         .routes(routes!(plans::generate_plan, plans::get_plan))
         .routes(routes!(plans::get_experiment))
         .routes(routes!(plans::schedule_csv))
         .routes(routes!(plans::run_sheet))
         .routes(routes!(runs::list_runs))
-        .routes(routes!(runs::get_run, run_description::describe_run))
+        .routes(routes!(
+            runs::get_run,
+            run_description::describe_run,
+            runs::delete_run
+        ))
         .routes(routes!(runs::raw_run))
         .routes(routes!(runs::run_quality))
         .routes(routes!(runs::coverage))
@@ -134,7 +139,11 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(jobs::job_events))
         .routes(routes!(models::list_models))
         .routes(routes!(models::compare_models))
-        .routes(routes!(models::get_model))
+        .routes(routes!(
+            models::get_model,
+            manage::patch_model,
+            manage::delete_model
+        ))
         .routes(routes!(models::export_model))
         .routes(routes!(discrepancies::list_model_discrepancies))
         .routes(routes!(discrepancies::get_discrepancy))

@@ -10,7 +10,7 @@ use seatrial_core::identification::document::ModelDocument;
 use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv};
 use serde::{Deserialize, Serialize};
 
-use super::query::ApiQuery;
+use super::query::{ApiQuery, Paging, with_total};
 use super::{AppState, blocking, campaign_and_vessel, found};
 use crate::clock::CampaignClocks;
 use crate::error::{ApiError, ApiResult, ErrorBody};
@@ -31,17 +31,27 @@ pub struct ModelFilter {
     pub lineage_id: Option<String>,
 }
 
-/// Models, newest first (metadata only).
-#[utoipa::path(get, path = "/api/models", tag = "models", params(ModelFilter),
-    responses((status = 200, description = "Models, newest first", body = [ModelSummary]),
-              (status = 400, description = "Malformed query parameter", body = ErrorBody)))]
+/// Models, newest first (metadata only); `limit`/`offset` page the list and
+/// the `X-Total-Count` header gives how many match.
+#[utoipa::path(get, path = "/api/models", tag = "models", params(ModelFilter, Paging),
+    responses((status = 200, description = "Models, newest first", body = [ModelSummary],
+                headers(("x-total-count" = i64, description = "Models that match the filters (all pages)"))),
+              (status = 400, description = "Malformed query parameter", body = ErrorBody),
+              (status = 422, description = "`limit` outside 1–1000", body = ErrorBody)))]
 pub async fn list_models(
     State(s): State<AppState>,
     ApiQuery(f): ApiQuery<ModelFilter>,
-) -> ApiResult<Json<Vec<ModelSummary>>> {
-    Ok(Json(
-        models::list(&s.db, f.campaign_id.as_deref(), f.lineage_id.as_deref()).await?,
-    ))
+    ApiQuery(p): ApiQuery<Paging>,
+) -> ApiResult<Response> {
+    let page = p.page()?;
+    let (items, total) = models::page(
+        &s.db,
+        f.campaign_id.as_deref(),
+        f.lineage_id.as_deref(),
+        page,
+    )
+    .await?;
+    Ok(with_total(items, total))
 }
 
 /// A model with provenance, its document and its validation reports.
