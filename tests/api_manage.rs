@@ -58,6 +58,13 @@ async fn integral_floats_are_accepted_where_integers_are_meant() {
         )
         .await;
     assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.headers["x-total-count"], "0", "{}", r.text);
+    // A fraction is refused, naming the parameter.
+    let r = app
+        .call("GET", "/api/campaigns/{id}/runs?limit=2.5", &[&cid], None)
+        .await;
+    assert_eq!(r.status, 400, "{}", r.text);
+    assert!(r.text.contains("limit"), "{}", r.text);
 }
 
 #[tokio::test]

@@ -292,3 +292,55 @@ impl Persist for NewModelOutput {
         })
     }
 }
+
+#[cfg(test)]
+mod manage_tests {
+    use super::*;
+    use seatrial_core::timeseries::UniformRecord;
+
+    fn input(id: &str, name: &str, fs: f64) -> RunInput {
+        RunInput {
+            run_id: id.into(),
+            name: name.into(),
+            family: None,
+            grid_speed_mps: None,
+            excited_dofs: vec![],
+            record: UniformRecord {
+                sample_rate_hz: fs,
+                t0: 0.0,
+                names: vec![],
+                data: vec![],
+                valid: vec![],
+            },
+        }
+    }
+
+    #[test]
+    fn a_run_at_another_rate_is_named_by_name_and_id() {
+        let ok = [input("r1", "DYN-1", 10.0), input("r2", "DYN-2", 10.0)];
+        assert!(one_sample_rate(&ok).is_ok());
+        let bad = [input("r1", "DYN-1", 10.0), input("r7", "bad dive", 20.0)];
+        let Err(JobFailure::Failed(e)) = one_sample_rate(&bad) else {
+            panic!("a second rate must fail the job");
+        };
+        assert_eq!(e.field.as_deref(), Some("runs[r7]"));
+        assert!(
+            e.message.contains("'bad dive' (r7)") && e.message.contains("20 Hz"),
+            "{}",
+            e.message
+        );
+    }
+
+    #[test]
+    fn errors_about_a_run_name_it() {
+        let runs = [("r1".to_string(), "DYN-1".to_string())];
+        assert_eq!(
+            run_inputs::naming_run("runs[r1].nu", "too short".into(), &runs),
+            "run 'DYN-1' (r1): too short"
+        );
+        assert_eq!(
+            run_inputs::naming_run("settings.k", "bad".into(), &runs),
+            "bad"
+        );
+    }
+}
