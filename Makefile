@@ -8,7 +8,7 @@ SHELL := /bin/bash
 DB ?= data/seatrial.db
 LISTEN ?= 127.0.0.1:8080
 
-.PHONY: run test deps web-deps browser test-rust test-web fmt lint
+.PHONY: run test deps web-deps browser spec-validator test-rust test-spec test-web fmt lint
 
 run: web-deps
 	cargo run --release --bin seatrial -- --demo --db $(DB) --listen $(LISTEN) --web-dir web
@@ -25,9 +25,21 @@ browser:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium >/dev/null; \
 	fi
 
-deps: web-deps browser
+# openapi-spec-validator (PyPI, pinned) checks openapi.yaml against the OpenAPI 3.1 schema.
+OPENAPI_SPEC_VALIDATOR := 0.9.0
+spec-validator:
+	@command -v python3 >/dev/null || { echo "python3 is needed to validate openapi.yaml (apt-get install -y python3 python3-pip)"; exit 1; }
+	@python3 -c "import importlib.metadata as m; assert m.version('openapi-spec-validator') == '$(OPENAPI_SPEC_VALIDATOR)'" 2>/dev/null \
+	  || python3 -m pip install -q --disable-pip-version-check openapi-spec-validator==$(OPENAPI_SPEC_VALIDATOR) \
+	  || python3 -m pip install -q --disable-pip-version-check --break-system-packages openapi-spec-validator==$(OPENAPI_SPEC_VALIDATOR)
 
-test: deps test-rust test-web
+deps: web-deps browser spec-validator
+
+test: deps test-spec test-rust test-web
+
+# The committed spec is valid OpenAPI (tests/openapi.rs holds it to the router).
+test-spec: spec-validator
+	python3 -m openapi_spec_validator openapi.yaml
 
 test-rust:
 	cargo test --release --workspace

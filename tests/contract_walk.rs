@@ -22,70 +22,9 @@ async fn job(app: &TestApp, settings: Value) -> String {
     r.json["id"].as_str().unwrap().to_string()
 }
 
-/// A stored one-DOF LPV model (the identify job itself is proven in
-/// api_models; here the model routes only need something to serve).
+/// A stored one-DOF LPV model of a new lineage, from no run.
 async fn stored_model(app: &TestApp, cid: &str, vid: &str) -> String {
-    use seatrial::storage::models::{Lineage, NewModel, insert};
-    use seatrial_core::identification::document::{
-        LpvDoc, LpvPoint, Method, ModelDocument, ModelKind,
-    };
-    let one = vec![vec![1.0]];
-    let doc = ModelDocument {
-        kind: ModelKind::Lpv,
-        method: Method::LambdaKf,
-        dofs: vec![seatrial_core::planning::Dof::Surge],
-        inputs: vec!["γ_X".into()],
-        outputs: vec!["u".into()],
-        restoring: None,
-        lpv: Some(LpvDoc {
-            t_lambda_s: 1.0,
-            structure: "diagonal".into(),
-            coupling: vec![vec![true]],
-            points: vec![LpvPoint {
-                load: None,
-                load_std: None,
-                speed_mps: 0.5,
-                m: vec![vec![5800.0]],
-                m_std: vec![vec![50.0]],
-                d_bar: vec![vec![1500.0]],
-                d_bar_std: vec![vec![20.0]],
-                a: vec![vec![-1500.0 / 5800.0]],
-                a_std: one.clone(),
-                b: vec![vec![1.0 / 5800.0]],
-                b_std: one,
-                n_samples: 100,
-                run_ids: vec![],
-                augmentation: None,
-            }],
-            logged_controller: None,
-        }),
-        dp_ship: None,
-        state_space: None,
-        parameters: vec![],
-        structure_findings: vec![],
-        notes: vec![],
-    };
-    let mut conn = app.state.db.acquire().await.unwrap();
-    let m = insert(
-        &mut conn,
-        NewModel {
-            lineage: Lineage::New,
-            campaign_id: cid.into(),
-            vessel_id: vid.into(),
-            kind: "lpv".into(),
-            method: "lambda_kf".into(),
-            name: "walk".into(),
-            settings: json!({}),
-            run_ids: vec![],
-            validation_run_ids: vec![],
-            job_id: None,
-            document: serde_json::to_value(&doc).unwrap(),
-            validation: json!([]),
-        },
-    )
-    .await
-    .unwrap();
-    m.id
+    common::stored_model(app, cid, vid, None, &[]).await
 }
 
 /// A stored discovery report (nothing named) on model `mid`.
@@ -263,7 +202,36 @@ async fn every_documented_operation_is_exercised_and_answers() {
                         "PATCH",
                         template,
                         &args,
-                        Some(json!({ "role": "dynamic", "grid_speed_kn": 1.0, "notes": "walked" })),
+                        Some(json!({ "role": "dynamic", "grid_speed_kn": 1.0, "notes": "walked", "name": "walked", "excluded": false })),
+                    )
+                    .await
+                }
+                // Deleting needs something of its own to delete.
+                ("delete", "/api/runs/{id}") => {
+                    let r = app
+                        .raw(
+                            "POST",
+                            &format!("/api/campaigns/{cid}/runs"),
+                            Some((&ct, body.clone())),
+                        )
+                        .await;
+                    let id = r.json["id"].as_str().unwrap().to_string();
+                    app.call("DELETE", template, &[&id], None).await
+                }
+                ("delete", "/api/models/{id}") => {
+                    let id = stored_model(&app, &cid, &vid).await;
+                    app.call("DELETE", template, &[&id], None).await
+                }
+                ("patch", "/api/campaigns/{id}") => {
+                    app.call("PATCH", template, &args, Some(json!({ "name": "walked" })))
+                        .await
+                }
+                ("patch", "/api/models/{id}") => {
+                    app.call(
+                        "PATCH",
+                        template,
+                        &args,
+                        Some(json!({ "name": "walked", "notes": "renamed" })),
                     )
                     .await
                 }

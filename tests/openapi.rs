@@ -50,10 +50,178 @@ fn every_fixed_route_of_the_contract_is_documented() {
         ("put", "/api/runs/{id}/clock-offset"),
         ("get", "/api/runs/{id}"),
         ("patch", "/api/runs/{id}"),
+        ("delete", "/api/runs/{id}"),
+        ("patch", "/api/campaigns/{id}"),
+        ("patch", "/api/models/{id}"),
+        ("delete", "/api/models/{id}"),
     ] {
         assert!(
             spec["paths"][path][method].is_object(),
             "{method} {path} missing from the spec"
         );
     }
+}
+
+/// The parameters of one operation: (name, in, required).
+fn parameters(spec: &serde_json::Value, path: &str, method: &str) -> Vec<(String, String, bool)> {
+    spec["paths"][path][method]["parameters"]
+        .as_array()
+        .map(|ps| {
+            ps.iter()
+                .map(|p| {
+                    (
+                        p["name"].as_str().unwrap().to_string(),
+                        p["in"].as_str().unwrap().to_string(),
+                        p["required"].as_bool().unwrap_or(false),
+                    )
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+#[test]
+fn path_parameters_are_exactly_the_templates_placeholders() {
+    let spec = serde_json::to_value(seatrial::http::openapi()).unwrap();
+    for (path, ops) in spec["paths"].as_object().unwrap() {
+        let placeholders: Vec<&str> = path
+            .split('{')
+            .skip(1)
+            .filter_map(|s| s.split('}').next())
+            .collect();
+        for method in ops.as_object().unwrap().keys() {
+            let params = parameters(&spec, path, method);
+            for (name, place, required) in &params {
+                if place == "path" {
+                    assert!(
+                        placeholders.contains(&name.as_str()),
+                        "{method} {path}: `{name}` is declared in: path but the path has no {{{name}}}"
+                    );
+                    assert!(
+                        required,
+                        "{method} {path}: path parameter `{name}` not required"
+                    );
+                } else {
+                    assert_eq!(place, "query", "{method} {path}: `{name}` is in {place}");
+                }
+            }
+            for p in &placeholders {
+                assert!(
+                    params.iter().any(|(n, i, _)| n == p && i == "path"),
+                    "{method} {path}: {{{p}}} is not declared as a path parameter"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn query_parameters_the_handlers_read_are_in_query() {
+    let spec = serde_json::to_value(seatrial::http::openapi()).unwrap();
+    // (path, method, parameter, required): every parameter a handler reads
+    // from the query string.
+    for (path, method, name, required) in [
+        ("/api/campaigns", "get", "vessel_id", false),
+        ("/api/jobs", "get", "campaign_id", false),
+        ("/api/jobs", "get", "state", false),
+        ("/api/runs/{id}/raw", "get", "file", false),
+        ("/api/models", "get", "campaign_id", false),
+        ("/api/models", "get", "lineage_id", false),
+        ("/api/models", "get", "limit", false),
+        ("/api/models", "get", "offset", false),
+        ("/api/campaigns/{id}/runs", "get", "limit", false),
+        ("/api/campaigns/{id}/runs", "get", "offset", false),
+        ("/api/campaigns/{id}/runs", "get", "status", false),
+        ("/api/models/{id}", "delete", "cascade", false),
+        ("/api/models/{id}", "get", "h", false),
+        ("/api/models/{id}/export", "get", "format", false),
+        ("/api/models/compare", "get", "a", true),
+        ("/api/models/compare", "get", "b", true),
+        ("/api/models/compare", "get", "run_id", true),
+        ("/api/models/compare", "get", "k", false),
+        ("/api/models/compare", "get", "restart_s", false),
+    ] {
+        let params = parameters(&spec, path, method);
+        let found = params.iter().find(|(n, _, _)| n == name);
+        assert_eq!(
+            found.map(|(_, i, r)| (i.as_str(), *r)),
+            Some(("query", required)),
+            "{method} {path}: `{name}` should be a query parameter (required: {required}); got {params:?}"
+        );
+    }
+}
+
+#[test]
+fn the_event_stream_is_documented_as_json_job_events() {
+    let spec = serde_json::to_value(seatrial::http::openapi()).unwrap();
+    let content = &spec["paths"]["/api/jobs/{id}/events"]["get"]["responses"]["200"]["content"];
+    let stream = &content["text/event-stream"]["schema"];
+    assert_eq!(
+        stream["$ref"], "#/components/schemas/JobEvent",
+        "the SSE response should reference JobEvent: {content}"
+    );
+}
+
+#[test]
+fn examples_and_limits_are_what_the_server_accepts() {
+    let spec = serde_json::to_value(seatrial::http::openapi()).unwrap();
+    let schemas = &spec["components"]["schemas"];
+    // The method is documented by the enum of identify's methods, whose
+    // example the server accepts.
+    let method = serde_json::to_string(&schemas["JobRequest"]["properties"]["method"]).unwrap();
+    assert!(
+        method.contains("#/components/schemas/IdentifyMethod"),
+        "{method}"
+    );
+    let example = &schemas["IdentifyMethod"]["example"];
+    assert!(
+        matches!(
+            example.as_str(),
+            Some("lambda_kf" | "parallel_ekf" | "n4sid")
+        ),
+        "IdentifyMethod example {example}"
+    );
+    assert!(
+        !method.contains("`lambda`") && !method.contains("`ekf`"),
+        "{method}"
+    );
+    let kinds = serde_json::to_string(&schemas["JobKind"]).unwrap();
+    assert!(
+        kinds.contains("identify") && kinds.contains("discover"),
+        "{kinds}"
+    );
+    let methods = serde_json::to_string(&schemas["IdentifyMethod"]).unwrap();
+    for m in ["lambda_kf", "parallel_ekf", "n4sid"] {
+        assert!(methods.contains(m), "{methods}");
+    }
+    for (schema, field) in [
+        ("VesselProfile", "name"),
+        ("NewCampaign", "name"),
+        ("CampaignSpec", "name"),
+        ("RunManage", "name"),
+        ("ModelChange", "name"),
+        ("CampaignChange", "name"),
+    ] {
+        let p = &schemas[schema]["properties"][field];
+        assert_eq!(
+            (p["minLength"].as_u64(), p["maxLength"].as_u64()),
+            (Some(1), Some(200)),
+            "{schema}.{field}: {p}"
+        );
+    }
+    for (schema, field) in [
+        ("VesselProfile", "dofs"),
+        ("SpeedGrid", "speeds"),
+        ("NewCampaign", "families"),
+    ] {
+        let p = &schemas[schema]["properties"][field];
+        assert_eq!(p["minItems"].as_u64(), Some(1), "{schema}.{field}: {p}");
+    }
+    let format = serde_json::to_string(&spec["paths"]["/api/models/{id}/export"]["get"]).unwrap();
+    assert!(format.contains("ExportFormat"), "{format}");
+    assert!(
+        serde_json::to_string(&schemas["ExportFormat"])
+            .unwrap()
+            .contains("fossen")
+    );
 }

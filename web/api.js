@@ -70,6 +70,8 @@ export const api = {
   run: (rid) => request('GET', `/api/runs/${enc(rid)}`),
   // What a run is: fields absent are kept, null clears a user value.
   describeRun: (rid, body) => request('PATCH', `/api/runs/${enc(rid)}`, body),
+  // Delete a run (409 names the models built from it).
+  deleteRun: (rid) => request('DELETE', `/api/runs/${enc(rid)}`),
   quality: (rid) => request('GET', urls.quality(rid)),
   coverage: (id) => request('GET', `/api/campaigns/${enc(id)}/coverage`),
   // Clock offsets of two-file runs (s; null clears the one set by hand).
@@ -86,6 +88,8 @@ export const api = {
   lineage: (lineageId) => request('GET', `/api/models?lineage_id=${enc(lineageId)}`),
   // `hSample`: add the ZOH-discretized Φ, Γ at this sample time.
   model: (mid, hSample) => request('GET', `/api/models/${enc(mid)}${hSample != null ? `?h=${enc(hSample)}` : ''}`),
+  // Delete a model version; `cascade` also the versions derived from it (else 409 names them).
+  deleteModel: (mid, cascade) => request('DELETE', `/api/models/${enc(mid)}${cascade ? '?cascade=true' : ''}`),
   // Missing-physics discovery reports.
   discrepancies: (mid) => request('GET', `/api/models/${enc(mid)}/discrepancies`),
   discrepancy: (did) => request('GET', `/api/discrepancies/${enc(did)}`),

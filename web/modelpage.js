@@ -11,6 +11,7 @@ import { METHOD_LABEL, KIND_LABEL_MODEL, errLine } from './identify.js';
 import { predictionPlot, autocorrelationPlot, zoomGroup } from './modelplots.js';
 import { exact } from './runplots.js';
 import { discoveryPanel } from './discoverpanel.js';
+import { modelDeleteControl } from './manage.js';
 
 /** Unit of an output channel (the log contract). */
 function outUnit(name) {
@@ -290,7 +291,7 @@ export async function modelPage(view, id) {
       h('div', null,
         h('h1', { 'data-testid': 'model-title' }, model.name, h('span', { class: 'badge neutral' }, `v${model.version}`)),
         h('div', { class: 'muted' }, `${METHOD_LABEL[model.method] || model.method} · ${(doc.dofs || []).join(', ')} · inputs ${(doc.inputs || []).join(', ')} → outputs ${(doc.outputs || []).join(', ')}`)),
-      exportsBox),
+      h('div', null, exportsBox, modelDeleteControl(model))),
     provenance,
     h('h2', { class: 'section-title' }, 'Findings'),
     findings,

@@ -14,6 +14,7 @@ import { spectrumPlot, singularValuePlot, syncX, exact } from './runplots.js';
 import { verdictBadge, statusBadge, coverageBadge, errorWhere, errorText, rawLinks } from './runs.js';
 import { runOffsetPanel } from './offsetpanel.js';
 import { descriptionSection } from './rundescribe.js';
+import { excludedBadge, runManageSection } from './manage.js';
 
 const GOOD_COHERENCE = 0.8; // server: quality::verdict::GOOD_COHERENCE (the reasons quote it)
 
@@ -156,7 +157,7 @@ export async function runPage(view, rid) {
   fill(view,
     h('div', { class: 'page-head' },
       h('div', null,
-        h('h1', { 'data-testid': 'run-title' }, run.name, statusBadge(run.status)),
+        h('h1', { 'data-testid': 'run-title' }, run.name, statusBadge(run.status), excludedBadge(run)),
         h('div', { class: 'muted' },
           'Run of ', campaign ? h('a', { href: `#/campaigns/${campaign.id}`, 'data-testid': 'run-campaign-link' }, campaign.name) : run.campaign_id,
           run.experiment_id ? [' · experiment ',
@@ -174,6 +175,7 @@ export async function runPage(view, rid) {
     run.status === 'stored' ? h('p', { class: 'empty' }, 'Stored, not processed yet.') : null,
 
     descriptionSection(run, { vessel }),
+    runManageSection(run),
 
     s.verdicts && s.verdicts.length ? [h('h2', null, 'Verdict per DOF ', h('span', { class: 'hint' }, 'green good · amber weak · red insufficient — the reason says what to do')), verdictCards(s.verdicts, run.description && run.description.excited_dofs ? run.description.excited_dofs.value : null)] : null,
 

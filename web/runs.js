@@ -9,6 +9,7 @@ import {
 } from './format.js';
 import { h, fill, banner, labelled, num, clearErrors, showFieldError } from './forms.js';
 import { describeCell } from './rundescribe.js';
+import { excludedBadge } from './manage.js';
 
 // ---- shared bits (the run page uses them too) ------------------------------
 
@@ -397,7 +398,7 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
         h('td', { class: 'mono nowrap' }, r.experiment_id ? codes.get(r.experiment_id) || h('span', { class: 'muted', title: r.experiment_id }, 'older plan') : h('span', { class: 'muted' }, '–')),
         h('td', { class: 'nowrap' }, describeCell(r)),
         h('td', null, r.layout === 'split' ? 'control + nav' : 'one log'),
-        h('td', null, statusBadge(r.status)),
+        h('td', null, statusBadge(r.status), r.excluded ? [' ', excludedBadge(r)] : null),
         h('td', { class: 'badges' }, r.status === 'rejected'
           ? h('span', { class: 'error-text', 'data-testid': 'run-error' }, errorWhere(r.error, r.files), r.error && r.error.message ? h('span', { class: 'muted' }, ` — ${errorText(r.error.message)}`) : null)
           : v.map((x) => verdictBadge(x))),

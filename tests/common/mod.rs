@@ -317,3 +317,76 @@ pub async fn wait_for_job(app: &TestApp, job_id: &str, seconds: u64) -> Value {
     }
     panic!("job {job_id} did not finish in {seconds} s");
 }
+
+/// A stored one-DOF LPV model (the identify job itself is proven in
+/// api_models; model routes only need something to serve): the next version
+/// after `after` (else a new lineage), estimated from `run_ids`.
+pub async fn stored_model(
+    app: &TestApp,
+    cid: &str,
+    vid: &str,
+    after: Option<&str>,
+    run_ids: &[&str],
+) -> String {
+    use seatrial::storage::models::{Lineage, NewModel, insert};
+    use seatrial_core::identification::document::{
+        LpvDoc, LpvPoint, Method, ModelDocument, ModelKind,
+    };
+    let one = vec![vec![1.0]];
+    let doc = ModelDocument {
+        kind: ModelKind::Lpv,
+        method: Method::LambdaKf,
+        dofs: vec![seatrial_core::planning::Dof::Surge],
+        inputs: vec!["γ_X".into()],
+        outputs: vec!["u".into()],
+        restoring: None,
+        lpv: Some(LpvDoc {
+            t_lambda_s: 1.0,
+            structure: "diagonal".into(),
+            coupling: vec![vec![true]],
+            points: vec![LpvPoint {
+                load: None,
+                load_std: None,
+                speed_mps: 0.5,
+                m: vec![vec![5800.0]],
+                m_std: vec![vec![50.0]],
+                d_bar: vec![vec![1500.0]],
+                d_bar_std: vec![vec![20.0]],
+                a: vec![vec![-1500.0 / 5800.0]],
+                a_std: one.clone(),
+                b: vec![vec![1.0 / 5800.0]],
+                b_std: one,
+                n_samples: 100,
+                run_ids: vec![],
+                augmentation: None,
+            }],
+            logged_controller: None,
+        }),
+        dp_ship: None,
+        state_space: None,
+        parameters: vec![],
+        structure_findings: vec![],
+        notes: vec![],
+    };
+    let mut conn = app.state.db.acquire().await.unwrap();
+    let m = insert(
+        &mut conn,
+        NewModel {
+            lineage: after.map_or(Lineage::New, |p| Lineage::After(p.to_string())),
+            campaign_id: cid.into(),
+            vessel_id: vid.into(),
+            kind: "lpv".into(),
+            method: "lambda_kf".into(),
+            name: "walk".into(),
+            settings: json!({}),
+            run_ids: run_ids.iter().map(|r| r.to_string()).collect(),
+            validation_run_ids: vec![],
+            job_id: None,
+            document: serde_json::to_value(&doc).unwrap(),
+            validation: json!([]),
+        },
+    )
+    .await
+    .unwrap();
+    m.id
+}

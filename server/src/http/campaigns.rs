@@ -1,13 +1,14 @@
 //! Campaigns: the LPV grid, families and excitation settings for a vessel.
 
 use axum::Json;
-use axum::extract::{Path, Query, State};
+use axum::extract::{Path, State};
 use axum::http::StatusCode;
 use seatrial_core::planning::campaign::{Durations, Excitation};
 use seatrial_core::planning::{CampaignSpec, ExperimentFamily, SpeedGrid, generate_plan};
 use serde::Deserialize;
 
 use super::json::ApiJson;
+use super::query::ApiQuery;
 use super::{AppState, blocking, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::storage::campaigns::{self, Campaign};
@@ -19,11 +20,13 @@ use crate::storage::vessels;
 pub struct NewCampaign {
     /// Vessel id.
     pub vessel_id: String,
-    /// Name.
+    /// Name (1–200 characters, not blank).
+    #[schema(min_length = 1, max_length = 200, pattern = r"\S")]
     pub name: String,
     /// Forward-speed grid, in kn or m/s.
     pub grid: SpeedGrid,
-    /// Families to fly.
+    /// Families to fly (at least one, each once).
+    #[schema(min_items = 1)]
     pub families: Vec<ExperimentFamily>,
     /// Repetitions (default 1 for a ROV, 2 for a DP vessel; DP needs ≥ 2).
     #[serde(default)]
@@ -42,6 +45,7 @@ pub struct NewCampaign {
 
 /// Filter of the campaign list.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct CampaignFilter {
     /// Only campaigns of this vessel.
     pub vessel_id: Option<String>,
@@ -94,7 +98,7 @@ pub async fn create_campaign(
     responses((status = 200, description = "Campaigns, oldest first", body = [Campaign])))]
 pub async fn list_campaigns(
     State(s): State<AppState>,
-    Query(f): Query<CampaignFilter>,
+    ApiQuery(f): ApiQuery<CampaignFilter>,
 ) -> ApiResult<Json<Vec<Campaign>>> {
     Ok(Json(campaigns::list(&s.db, f.vessel_id.as_deref()).await?))
 }

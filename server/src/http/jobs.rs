@@ -3,8 +3,7 @@
 use std::convert::Infallible;
 
 use axum::Json;
-use axum::extract::rejection::QueryRejection;
-use axum::extract::{Path, Query, State};
+use axum::extract::{Path, State};
 use axum::http::StatusCode;
 use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::{IntoResponse, Response};
@@ -12,9 +11,10 @@ use futures_util::StreamExt;
 use serde::Deserialize;
 
 use super::json::ApiJson;
+use super::query::ApiQuery;
 use super::{AppState, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
-use crate::jobs;
+use crate::jobs::{self, JobEvent};
 use crate::storage::campaigns;
 use crate::storage::jobs::{
     self as stored, CancelOutcome, Job, JobRequest, JobState, RetryOutcome,
@@ -60,10 +60,12 @@ pub async fn submit_job(
 
 /// Filter of the job list.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct JobFilter {
     /// Only jobs of this campaign.
     pub campaign_id: Option<String>,
     /// Only jobs in this state: queued, running, succeeded, failed, cancelled or interrupted.
+    #[param(value_type = Option<JobState>)]
     pub state: Option<String>,
 }
 
@@ -76,12 +78,8 @@ pub struct JobFilter {
         (status = 404, description = "No such campaign", body = ErrorBody)))]
 pub async fn list_jobs(
     State(s): State<AppState>,
-    q: Result<Query<JobFilter>, QueryRejection>,
+    ApiQuery(q): ApiQuery<JobFilter>,
 ) -> ApiResult<Json<Vec<Job>>> {
-    let Query(q) = q.map_err(|e| ApiError::BadRequest {
-        message: format!("invalid query: {e}"),
-        field: None,
-    })?;
     let state = match q.state.as_deref() {
         None => None,
         Some(v) => Some(JobState::parse(v).ok_or_else(|| {
@@ -182,7 +180,7 @@ pub async fn retry_job(
 #[utoipa::path(get, path = "/api/jobs/{id}/events", tag = "jobs",
     params(("id" = String, Path, description = "Job id")),
     responses(
-        (status = 200, description = "`text/event-stream` of `JobEvent`s, until a terminal state", content_type = "text/event-stream", body = String),
+        (status = 200, description = "`text/event-stream`: each event's `data` is one JSON `JobEvent` (the schema given here), until a terminal state", content_type = "text/event-stream", body = JobEvent),
         (status = 404, description = "No such job", body = ErrorBody)))]
 pub async fn job_events(State(s): State<AppState>, Path(id): Path<String>) -> ApiResult<Response> {
     get_job_or_404(&s, &id).await?;

@@ -5,6 +5,7 @@ use axum::body::Bytes;
 use axum::extract::{FromRequest, Request};
 use axum::http::header::CONTENT_TYPE;
 use serde::de::DeserializeOwned;
+use serde_json::Value;
 
 use crate::error::ApiError;
 
@@ -43,7 +44,33 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for ApiJson<T> {
     }
 }
 
-/// Parses JSON, naming the field (JSON path), line and column of an error.
+/// Largest magnitude below which every integer is exactly a double (2⁵³).
+const EXACT_INTEGER: f64 = 9_007_199_254_740_992.0;
+
+/// Rewrites every number with an integral value written as a float
+/// (`7489.0`, `2e3`) as that integer, in place: JSON has one number type, so
+/// a field documented as `integer` accepts it (JSON Schema's `integer` is
+/// any number with a zero fractional part). Fields that are floats accept
+/// integers anyway.
+pub fn integral_floats_as_integers(v: &mut Value) {
+    match v {
+        Value::Number(n) => {
+            if let Some(f) = n.as_f64().filter(|_| n.is_f64())
+                && f.fract() == 0.0
+                && f.abs() <= EXACT_INTEGER
+            {
+                *n = serde_json::Number::from(f as i64);
+            }
+        }
+        Value::Array(a) => a.iter_mut().for_each(integral_floats_as_integers),
+        Value::Object(o) => o.values_mut().for_each(integral_floats_as_integers),
+        _ => {}
+    }
+}
+
+/// Parses JSON, naming the field (JSON path) of an error, and the line and
+/// column of a syntax error. Integral floats are read as integers
+/// ([`integral_floats_as_integers`]).
 pub fn parse_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
     if bytes.iter().all(u8::is_ascii_whitespace) {
         return Err(ApiError::BadRequest {
@@ -51,8 +78,12 @@ pub fn parse_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
             field: None,
         });
     }
-    let de = &mut serde_json::Deserializer::from_slice(bytes);
-    serde_path_to_error::deserialize(de).map_err(|e| {
+    let mut value: Value = serde_json::from_slice(bytes).map_err(|e| ApiError::BadRequest {
+        message: format!("invalid JSON body: {e}"),
+        field: None,
+    })?;
+    integral_floats_as_integers(&mut value);
+    serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
         let inner = e.inner();
         let mut field = if path == "." { None } else { Some(path) };

@@ -11,6 +11,7 @@ pub mod exposure;
 pub mod health;
 pub mod jobs;
 pub mod json;
+pub mod manage;
 pub mod models;
 pub mod plans;
 pub mod query;
@@ -92,7 +93,7 @@ impl AppState {
         description = "Sea-trial system identification of ROVs and dynamically positioned ships: plan trial campaigns, score runs, identify and validate models.",
         license(name = "MIT")
     ),
-    components(schemas(ErrorBody, JobEvent)),
+    components(schemas(ErrorBody, JobEvent, models::ExportFormat, crate::storage::jobs::JobKind, crate::storage::jobs::IdentifyMethod)),
     tags(
         (name = "service", description = "Service health"),
         (name = "planning", description = "Vessels, campaigns, excitation plans and their exports"),
@@ -114,13 +115,17 @@ pub fn api() -> OpenApiRouter<AppState> {
             campaigns::create_campaign,
             campaigns::list_campaigns
         ))
-        .routes(routes!(campaigns::get_campaign))
+        .routes(routes!(campaigns::get_campaign, manage::patch_campaign))
         .routes(routes!(plans::generate_plan, plans::get_plan))
         .routes(routes!(plans::get_experiment))
         .routes(routes!(plans::schedule_csv))
         .routes(routes!(plans::run_sheet))
         .routes(routes!(runs::list_runs))
-        .routes(routes!(runs::get_run, run_description::describe_run))
+        .routes(routes!(
+            runs::get_run,
+            run_description::describe_run,
+            runs::delete_run
+        ))
         .routes(routes!(runs::raw_run))
         .routes(routes!(runs::run_quality))
         .routes(routes!(runs::coverage))
@@ -139,7 +144,11 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(jobs::job_events))
         .routes(routes!(models::list_models))
         .routes(routes!(models::compare_models))
-        .routes(routes!(models::get_model))
+        .routes(routes!(
+            models::get_model,
+            manage::patch_model,
+            manage::delete_model
+        ))
         .routes(routes!(models::export_model))
         .routes(routes!(discrepancies::list_model_discrepancies))
         .routes(routes!(discrepancies::get_discrepancy))

@@ -11,7 +11,7 @@ use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv}
 use seatrial_core::identification::export_matlab::matlab_script;
 use serde::{Deserialize, Serialize};
 
-use super::query::ApiQuery;
+use super::query::{ApiQuery, Paging, with_total};
 use super::{AppState, blocking, campaign_and_vessel, found};
 use crate::clock::CampaignClocks;
 use crate::error::{ApiError, ApiResult, ErrorBody};
@@ -24,6 +24,7 @@ use seatrial_core::validation::ValidationSettings;
 
 /// Filters of the model list.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct ModelFilter {
     /// Only models of this campaign.
     pub campaign_id: Option<String>,
@@ -31,17 +32,27 @@ pub struct ModelFilter {
     pub lineage_id: Option<String>,
 }
 
-/// Models, newest first (metadata only).
-#[utoipa::path(get, path = "/api/models", tag = "models", params(ModelFilter),
-    responses((status = 200, description = "Models, newest first", body = [ModelSummary]),
-              (status = 400, description = "Malformed query parameter", body = ErrorBody)))]
+/// Models, newest first (metadata only); `limit`/`offset` page the list and
+/// the `X-Total-Count` header gives how many match.
+#[utoipa::path(get, path = "/api/models", tag = "models", params(ModelFilter, Paging),
+    responses((status = 200, description = "Models, newest first", body = [ModelSummary],
+                headers(("x-total-count" = i64, description = "Models that match the filters (all pages)"))),
+              (status = 400, description = "Malformed query parameter", body = ErrorBody),
+              (status = 422, description = "`limit` outside 1–1000", body = ErrorBody)))]
 pub async fn list_models(
     State(s): State<AppState>,
     ApiQuery(f): ApiQuery<ModelFilter>,
-) -> ApiResult<Json<Vec<ModelSummary>>> {
-    Ok(Json(
-        models::list(&s.db, f.campaign_id.as_deref(), f.lineage_id.as_deref()).await?,
-    ))
+    ApiQuery(p): ApiQuery<Paging>,
+) -> ApiResult<Response> {
+    let page = p.page()?;
+    let (items, total) = models::page(
+        &s.db,
+        f.campaign_id.as_deref(),
+        f.lineage_id.as_deref(),
+        page,
+    )
+    .await?;
+    Ok(with_total(items, total))
 }
 
 /// A model with provenance, its document and its validation reports.
@@ -67,6 +78,7 @@ pub struct ModelView {
 
 /// Options of one model.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct ModelQuery {
     /// Sample time h (s) at which to add the ZOH-discretized Φ, Γ.
     pub h: Option<f64>,
@@ -110,13 +122,30 @@ pub async fn get_model(
 
 /// Export format.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct ExportQuery {
     /// `json` (default: the whole model with provenance), `csv` (parameter
     /// table with standard deviations), `fossen` (M, D, g(η), T, K in Fossen
     /// form for MSS / PythonVehicleSimulator) or `matlab` (a `.m` script
     /// defining the struct `model`: every matrix with its std, g(η), the
     /// logged controller, the parameter table).
+    #[param(value_type = Option<ExportFormat>)]
     pub format: Option<String>,
+}
+
+/// The export formats (documentation of `format`; an unknown one is a 400 naming it).
+#[derive(utoipa::ToSchema)]
+#[schema(rename_all = "snake_case")]
+#[allow(dead_code)]
+pub enum ExportFormat {
+    /// The whole model with provenance.
+    Json,
+    /// The parameter table with standard deviations.
+    Csv,
+    /// M, D, g(η), T, K in Fossen form.
+    Fossen,
+    /// A MATLAB/Octave script defining the struct `model`.
+    Matlab,
 }
 
 /// What a JSON export holds: the whole model (`json`) or its Fossen-form
@@ -205,6 +234,7 @@ pub async fn export_model(
 
 /// Which models to compare on which run.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct CompareQuery {
     /// First model.
     pub a: String,

@@ -225,30 +225,136 @@ pub fn from_value<T: DeserializeOwned>(v: Value, prefix: &str) -> Result<T, ApiE
     })
 }
 
-/// Say what a run is: role, grid speed (`grid_speed_mps` or
-/// `grid_speed_kn`), excited DOFs, signal, notes. Absent fields are kept,
-/// `null` clears a user value (the planned experiment's, else the inferred
-/// value applies again). Answers the run with its description, each field
-/// with its source (`user`, `plan`, `inferred`).
+/// A change to a run's name and to its use in identification.
+#[derive(Debug, Default, Deserialize, utoipa::ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RunManage {
+    /// New name, 1–200 characters (trimmed).
+    #[schema(min_length = 1, max_length = 200, pattern = r"\S")]
+    pub name: Option<String>,
+    /// `true`: leave the run out of identification unless a job names it
+    /// (give `excluded_reason`); `false`: use it again.
+    pub excluded: Option<bool>,
+    /// Why it is excluded: required with `excluded: true`, at most 2000 characters.
+    #[schema(min_length = 1, max_length = 2000)]
+    pub excluded_reason: Option<String>,
+}
+
+/// The keys of [`RunManage`] in a PATCH body; the others describe the run.
+const MANAGE_KEYS: [&str; 3] = ["name", "excluded", "excluded_reason"];
+
+impl RunManage {
+    /// The checked update; refusals are 422s naming the field.
+    fn update(self) -> Result<runs::RunUpdate, ApiError> {
+        let name = self
+            .name
+            .as_deref()
+            .map(|n| check_name("name", n))
+            .transpose()?;
+        let exclusion = match (self.excluded, self.excluded_reason) {
+            (Some(true), reason) => {
+                let reason = reason.as_deref().map(str::trim).unwrap_or("");
+                if reason.is_empty() {
+                    return Err(ApiError::invalid(
+                        "excluded_reason",
+                        "say why the run is excluded (excluded_reason), so that whoever identifies next knows",
+                    ));
+                }
+                let chars = reason.chars().count();
+                if chars > MAX_NOTES_CHARS {
+                    return Err(ApiError::Unprocessable(PlanError::over_limit(
+                        "excluded_reason",
+                        format!(
+                            "the reason is limited to {MAX_NOTES_CHARS} characters, got {chars}"
+                        ),
+                        MAX_NOTES_CHARS as f64,
+                    )));
+                }
+                Some(Some(reason.to_string()))
+            }
+            (Some(false), _) => Some(None),
+            (None, Some(_)) => {
+                return Err(ApiError::invalid(
+                    "excluded_reason",
+                    "a reason goes with excluded: true",
+                ));
+            }
+            (None, None) => None,
+        };
+        Ok(runs::RunUpdate { name, exclusion })
+    }
+}
+
+/// A name checked against the documented limits (1–200 characters once
+/// trimmed); a 422 naming `field` otherwise.
+pub fn check_name(field: &str, name: &str) -> Result<String, ApiError> {
+    let name = name.trim();
+    if name.is_empty() {
+        return Err(ApiError::invalid(field, "a name must not be empty"));
+    }
+    let chars = name.chars().count();
+    if chars > MAX_NAME_CHARS {
+        return Err(ApiError::Unprocessable(PlanError::over_limit(
+            field,
+            format!("names are limited to {MAX_NAME_CHARS} characters, got {chars}"),
+            MAX_NAME_CHARS as f64,
+        )));
+    }
+    Ok(name.to_string())
+}
+
+/// Longest name (characters).
+pub const MAX_NAME_CHARS: usize = 200;
+
+/// The body of `PATCH /api/runs/{id}`: name and exclusion, and what the run
+/// is (documentation; the handler reads the two parts apart).
+#[derive(Deserialize, utoipa::ToSchema)]
+#[allow(dead_code)]
+pub struct RunChange {
+    #[serde(flatten)]
+    manage: RunManage,
+    #[serde(flatten)]
+    description: DescriptionChange,
+}
+
+/// Change a run: rename it, exclude it from identification (with a reason)
+/// or include it again, and say what it is — role, grid speed
+/// (`grid_speed_mps` or `grid_speed_kn`), excited DOFs, signal, notes.
+/// Absent fields are kept, `null` clears a user description value (the
+/// planned experiment's, else the inferred value applies again). One
+/// transaction. Answers the run with its description, each field with its
+/// source (`user`, `plan`, `inferred`).
 #[utoipa::path(patch, path = "/api/runs/{id}", tag = "runs",
     params(("id" = String, Path, description = "Run id")),
-    request_body = DescriptionChange,
+    request_body = RunChange,
     responses(
         (status = 200, description = "The run with its description", body = Run),
         (status = 400, description = "Not JSON", body = ErrorBody),
         (status = 404, description = "No such run", body = ErrorBody),
         (status = 415, description = "Not application/json", body = ErrorBody),
-        (status = 422, description = "A field the vessel or the service does not accept (unknown field or role, negative speed, a DOF not modelled, notes over 2000 characters): `field` names it", body = ErrorBody)))]
+        (status = 422, description = "A field the vessel or the service does not accept (unknown field or role, negative speed, a DOF not modelled, notes over 2000 characters, an empty or too long name, exclusion without a reason): `field` names it", body = ErrorBody)))]
 pub async fn describe_run(
     State(s): State<AppState>,
     Path(id): Path<String>,
     ApiJson(body): ApiJson<Value>,
 ) -> ApiResult<Json<Run>> {
     let run = found(runs::get(&s.db, &id).await?, "run", &id)?;
-    let change: DescriptionChange = from_value(body, "")?;
+    let Value::Object(mut rest) = body else {
+        return Err(ApiError::invalid("body", "a JSON object is expected"));
+    };
+    let mut manage = serde_json::Map::new();
+    for k in MANAGE_KEYS {
+        if let Some(v) = rest.remove(k) {
+            manage.insert(k.to_string(), v);
+        }
+    }
+    let update = from_value::<RunManage>(Value::Object(manage), "")?.update()?;
+    let change: DescriptionChange = from_value(Value::Object(rest), "")?;
     let (_, vessel) = campaign_and_vessel(&s.db, &run).await?;
     let mut user = UserDescription::default();
     let touched = change.apply(&mut user, &vessel.profile, "")?;
-    runs::set_description(&s.db, &id, &user, &touched).await?;
+    if !runs::update(&s.db, &id, &user, &touched, &update).await? {
+        return Err(ApiError::NotFound(format!("no run with id '{id}'")));
+    }
     Ok(Json(found(runs::get(&s.db, &id).await?, "run", &id)?))
 }

@@ -4,12 +4,13 @@
 use axum::Json;
 use axum::body::Body;
 use axum::extract::multipart::{Field, MultipartRejection};
-use axum::extract::{Multipart, Path, Query, State};
+use axum::extract::{Multipart, Path, State};
 use axum::http::{HeaderMap, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use serde::Deserialize;
 
 use super::json::parse_json;
+use super::query::{ApiQuery, Paging, with_total};
 use super::run_description::{DescriptionChange, from_value};
 use super::{AppState, found};
 use seatrial_core::alignment::check_user_offset;
@@ -287,17 +288,88 @@ pub async fn upload_run(
     }
 }
 
-/// Runs of a campaign.
+/// Which runs of a campaign to list.
+#[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
+pub struct RunFilter {
+    /// Only runs with this status: `accepted`, `rejected` (uploads that failed
+    /// validation, listed apart) or `stored`.
+    pub status: Option<String>,
+}
+
+const RUN_STATUSES: [&str; 3] = ["stored", "accepted", "rejected"];
+
+/// Runs of a campaign, oldest first, each with `excluded` (left out of
+/// identification) and its reason; `limit`/`offset` page the list and the
+/// `X-Total-Count` header gives how many match.
 #[utoipa::path(get, path = "/api/campaigns/{id}/runs", tag = "runs",
-    params(("id" = String, Path, description = "Campaign id")),
-    responses((status = 200, description = "Runs, oldest first", body = [Run]),
-              (status = 404, description = "No such campaign", body = ErrorBody)))]
+    params(("id" = String, Path, description = "Campaign id"), RunFilter, Paging),
+    responses((status = 200, description = "Runs, oldest first", body = [Run],
+                headers(("x-total-count" = i64, description = "Runs that match the filter (all pages)"))),
+              (status = 400, description = "Malformed query parameter", body = ErrorBody),
+              (status = 404, description = "No such campaign", body = ErrorBody),
+              (status = 422, description = "`limit` outside 1–1000 or an unknown `status`", body = ErrorBody)))]
 pub async fn list_runs(
     State(s): State<AppState>,
     Path(id): Path<String>,
-) -> ApiResult<Json<Vec<Run>>> {
+    ApiQuery(f): ApiQuery<RunFilter>,
+    ApiQuery(p): ApiQuery<Paging>,
+) -> ApiResult<Response> {
+    let page = p.page()?;
+    if let Some(st) = &f.status
+        && !RUN_STATUSES.contains(&st.as_str())
+    {
+        return Err(ApiError::invalid(
+            "status",
+            format!("unknown status '{st}'; one of {}", RUN_STATUSES.join(", ")),
+        ));
+    }
     found(campaigns::get(&s.db, &id).await?, "campaign", &id)?;
-    Ok(Json(runs::list(&s.db, &id).await?))
+    let (items, total) = runs::page(&s.db, &id, f.status.as_deref(), page).await?;
+    Ok(with_total(items, total))
+}
+
+/// What deleting a run removed.
+#[derive(Debug, serde::Serialize, utoipa::ToSchema)]
+pub struct DeletedRun {
+    /// The run's id.
+    pub deleted: String,
+    /// SHA-256 of the stored files removed with it (a file another run shares stays).
+    pub files_removed: Vec<String>,
+}
+
+/// Delete a run with its files (a file another run shares stays), quality
+/// report and clock offset. A run a model or discovery report was built from
+/// is kept (409 naming them): delete those models first, or exclude the run.
+#[utoipa::path(delete, path = "/api/runs/{id}", tag = "runs",
+    params(("id" = String, Path, description = "Run id")),
+    responses((status = 200, description = "Deleted: the run and the stored files that went with it", body = DeletedRun),
+              (status = 404, description = "No such run", body = ErrorBody),
+              (status = 409, description = "Models or discovery reports were built from it; the message names them", body = ErrorBody)))]
+pub async fn delete_run(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+) -> ApiResult<Json<DeletedRun>> {
+    match runs::delete(&s.db, &id).await? {
+        runs::Deleted::NotFound => Err(ApiError::NotFound(format!("no run with id '{id}'"))),
+        runs::Deleted::InUse(users) => Err(ApiError::Conflict(format!(
+            "run '{id}' is kept: {} {} built from it; delete {} first, or exclude the run from identification",
+            users.join(", "),
+            if users.len() == 1 { "was" } else { "were" },
+            if users.len() == 1 { "it" } else { "them" },
+        ))),
+        runs::Deleted::Gone(orphans) => {
+            for sha in &orphans {
+                if let Err(e) = s.blobs.remove(sha).await {
+                    tracing::warn!(sha256 = %sha, error = %e, "removing the file of a deleted run");
+                }
+            }
+            Ok(Json(DeletedRun {
+                deleted: id,
+                files_removed: orphans,
+            }))
+        }
+    }
 }
 
 /// One run: files, status, summary (rates, gaps, warnings, alignment,
@@ -313,6 +385,7 @@ pub async fn get_run(State(s): State<AppState>, Path(id): Path<String>) -> ApiRe
 
 /// Which file of a run.
 #[derive(Debug, Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct RawQuery {
     /// `file` (single-file run, the default), `control` or `nav`.
     pub file: Option<String>,
@@ -327,7 +400,7 @@ pub struct RawQuery {
 pub async fn raw_run(
     State(s): State<AppState>,
     Path(id): Path<String>,
-    Query(q): Query<RawQuery>,
+    ApiQuery(q): ApiQuery<RawQuery>,
 ) -> ApiResult<Response> {
     let run = found(runs::get(&s.db, &id).await?, "run", &id)?;
     let role = match (q.file.as_deref(), run.layout.as_str()) {

@@ -5,6 +5,7 @@
 //! [`seatrial_core::identification`]; this file loads, calls and stores.
 
 use seatrial_core::estimation::Progress;
+use seatrial_core::identification::dataset::RunInput;
 use seatrial_core::identification::{
     EkfCampaignSettings, Identified, IdentifyError, LambdaCampaignSettings, N4sidCampaignSettings,
     identify_ekf_campaign, identify_lambda_campaign, identify_n4sid_campaign,
@@ -109,16 +110,21 @@ impl JobHandler for Identify {
             check_settings(method, &req.settings)
                 .map_err(|(field, msg)| ApiError::invalid(field, msg))?;
             if req.run_ids.is_empty() {
-                let accepted = runs::list(&cx.db, cid)
-                    .await?
-                    .iter()
-                    .filter(|r| r.status == "accepted")
-                    .count();
-                if accepted < 2 {
+                let all = runs::list(&cx.db, cid).await?;
+                let usable = all.iter().filter(|r| usable_by_default(r)).count();
+                if usable < 2 {
+                    let excluded = all.iter().filter(|r| r.excluded).count();
                     return Err(ApiError::invalid(
                         "run_ids",
                         format!(
-                            "the campaign has {accepted} accepted run(s); identification needs estimation runs and a held-out validation run"
+                            "the campaign has {usable} accepted run(s) not excluded{}; identification needs estimation runs and a held-out validation run",
+                            if excluded > 0 {
+                                format!(
+                                    " ({excluded} excluded: include them again or name them in run_ids)"
+                                )
+                            } else {
+                                String::new()
+                            }
                         ),
                     ));
                 }
@@ -146,7 +152,7 @@ impl JobHandler for Identify {
                 .ok_or_else(|| JobFailure::field("campaign_id", "the vessel was deleted"))?;
             let all = runs::list(&cx.db, &cid).await?;
             let chosen: Vec<_> = if req.run_ids.is_empty() {
-                all.into_iter().filter(|r| r.status == "accepted").collect()
+                all.into_iter().filter(usable_by_default).collect()
             } else {
                 let mut v = Vec::new();
                 for id in &req.run_ids {
@@ -156,6 +162,10 @@ impl JobHandler for Identify {
                 }
                 v
             };
+            let names: Vec<(String, String)> = chosen
+                .iter()
+                .map(|r| (r.id.clone(), r.name.clone()))
+                .collect();
             let stored = run_inputs::describe(cx, &cid, chosen).await?;
             let method = req
                 .method
@@ -173,6 +183,9 @@ impl JobHandler for Identify {
             Ok(compute(move |progress: &mut dyn Progress| {
                 progress.update(0.0, "reading runs")?;
                 let (inputs, clocks) = run_inputs::read(&profile, &stored)?;
+                if method == "lambda_kf" {
+                    one_sample_rate(&inputs)?;
+                }
                 let mut sub = seatrial_core::estimation::SubProgress::new(progress, 0.05, 0.95);
                 let forces = generalized_force_columns(&profile);
                 let out: Result<Identified, IdentifyError> = match method.as_str() {
@@ -195,7 +208,11 @@ impl JobHandler for Identify {
                 };
                 let mut out = out.map_err(|e| match e {
                     IdentifyError::Cancelled => JobFailure::Cancelled,
-                    e => JobFailure::field(e.field().to_string(), e.to_string()),
+                    e => {
+                        let field = e.field().to_string();
+                        let message = run_inputs::naming_run(&field, e.to_string(), &names);
+                        JobFailure::field(field, message)
+                    }
                 })?;
                 out.document
                     .notes
@@ -225,6 +242,34 @@ impl JobHandler for Identify {
     }
 }
 
+/// Runs identification uses when the request names none: accepted and not excluded.
+fn usable_by_default(r: &crate::storage::runs::Run) -> bool {
+    r.status == "accepted" && !r.excluded
+}
+
+/// The λ-filter fit needs one sample time over its runs: a run logged at
+/// another rate fails the job naming it (name and id), not an index into
+/// the estimator's list.
+fn one_sample_rate(inputs: &[RunInput]) -> Result<(), JobFailure> {
+    let Some(first) = inputs.first() else {
+        return Ok(());
+    };
+    let fs = first.record.sample_rate_hz;
+    for r in &inputs[1..] {
+        let other = r.record.sample_rate_hz;
+        if (other - fs).abs() > 1e-9 * fs {
+            return Err(JobFailure::field(
+                format!("runs[{}]", r.run_id),
+                format!(
+                    "run '{}' ({}) is logged at {other} Hz, run '{}' ({}) at {fs} Hz: the λ-filter fit needs one sample rate; exclude one of them (PATCH /api/runs/{{id}} with excluded: true) or leave it out of run_ids",
+                    r.name, r.run_id, first.name, first.run_id
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// A model to store when the job succeeds, and the clock offsets its
 /// two-file runs were read with (reported in the job's result).
 pub struct NewModelOutput(pub NewModel, pub Vec<run_inputs::RunClock>);
@@ -245,5 +290,57 @@ impl Persist for NewModelOutput {
             }
             Ok(result)
         })
+    }
+}
+
+#[cfg(test)]
+mod manage_tests {
+    use super::*;
+    use seatrial_core::timeseries::UniformRecord;
+
+    fn input(id: &str, name: &str, fs: f64) -> RunInput {
+        RunInput {
+            run_id: id.into(),
+            name: name.into(),
+            family: None,
+            grid_speed_mps: None,
+            excited_dofs: vec![],
+            record: UniformRecord {
+                sample_rate_hz: fs,
+                t0: 0.0,
+                names: vec![],
+                data: vec![],
+                valid: vec![],
+            },
+        }
+    }
+
+    #[test]
+    fn a_run_at_another_rate_is_named_by_name_and_id() {
+        let ok = [input("r1", "DYN-1", 10.0), input("r2", "DYN-2", 10.0)];
+        assert!(one_sample_rate(&ok).is_ok());
+        let bad = [input("r1", "DYN-1", 10.0), input("r7", "bad dive", 20.0)];
+        let Err(JobFailure::Failed(e)) = one_sample_rate(&bad) else {
+            panic!("a second rate must fail the job");
+        };
+        assert_eq!(e.field.as_deref(), Some("runs[r7]"));
+        assert!(
+            e.message.contains("'bad dive' (r7)") && e.message.contains("20 Hz"),
+            "{}",
+            e.message
+        );
+    }
+
+    #[test]
+    fn errors_about_a_run_name_it() {
+        let runs = [("r1".to_string(), "DYN-1".to_string())];
+        assert_eq!(
+            run_inputs::naming_run("runs[r1].nu", "too short".into(), &runs),
+            "run 'DYN-1' (r1): too short"
+        );
+        assert_eq!(
+            run_inputs::naming_run("settings.k", "bad".into(), &runs),
+            "bad"
+        );
     }
 }

@@ -140,7 +140,12 @@ pub fn read(
     for s in stored {
         let mut summary = RunSummary::default();
         let record = processing::load_record(profile, &s.files, &s.meta, &s.priors, &mut summary)
-            .map_err(|e| JobFailure::field(format!("runs[{}]", s.id), e.message))?;
+            .map_err(|e| {
+            JobFailure::field(
+                format!("runs[{}]", s.id),
+                format!("run '{}' ({}): {}", s.name, s.id, e.message),
+            )
+        })?;
         if let Some(a) = summary.alignment {
             clocks.push(RunClock {
                 run_id: s.id.clone(),
@@ -154,4 +159,15 @@ pub fn read(
         inputs.push(s.input(record));
     }
     Ok((inputs, clocks))
+}
+
+/// An identification error's message naming the run its field points at
+/// (`runs[<run id>]…`) by name and id, so the engineer finds it.
+pub fn naming_run(field: &str, message: String, runs: &[(String, String)]) -> String {
+    runs.iter()
+        .find(|(id, _)| field.contains(&format!("[{id}]")))
+        .filter(|(id, _)| !message.contains(id.as_str()))
+        .map_or(message.clone(), |(id, name)| {
+            format!("run '{name}' ({id}): {message}")
+        })
 }

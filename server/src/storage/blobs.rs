@@ -61,6 +61,15 @@ impl BlobStore {
         self.dir.join(sha256)
     }
 
+    /// Removes the file of a blob no run references any more (its row is
+    /// already gone); a missing file is no error.
+    pub async fn remove(&self, sha256: &str) -> std::io::Result<()> {
+        match tokio::fs::remove_file(self.path(sha256)).await {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+            _ => Ok(()),
+        }
+    }
+
     /// Starts writing a blob.
     pub async fn begin(&self) -> std::io::Result<BlobWriter> {
         let tmp = self.dir.join("tmp").join(uuid::Uuid::now_v7().to_string());

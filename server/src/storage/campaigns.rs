@@ -3,7 +3,7 @@
 use seatrial_core::planning::CampaignSpec;
 use serde::Serialize;
 
-use super::{Db, new_id, now};
+use super::{Db, lock_row, new_id, now};
 
 /// A stored campaign.
 #[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
@@ -100,4 +100,27 @@ pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Campaign>> {
         .await?
         .map(Campaign::try_from)
         .transpose()
+}
+
+/// Renames a campaign (the `name` column and the stored spec), in one
+/// transaction. The renamed campaign, or None when there is no such campaign.
+pub async fn rename(db: &Db, id: &str, name: &str) -> anyhow::Result<Option<Campaign>> {
+    let mut tx = db.begin().await?;
+    if !lock_row(&mut tx, "campaign", id).await? {
+        return Ok(None);
+    }
+    let row = sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!("{SELECT} WHERE id = $1")))
+        .bind(id)
+        .fetch_one(&mut *tx)
+        .await?;
+    let mut c = Campaign::try_from(row)?;
+    c.spec.name = name.to_string();
+    sqlx::query("UPDATE campaign SET name = $1, spec = $2 WHERE id = $3")
+        .bind(name)
+        .bind(serde_json::to_string(&c.spec)?)
+        .bind(id)
+        .execute(&mut *tx)
+        .await?;
+    tx.commit().await?;
+    Ok(Some(c))
 }

@@ -64,7 +64,8 @@ impl JobState {
 #[derive(Debug, Clone, Default, Serialize, Deserialize, utoipa::ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JobRequest {
-    /// The job's kind: one of the registered handlers (e.g. `identify`, `discover`).
+    /// The job's kind: one of the registered handlers (`identify`, `discover`).
+    #[schema(value_type = JobKind)]
     pub kind: String,
     /// The campaign the runs belong to.
     #[serde(default)]
@@ -72,8 +73,11 @@ pub struct JobRequest {
     /// Runs to use; they must belong to `campaign_id` and have been accepted at upload.
     #[serde(default)]
     pub run_ids: Vec<String>,
-    /// The method, as the kind defines it (e.g. `lambda`, `ekf`, `n4sid`).
+    /// The method, as the kind defines it. `identify`: `lambda_kf` (default
+    /// for ROVs), `parallel_ekf` (default for DP vessels; DP only) or
+    /// `n4sid`; `discover` takes none.
     #[serde(default)]
+    #[schema(value_type = Option<IdentifyMethod>)]
     pub method: Option<String>,
     /// Settings of the method (a JSON object; its fields are the kind's).
     #[serde(default = "empty_object")]
@@ -82,6 +86,31 @@ pub struct JobRequest {
     /// A model to start from (discovery).
     #[serde(default)]
     pub model_id: Option<String>,
+}
+
+/// The kinds of job the service registers (documentation only: a request
+/// naming another kind is a 422 listing the registered ones).
+#[derive(utoipa::ToSchema)]
+#[schema(rename_all = "snake_case", example = "identify")]
+#[allow(dead_code)]
+pub enum JobKind {
+    /// Identification of a campaign's runs (`method`).
+    Identify,
+    /// Missing-physics discovery on a stored model (`model_id`).
+    Discover,
+}
+
+/// The methods of an `identify` job (documentation only; an unknown one is a 422).
+#[derive(utoipa::ToSchema)]
+#[schema(rename_all = "snake_case", example = "lambda_kf")]
+#[allow(dead_code)]
+pub enum IdentifyMethod {
+    /// λ-filter Kalman LPV model on forward speed.
+    LambdaKf,
+    /// DP ship by the parallel EKF (DP vessels only).
+    ParallelEkf,
+    /// Black-box subspace state-space model.
+    N4sid,
 }
 
 fn empty_object() -> serde_json::Value {
@@ -117,7 +146,10 @@ pub struct Job {
     pub kind: String,
     /// Campaign, if the job has one.
     pub campaign_id: Option<String>,
-    /// The request as submitted.
+    /// The request as submitted: a `JobRequest` (its `kind` and `method`
+    /// are those the server registers, which the `JobRequest` schema lists
+    /// for this service).
+    #[schema(value_type = Object)]
     pub request: JobRequest,
     /// Lifecycle state.
     pub state: JobState,

@@ -43,6 +43,39 @@ pub async fn open(path: &Path) -> anyhow::Result<Db> {
     Ok(pool)
 }
 
+/// A page of a list: at most `limit` items after skipping `offset`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Page {
+    /// Most items (None: all).
+    pub limit: Option<i64>,
+    /// Items skipped.
+    pub offset: i64,
+}
+
+impl Page {
+    /// The `LIMIT` to bind (every row when no limit is set).
+    pub fn sql_limit(self) -> i64 {
+        self.limit.unwrap_or(i64::MAX)
+    }
+}
+
+/// Takes the database's write lock for the caller's transaction by a no-op
+/// write to row `id` of `table` (so what it reads next cannot change before
+/// it commits); false when there is no such row.
+pub(crate) async fn lock_row(
+    conn: &mut sqlx::SqliteConnection,
+    table: &'static str,
+    id: &str,
+) -> anyhow::Result<bool> {
+    let sql = format!("UPDATE {table} SET id = id WHERE id = $1");
+    Ok(sqlx::query(sqlx::AssertSqlSafe(sql))
+        .bind(id)
+        .execute(conn)
+        .await?
+        .rows_affected()
+        > 0)
+}
+
 /// A new time-ordered id.
 pub fn new_id() -> String {
     uuid::Uuid::now_v7().to_string()

@@ -6,7 +6,7 @@
 use serde::Serialize;
 use sqlx::SqliteConnection;
 
-use super::{Db, new_id, now};
+use super::{Db, Page, lock_row, new_id, now};
 
 /// A stored model without its (large) document and validation.
 #[derive(Debug, Clone, Serialize, sqlx::FromRow, utoipa::ToSchema)]
@@ -35,6 +35,8 @@ pub struct ModelSummary {
     pub job_id: Option<String>,
     /// Creation time (RFC 3339).
     pub created_at: String,
+    /// The engineer's notes.
+    pub notes: Option<String>,
 }
 
 /// A stored model with provenance, document and validation (JSON).
@@ -93,7 +95,7 @@ pub struct NewModel {
 }
 
 const SUMMARY: &str = "id, lineage_id, version, parent_id, campaign_id, vessel_id, kind, method, \
-                       name, software_version, job_id, created_at";
+                       name, software_version, job_id, created_at, notes";
 
 /// Stores a model inside the caller's transaction (so a job's success and its
 /// model commit together); versions are assigned here.
@@ -171,25 +173,6 @@ pub async fn latest_of_method(
     )
 }
 
-/// Models, newest first, optionally of one campaign or lineage.
-pub async fn list(
-    db: &Db,
-    campaign_id: Option<&str>,
-    lineage_id: Option<&str>,
-) -> anyhow::Result<Vec<ModelSummary>> {
-    Ok(
-        sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
-            "SELECT {SUMMARY} FROM model \
-         WHERE ($1 IS NULL OR campaign_id = $1) AND ($2 IS NULL OR lineage_id = $2) \
-         ORDER BY created_at DESC, version DESC"
-        )))
-        .bind(campaign_id)
-        .bind(lineage_id)
-        .fetch_all(db)
-        .await?,
-    )
-}
-
 #[derive(sqlx::FromRow)]
 struct Heavy {
     settings: String,
@@ -224,4 +207,137 @@ pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<StoredModel>> {
         document: serde_json::from_str(&h.document)?,
         validation: serde_json::from_str(&h.validation)?,
     }))
+}
+
+/// A page of models, newest first, optionally of one campaign or lineage,
+/// and the number that match.
+pub async fn page(
+    db: &Db,
+    campaign_id: Option<&str>,
+    lineage_id: Option<&str>,
+    page: Page,
+) -> anyhow::Result<(Vec<ModelSummary>, i64)> {
+    const WHERE: &str =
+        "WHERE ($1 IS NULL OR campaign_id = $1) AND ($2 IS NULL OR lineage_id = $2)";
+    let (total,): (i64,) = sqlx::query_as(sqlx::AssertSqlSafe(format!(
+        "SELECT COUNT(*) FROM model {WHERE}"
+    )))
+    .bind(campaign_id)
+    .bind(lineage_id)
+    .fetch_one(db)
+    .await?;
+    let items = sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
+        "SELECT {SUMMARY} FROM model {WHERE} ORDER BY created_at DESC, version DESC LIMIT $3 OFFSET $4"
+    )))
+    .bind(campaign_id)
+    .bind(lineage_id)
+    .bind(page.sql_limit())
+    .bind(page.offset)
+    .fetch_all(db)
+    .await?;
+    Ok((items, total))
+}
+
+/// Renames a model and/or sets its notes (`Some(None)` clears them), in one
+/// transaction. False when there is no such model.
+pub async fn update(
+    db: &Db,
+    id: &str,
+    name: Option<&str>,
+    notes: Option<Option<&str>>,
+) -> anyhow::Result<bool> {
+    let mut tx = db.begin().await?;
+    let found = sqlx::query(
+        "UPDATE model SET name = COALESCE($1, name), \
+         notes = CASE WHEN $2 THEN $3 ELSE notes END WHERE id = $4",
+    )
+    .bind(name)
+    .bind(notes.is_some())
+    .bind(notes.flatten())
+    .bind(id)
+    .execute(&mut *tx)
+    .await?
+    .rows_affected()
+        > 0;
+    tx.commit().await?;
+    Ok(found)
+}
+
+/// What deleting a model did.
+#[derive(Debug)]
+pub enum Deleted {
+    /// No such model.
+    NotFound,
+    /// Versions derived from it (without `cascade`), or jobs waiting on it,
+    /// as phrases naming them; nothing changed.
+    InUse(Vec<String>),
+    /// The ids deleted: the model, then (with `cascade`) what was derived from it.
+    Gone(Vec<String>),
+}
+
+/// Deletes a model version with its discovery reports, in one transaction.
+/// A version another was derived from (`parent_id`) is refused unless
+/// `cascade`, which deletes the derived versions too; so is a model a queued
+/// or running job works on. Discovery reports of a deleted model go with it;
+/// a report whose augmented model is deleted keeps its text without the link.
+pub async fn delete(db: &Db, id: &str, cascade: bool) -> anyhow::Result<Deleted> {
+    let mut tx = db.begin().await?;
+    if !lock_row(&mut tx, "model", id).await? {
+        return Ok(Deleted::NotFound);
+    }
+    // The model and everything derived from it, parents before children.
+    let mut ids = vec![id.to_string()];
+    let mut i = 0;
+    while i < ids.len() {
+        let children: Vec<(String, String, i64)> = sqlx::query_as(
+            "SELECT id, name, version FROM model WHERE parent_id = $1 ORDER BY version",
+        )
+        .bind(&ids[i])
+        .fetch_all(&mut *tx)
+        .await?;
+        if !cascade && !children.is_empty() {
+            return Ok(Deleted::InUse(
+                children
+                    .into_iter()
+                    .map(|(id, name, v)| format!("model '{name}' v{v} ({id}) was derived from it"))
+                    .collect(),
+            ));
+        }
+        ids.extend(children.into_iter().map(|c| c.0));
+        i += 1;
+    }
+    let mut busy = Vec::new();
+    for m in &ids {
+        let jobs: Vec<(String, String)> = sqlx::query_as(
+            "SELECT id, kind FROM job WHERE state IN ('queued', 'running') AND request LIKE $1",
+        )
+        .bind(format!("%\"model_id\":\"{m}\"%"))
+        .fetch_all(&mut *tx)
+        .await?;
+        busy.extend(
+            jobs.into_iter()
+                .map(|(j, kind)| format!("{kind} job {j} works on model {m}")),
+        );
+    }
+    if !busy.is_empty() {
+        return Ok(Deleted::InUse(busy));
+    }
+    for m in ids.iter().rev() {
+        sqlx::query(
+            "UPDATE discrepancy SET augmented_model_id = NULL WHERE augmented_model_id = $1",
+        )
+        .bind(m)
+        .execute(&mut *tx)
+        .await?;
+        sqlx::query("DELETE FROM discrepancy WHERE model_id = $1")
+            .bind(m)
+            .execute(&mut *tx)
+            .await?;
+        sqlx::query("DELETE FROM model WHERE id = $1")
+            .bind(m)
+            .execute(&mut *tx)
+            .await?;
+    }
+    tx.commit().await?;
+    Ok(Deleted::Gone(ids))
 }

@@ -10,7 +10,9 @@ use seatrial_core::planning::{Dof, Experiment};
 use serde::Serialize;
 
 use super::blobs::StoredBlob;
-use super::{Db, new_id, now};
+use sqlx::SqliteConnection;
+
+use super::{Db, Page, lock_row, new_id, now};
 
 /// One uploaded file of a run.
 #[derive(Debug, Clone, Serialize, sqlx::FromRow, utoipa::ToSchema)]
@@ -54,6 +56,12 @@ pub struct Run {
     /// each with its source: the supervisor (`user`, wins), the matched
     /// planned experiment (`plan`), or the data (`inferred`, with the reason).
     pub description: RunDescription,
+    /// Left out of identification unless a job names it in `run_ids`.
+    pub excluded: bool,
+    /// Why it is excluded.
+    pub excluded_reason: Option<String>,
+    /// When it was excluded (RFC 3339).
+    pub excluded_at: Option<String>,
 }
 
 #[derive(sqlx::FromRow)]
@@ -74,12 +82,15 @@ struct Row {
     notes: Option<String>,
     inferred: Option<String>,
     plan_detail: Option<String>,
+    excluded: bool,
+    excluded_reason: Option<String>,
+    excluded_at: Option<String>,
 }
 
 /// The run's columns, and its planned experiment's description (if any).
 const FROM: &str = "SELECT r.id, r.campaign_id, r.experiment_id, r.name, r.layout, r.status, r.error, \
      r.summary, r.created_at, r.role, r.grid_speed_mps, r.excited_dofs, r.signal, r.notes, \
-     r.inferred, e.detail AS plan_detail \
+     r.inferred, e.detail AS plan_detail, r.excluded, r.excluded_reason, r.excluded_at \
      FROM run r LEFT JOIN experiment e ON e.id = r.experiment_id";
 
 impl Row {
@@ -137,6 +148,9 @@ async fn with_files(db: &Db, r: Row) -> anyhow::Result<Run> {
         created_at: r.created_at,
         files,
         description,
+        excluded: r.excluded,
+        excluded_reason: r.excluded_reason,
+        excluded_at: r.excluded_at,
     })
 }
 
@@ -296,11 +310,10 @@ impl DescriptionField {
     }
 }
 
-/// Writes the `fields` of what the supervisor said about a run from `user`
-/// (one statement in one transaction; fields not named keep their value, so
-/// two edits of different fields never undo each other).
-pub async fn set_description(
-    db: &Db,
+/// Writes the `fields` of what the supervisor said about a run from `user`,
+/// in the caller's transaction (one statement).
+async fn set_description(
+    conn: &mut SqliteConnection,
     id: &str,
     user: &UserDescription,
     fields: &[DescriptionField],
@@ -319,7 +332,6 @@ pub async fn set_description(
         sets.join(", "),
         fields.len() + 1
     );
-    let mut tx = db.begin().await?;
     let mut q = sqlx::query(sqlx::AssertSqlSafe(sql));
     for f in fields {
         q = match f {
@@ -330,8 +342,7 @@ pub async fn set_description(
             DescriptionField::Notes => q.bind(user.notes.clone()),
         };
     }
-    q.bind(id).execute(&mut *tx).await?;
-    tx.commit().await?;
+    q.bind(id).execute(&mut *conn).await?;
     Ok(())
 }
 
@@ -388,4 +399,168 @@ pub async fn quality(db: &Db, id: &str) -> anyhow::Result<Option<String>> {
             .fetch_optional(db)
             .await?,
     )
+}
+
+/// A page of a campaign's runs, oldest first, optionally of one status, and
+/// the number of runs that match.
+pub async fn page(
+    db: &Db,
+    campaign_id: &str,
+    status: Option<&str>,
+    page: Page,
+) -> anyhow::Result<(Vec<Run>, i64)> {
+    let (total,): (i64,) = sqlx::query_as(
+        "SELECT COUNT(*) FROM run WHERE campaign_id = $1 AND ($2 IS NULL OR status = $2)",
+    )
+    .bind(campaign_id)
+    .bind(status)
+    .fetch_one(db)
+    .await?;
+    let rows = sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!(
+        "{FROM} WHERE r.campaign_id = $1 AND ($2 IS NULL OR r.status = $2) ORDER BY r.id LIMIT $3 OFFSET $4"
+    )))
+    .bind(campaign_id)
+    .bind(status)
+    .bind(page.sql_limit())
+    .bind(page.offset)
+    .fetch_all(db)
+    .await?;
+    let mut out = Vec::with_capacity(rows.len());
+    for r in rows {
+        out.push(with_files(db, r).await?);
+    }
+    Ok((out, total))
+}
+
+/// A change to a run's name or exclusion, beside its description.
+#[derive(Debug, Default, Clone)]
+pub struct RunUpdate {
+    /// New name.
+    pub name: Option<String>,
+    /// `Some(Some(reason))`: exclude from identification; `Some(None)`: include again.
+    pub exclusion: Option<Option<String>>,
+}
+
+/// Writes the `fields` of what the supervisor said about a run from `user`
+/// and the name and exclusion of `update`, in one transaction (fields not
+/// named keep their value, so two edits of different fields never undo each
+/// other). False when there is no such run.
+pub async fn update(
+    db: &Db,
+    id: &str,
+    user: &UserDescription,
+    fields: &[DescriptionField],
+    update: &RunUpdate,
+) -> anyhow::Result<bool> {
+    let mut tx = db.begin().await?;
+    if !lock_row(&mut tx, "run", id).await? {
+        return Ok(false);
+    }
+    if let Some(name) = &update.name {
+        sqlx::query("UPDATE run SET name = $1 WHERE id = $2")
+            .bind(name)
+            .bind(id)
+            .execute(&mut *tx)
+            .await?;
+    }
+    if let Some(exclusion) = &update.exclusion {
+        sqlx::query(
+            "UPDATE run SET excluded = $1, excluded_reason = $2, \
+             excluded_at = CASE WHEN $1 THEN COALESCE(CASE WHEN excluded THEN excluded_at END, $3) END \
+             WHERE id = $4",
+        )
+        .bind(exclusion.is_some())
+        .bind(exclusion)
+        .bind(now())
+        .bind(id)
+        .execute(&mut *tx)
+        .await?;
+    }
+    set_description(&mut tx, id, user, fields).await?;
+    tx.commit().await?;
+    Ok(true)
+}
+
+/// What is built from a run: the models (estimation or validation) and the
+/// discovery reports that used it, as `kind 'name' v<version> (id)` phrases.
+pub async fn users(conn: &mut SqliteConnection, id: &str) -> anyhow::Result<Vec<String>> {
+    // Ids are UUIDs: a quoted id matches exactly one element of a JSON list.
+    let quoted = format!("%\"{id}\"%");
+    let models: Vec<(String, String, i64)> = sqlx::query_as(
+        "SELECT id, name, version FROM model WHERE run_ids LIKE $1 OR validation_run_ids LIKE $1 \
+         ORDER BY created_at",
+    )
+    .bind(&quoted)
+    .fetch_all(&mut *conn)
+    .await?;
+    let reports: Vec<(String,)> = sqlx::query_as(
+        "SELECT id FROM discrepancy WHERE run_ids LIKE $1 OR validation_run_ids LIKE $1 \
+         ORDER BY created_at",
+    )
+    .bind(&quoted)
+    .fetch_all(&mut *conn)
+    .await?;
+    Ok(models
+        .into_iter()
+        .map(|(id, name, v)| format!("model '{name}' v{v} ({id})"))
+        .chain(
+            reports
+                .into_iter()
+                .map(|(id,)| format!("discovery report {id}")),
+        )
+        .collect())
+}
+
+/// What deleting a run did.
+#[derive(Debug)]
+pub enum Deleted {
+    /// No such run.
+    NotFound,
+    /// Models or reports were built from it (phrases naming them); nothing changed.
+    InUse(Vec<String>),
+    /// Deleted; these blobs are no longer referenced by any run (their files may go).
+    Gone(Vec<String>),
+}
+
+/// Deletes a run with its files' rows, quality report and clock offset, in
+/// one transaction, unless a model or discovery report was built from it.
+pub async fn delete(db: &Db, id: &str) -> anyhow::Result<Deleted> {
+    let mut tx = db.begin().await?;
+    // The write lock first: no model can be stored from the run between the
+    // check and the delete.
+    if !lock_row(&mut tx, "run", id).await? {
+        return Ok(Deleted::NotFound);
+    }
+    let users = users(&mut tx, id).await?;
+    if !users.is_empty() {
+        return Ok(Deleted::InUse(users));
+    }
+    let blobs: Vec<(String,)> = sqlx::query_as("SELECT sha256 FROM run_file WHERE run_id = $1")
+        .bind(id)
+        .fetch_all(&mut *tx)
+        .await?;
+    for sql in [
+        "DELETE FROM run_quality WHERE run_id = $1",
+        "DELETE FROM run_clock_offset WHERE run_id = $1",
+        "DELETE FROM run_file WHERE run_id = $1",
+        "DELETE FROM run WHERE id = $1",
+    ] {
+        sqlx::query(sql).bind(id).execute(&mut *tx).await?;
+    }
+    let mut orphans = Vec::new();
+    for (sha,) in blobs {
+        let deleted = sqlx::query(
+            "DELETE FROM blob WHERE sha256 = $1 \
+             AND NOT EXISTS (SELECT 1 FROM run_file WHERE sha256 = $1)",
+        )
+        .bind(&sha)
+        .execute(&mut *tx)
+        .await?
+        .rows_affected();
+        if deleted > 0 {
+            orphans.push(sha);
+        }
+    }
+    tx.commit().await?;
+    Ok(Deleted::Gone(orphans))
 }

@@ -29,7 +29,8 @@ pub enum SpeedUnit {
 pub struct SpeedGrid {
     /// Unit of `speeds` as entered.
     pub unit: SpeedUnit,
-    /// Forward speeds, ascending.
+    /// Forward speeds, ascending (1–50 of them).
+    #[cfg_attr(feature = "openapi", schema(min_items = 1, max_items = 50))]
     pub speeds: Vec<f64>,
 }
 
@@ -234,11 +235,16 @@ pub const MAX_REPETITIONS: u32 = 10;
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
 pub struct CampaignSpec {
-    /// Name, e.g. "Stril Explorer, March".
+    /// Name, e.g. "Stril Explorer, March" (1–200 characters, not blank).
+    #[cfg_attr(
+        feature = "openapi",
+        schema(min_length = 1, max_length = 200, pattern = r"\S")
+    )]
     pub name: String,
     /// Forward-speed grid.
     pub grid: SpeedGrid,
-    /// Families to fly.
+    /// Families to fly (at least one, each once).
+    #[cfg_attr(feature = "openapi", schema(min_items = 1))]
     pub families: Vec<ExperimentFamily>,
     /// Repetitions per grid point × DOF (N ≥ 2 for the parallel EKF of DP vessels).
     /// Default: 1 for a ROV, 2 for a DP vessel.

@@ -45,7 +45,7 @@ pub fn check_name(field: &str, name: &str) -> Result<(), PlanError> {
     if name.trim().is_empty() {
         return Err(PlanError::invalid(field, "must not be empty"));
     }
-    if name.len() > MAX_NAME_LEN {
+    if name.chars().count() > MAX_NAME_LEN {
         return Err(PlanError::invalid(
             field,
             format!("must be at most {MAX_NAME_LEN} characters"),

@@ -154,11 +154,16 @@ impl DpPrior {
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 #[serde(deny_unknown_fields)]
 pub struct VesselProfile {
-    /// Name, e.g. "Surveyor ROV".
+    /// Name, e.g. "Surveyor ROV" (1–200 characters, not blank).
+    #[cfg_attr(
+        feature = "openapi",
+        schema(min_length = 1, max_length = 200, pattern = r"\S")
+    )]
     pub name: String,
     /// ROV or DP vessel.
     pub kind: VesselKind,
-    /// Modeled DOFs (surge is required: it is the LPV scheduling variable).
+    /// Modeled DOFs (surge is required: it is the LPV scheduling variable), each once.
+    #[cfg_attr(feature = "openapi", schema(min_items = 1, max_items = 6))]
     pub dofs: Vec<Dof>,
     /// Input channels.
     pub inputs: InputChannels,

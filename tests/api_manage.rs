@@ -1,0 +1,504 @@
+//! Managing data and models (issue 16): what the contract promises about
+//! requests — integral floats where integers are meant, names by characters.
+
+mod common;
+
+use common::{TestApp, rov_profile, sim};
+use serde_json::json;
+
+/// A vessel and a campaign on it; their ids.
+async fn vessel_and_campaign(app: &TestApp, spec: serde_json::Value) -> (String, String) {
+    let r = app
+        .call("POST", "/api/vessels", &[], Some(rov_profile()))
+        .await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let vid = r.json["id"].as_str().unwrap().to_string();
+    let mut body = json!({
+        "vessel_id": vid, "name": "manage", "seed": 3,
+        "grid": { "unit": "kn", "speeds": [1.0] },
+        "families": ["dynamic"]
+    });
+    for (k, v) in spec.as_object().unwrap() {
+        body[k] = v.clone();
+    }
+    let r = app.call("POST", "/api/campaigns", &[], Some(body)).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    (vid, r.json["id"].as_str().unwrap().to_string())
+}
+
+#[tokio::test]
+async fn integral_floats_are_accepted_where_integers_are_meant() {
+    let app = TestApp::new().await;
+    // JSON: a seed and repetitions written as floats with a zero fraction.
+    let (_, cid) = vessel_and_campaign(&app, json!({ "seed": 7489.0, "repetitions": 2.0 })).await;
+    let r = app.call("GET", "/api/campaigns/{id}", &[&cid], None).await;
+    assert_eq!(r.json["spec"]["seed"], 7489, "{}", r.text);
+    assert_eq!(r.json["spec"]["repetitions"], 2, "{}", r.text);
+    // A fraction is still refused, naming the field.
+    let r = app.call("GET", "/api/vessels", &[], None).await;
+    let vid = r.json[0]["id"].as_str().unwrap().to_string();
+    let r = app
+        .call(
+            "POST",
+            "/api/campaigns",
+            &[],
+            Some(json!({ "vessel_id": vid, "name": "x", "seed": 7489.5,
+                         "grid": { "unit": "kn", "speeds": [1.0] }, "families": ["dynamic"] })),
+        )
+        .await;
+    assert_eq!(r.status, 400, "{}", r.text);
+    assert_eq!(r.json["field"], "seed", "{}", r.text);
+    // Query string: `limit=2.0` is the integer 2 (k, limit, offset alike).
+    let r = app
+        .call(
+            "GET",
+            "/api/campaigns/{id}/runs?limit=2.0&offset=0.0",
+            &[&cid],
+            None,
+        )
+        .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.headers["x-total-count"], "0", "{}", r.text);
+    // A fraction is refused, naming the parameter.
+    let r = app
+        .call("GET", "/api/campaigns/{id}/runs?limit=2.5", &[&cid], None)
+        .await;
+    assert_eq!(r.status, 400, "{}", r.text);
+    assert!(r.text.contains("limit"), "{}", r.text);
+}
+
+#[tokio::test]
+async fn names_are_limited_in_characters_not_bytes() {
+    let app = TestApp::new().await;
+    // 200 two-byte characters: within the documented 1–200 characters.
+    let (_, cid) = vessel_and_campaign(&app, json!({ "name": "é".repeat(200) })).await;
+    assert!(!cid.is_empty());
+    let r = app.call("GET", "/api/vessels", &[], None).await;
+    let vid = r.json[0]["id"].as_str().unwrap().to_string();
+    for (name, field) in [("é".repeat(201), "name"), ("  ".to_string(), "name")] {
+        let r = app
+            .call(
+                "POST",
+                "/api/campaigns",
+                &[],
+                Some(json!({ "vessel_id": vid, "name": name,
+                             "grid": { "unit": "kn", "speeds": [1.0] }, "families": ["dynamic"] })),
+            )
+            .await;
+        assert_eq!(r.status, 422, "{}", r.text);
+        assert_eq!(r.json["field"], field, "{}", r.text);
+    }
+}
+
+/// A run uploaded as `csv` named `name`; its id.
+async fn upload(app: &TestApp, cid: &str, name: &str, csv: &str) -> common::Resp {
+    let meta = json!({ "name": name }).to_string();
+    app.upload_run(
+        cid,
+        &[("meta", None, &meta), ("file", Some("log.csv"), csv)],
+    )
+    .await
+}
+
+fn log(seed: u64) -> String {
+    sim::csv(
+        &sim::simulate(seed, 10.0, 300.0, [300.0; 6], 2.0, 1e-4),
+        &sim::all_columns(),
+        0.0,
+        1,
+    )
+}
+
+/// Asserts a refusal with `status` naming `field`.
+fn refused(r: &common::Resp, status: u16, field: &str) {
+    assert_eq!(
+        (r.status.as_u16(), r.json["field"].as_str()),
+        (status, Some(field)),
+        "{}",
+        r.text
+    );
+}
+
+fn total(r: &common::Resp) -> i64 {
+    r.headers["x-total-count"]
+        .to_str()
+        .unwrap()
+        .parse()
+        .unwrap()
+}
+
+fn id(r: &common::Resp) -> String {
+    r.json["id"].as_str().unwrap().to_string()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn runs_are_renamed_excluded_paged_and_deleted_with_their_files() {
+    // The production job kinds, no worker: submissions are checked, nothing runs.
+    let app = TestApp::with_jobs(
+        seatrial::jobs::JobRegistry::production(),
+        common::jobs::config(0),
+    )
+    .await;
+    let (vid, cid) = vessel_and_campaign(&app, json!({})).await;
+    let (one, two) = (log(1), log(2));
+    let a = id(&upload(&app, &cid, "a", &one).await);
+    let b = id(&upload(&app, &cid, "b (same bytes as a)", &one).await);
+    let c = id(&upload(&app, &cid, "c", &two).await);
+    let r = upload(&app, &cid, "bad", "t,u\n0,x\n").await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    let bad = r.json["run_id"].as_str().unwrap().to_string();
+
+    // Rename, exclude with a reason, include again.
+    let patch = |rid: String, body: serde_json::Value| {
+        let app = &app;
+        async move {
+            app.call("PATCH", "/api/runs/{id}", &[&rid], Some(body))
+                .await
+        }
+    };
+    let r = patch(a.clone(), json!({ "name": "  dive 3  " })).await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["name"].as_str()),
+        (200, Some("dive 3")),
+        "{}",
+        r.text
+    );
+    let r = patch(a.clone(), json!({ "excluded": true })).await;
+    refused(&r, 422, "excluded_reason");
+    let r = patch(a.clone(), json!({ "excluded": true, "excluded_reason": "thruster 2 failed", "notes": "kept for the record" })).await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["excluded"], true);
+    assert_eq!(r.json["excluded_reason"], "thruster 2 failed");
+    assert!(r.json["excluded_at"].is_string(), "{}", r.text);
+    assert_eq!(
+        r.json["description"]["notes"]["value"], "kept for the record",
+        "{}",
+        r.text
+    );
+    let r = app
+        .call("GET", "/api/campaigns/{id}/runs", &[&cid], None)
+        .await;
+    let listed: Vec<bool> = r
+        .json
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["excluded"] == true)
+        .collect();
+    assert_eq!(listed, [true, false, false, false], "{}", r.text);
+    for (body, field) in [
+        (json!({ "name": "" }), "name"),
+        (json!({ "name": "x".repeat(201) }), "name"),
+        (json!({ "excluded_reason": "why" }), "excluded_reason"),
+        (json!({ "excluded": "yes" }), "excluded"),
+        (json!({ "colour": "red" }), "colour"),
+    ] {
+        let r = patch(b.clone(), body.clone()).await;
+        assert_eq!(
+            (r.status.as_u16(), r.json["field"].as_str()),
+            (422, Some(field)),
+            "{body}: {}",
+            r.text
+        );
+        assert!(r.json["message"].as_str().unwrap().len() > 5);
+    }
+    let r = patch("no-such-run".into(), json!({ "name": "x" })).await;
+    assert_eq!(r.status, 404, "{}", r.text);
+    let r = patch(a.clone(), json!({ "excluded": false })).await;
+    assert_eq!(
+        (
+            r.json["excluded"].as_bool(),
+            r.json["excluded_reason"].is_null()
+        ),
+        (Some(false), true),
+        "{}",
+        r.text
+    );
+
+    // An excluded run is not used by default: with one usable run left, identify is refused.
+    for rid in [&a, &b] {
+        patch(
+            rid.clone(),
+            json!({ "excluded": true, "excluded_reason": "test" }),
+        )
+        .await;
+    }
+    let r = app
+        .call(
+            "POST",
+            "/api/jobs",
+            &[],
+            Some(json!({ "kind": "identify", "campaign_id": cid })),
+        )
+        .await;
+    refused(&r, 422, "run_ids");
+    assert!(
+        r.json["message"].as_str().unwrap().contains("2 excluded"),
+        "{}",
+        r.text
+    );
+    // Named in run_ids, an excluded run is used: the request is accepted.
+    let r = app
+        .call(
+            "POST",
+            "/api/jobs",
+            &[],
+            Some(json!({ "kind": "identify", "campaign_id": cid, "run_ids": [a, c] })),
+        )
+        .await;
+    assert_eq!(r.status, 202, "{}", r.text);
+    app.call(
+        "POST",
+        "/api/jobs/{id}/cancel",
+        &[r.json["id"].as_str().unwrap()],
+        None,
+    )
+    .await;
+
+    // Pages with the total in X-Total-Count; rejected uploads listed apart.
+    let r = app
+        .call("GET", "/api/campaigns/{id}/runs?limit=2", &[&cid], None)
+        .await;
+    assert_eq!(
+        (r.json.as_array().unwrap().len(), total(&r)),
+        (2, 4),
+        "{}",
+        r.text
+    );
+    let r = app
+        .call(
+            "GET",
+            "/api/campaigns/{id}/runs?limit=2&offset=3",
+            &[&cid],
+            None,
+        )
+        .await;
+    assert_eq!(r.json.as_array().unwrap().len(), 1, "{}", r.text);
+    assert_eq!(r.json[0]["id"], bad.as_str());
+    let r = app
+        .call(
+            "GET",
+            "/api/campaigns/{id}/runs?status=rejected",
+            &[&cid],
+            None,
+        )
+        .await;
+    assert_eq!(
+        (r.json.as_array().unwrap().len(), total(&r)),
+        (1, 1),
+        "{}",
+        r.text
+    );
+    for (q, field) in [
+        ("limit=0", "limit"),
+        ("limit=1001", "limit"),
+        ("status=lost", "status"),
+    ] {
+        let r = app
+            .call(
+                "GET",
+                &format!("/api/campaigns/{{id}}/runs?{q}"),
+                &[&cid],
+                None,
+            )
+            .await;
+        assert_eq!(
+            (r.status.as_u16(), r.json["field"].as_str()),
+            (422, Some(field)),
+            "{q}: {}",
+            r.text
+        );
+    }
+    let r = app
+        .call("GET", "/api/campaigns/{id}/runs", &["nope"], None)
+        .await;
+    assert_eq!(r.status, 404);
+
+    // A run a model was built from is kept, naming the model.
+    let mid = common::stored_model(&app, &cid, &vid, None, &[&c]).await;
+    let r = app.call("DELETE", "/api/runs/{id}", &[&c], None).await;
+    assert_eq!(r.status, 409, "{}", r.text);
+    assert!(
+        r.json["message"].as_str().unwrap().contains(&mid),
+        "{}",
+        r.text
+    );
+
+    // Deleting a run keeps a file another run shares, and removes it with the last.
+    let sha = {
+        let r = app.call("GET", "/api/runs/{id}", &[&a], None).await;
+        r.json["files"][0]["sha256"].as_str().unwrap().to_string()
+    };
+    let path = app.state.blobs.path(&sha);
+    let r = app.call("DELETE", "/api/runs/{id}", &[&a], None).await;
+    assert_eq!(
+        (
+            r.status.as_u16(),
+            r.json["files_removed"].as_array().unwrap().len()
+        ),
+        (200, 0),
+        "{}",
+        r.text
+    );
+    assert!(path.exists());
+    let r = app.call("DELETE", "/api/runs/{id}", &[&b], None).await;
+    assert_eq!(r.json["files_removed"][0], sha.as_str(), "{}", r.text);
+    assert!(!path.exists());
+    assert_eq!(
+        app.call("GET", "/api/runs/{id}", &[&a], None).await.status,
+        404
+    );
+    assert_eq!(
+        app.call("DELETE", "/api/runs/{id}", &[&a], None)
+            .await
+            .status,
+        404
+    );
+    // A rejected upload is removable too.
+    assert_eq!(
+        app.call("DELETE", "/api/runs/{id}", &[&bad], None)
+            .await
+            .status,
+        200
+    );
+    let r = app
+        .call("GET", "/api/campaigns/{id}/runs", &[&cid], None)
+        .await;
+    assert_eq!(total(&r), 1, "{}", r.text);
+}
+
+#[tokio::test]
+async fn model_versions_are_deleted_unless_derived_from_and_campaigns_renamed() {
+    let app = TestApp::new().await;
+    let (vid, cid) = vessel_and_campaign(&app, json!({})).await;
+    let v1 = common::stored_model(&app, &cid, &vid, None, &[]).await;
+    let v2 = common::stored_model(&app, &cid, &vid, Some(&v1), &[]).await;
+
+    let r = app.call("GET", "/api/models?limit=1", &[], None).await;
+    assert_eq!(
+        (r.json.as_array().unwrap().len(), total(&r)),
+        (1, 2),
+        "{}",
+        r.text
+    );
+    assert_eq!(r.json[0]["id"], v2.as_str(), "newest first");
+
+    // v2 was derived from v1: 409 naming it, unless cascade.
+    let r = app.call("DELETE", "/api/models/{id}", &[&v1], None).await;
+    assert_eq!(r.status, 409, "{}", r.text);
+    let msg = r.json["message"].as_str().unwrap();
+    assert!(msg.contains(&v2) && msg.contains("cascade"), "{msg}");
+    let r = app.call("DELETE", "/api/models/{id}", &[&v2], None).await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["deleted"].clone()),
+        (200, json!([v2])),
+        "{}",
+        r.text
+    );
+    assert_eq!(
+        app.call("GET", "/api/models/{id}", &[&v2], None)
+            .await
+            .status,
+        404
+    );
+    let v3 = common::stored_model(&app, &cid, &vid, Some(&v1), &[]).await;
+    let r = app
+        .call("DELETE", "/api/models/{id}?cascade=true", &[&v1], None)
+        .await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["deleted"].clone()),
+        (200, json!([v1, v3])),
+        "{}",
+        r.text
+    );
+    assert_eq!(
+        app.call("DELETE", "/api/models/{id}", &[&v1], None)
+            .await
+            .status,
+        404
+    );
+    let r = app
+        .call("DELETE", "/api/models/{id}?cascade=maybe", &[&v1], None)
+        .await;
+    assert_eq!(r.status, 400, "{}", r.text);
+
+    // Rename and annotate a model.
+    let m = common::stored_model(&app, &cid, &vid, None, &[]).await;
+    let r = app
+        .call(
+            "PATCH",
+            "/api/models/{id}",
+            &[&m],
+            Some(json!({ "name": "Surveyor, final", "notes": "for the DP tuning" })),
+        )
+        .await;
+    assert_eq!(
+        (r.json["name"].as_str(), r.json["notes"].as_str()),
+        (Some("Surveyor, final"), Some("for the DP tuning")),
+        "{}",
+        r.text
+    );
+    let r = app
+        .call(
+            "PATCH",
+            "/api/models/{id}",
+            &[&m],
+            Some(json!({ "notes": null })),
+        )
+        .await;
+    assert_eq!(
+        (r.json["name"].as_str(), r.json["notes"].is_null()),
+        (Some("Surveyor, final"), true),
+        "{}",
+        r.text
+    );
+    let r = app
+        .call(
+            "PATCH",
+            "/api/models/{id}",
+            &[&m],
+            Some(json!({ "name": " " })),
+        )
+        .await;
+    refused(&r, 422, "name");
+    let r = app
+        .call(
+            "PATCH",
+            "/api/models/{id}",
+            &["nope"],
+            Some(json!({ "name": "x" })),
+        )
+        .await;
+    assert_eq!(r.status, 404, "{}", r.text);
+
+    // Rename a campaign.
+    let r = app
+        .call(
+            "PATCH",
+            "/api/campaigns/{id}",
+            &[&cid],
+            Some(json!({ "name": "March trials" })),
+        )
+        .await;
+    assert_eq!(r.json["spec"]["name"], "March trials", "{}", r.text);
+    let r = app.call("GET", "/api/campaigns/{id}", &[&cid], None).await;
+    assert_eq!(r.json["spec"]["name"], "March trials");
+    let r = app
+        .call(
+            "PATCH",
+            "/api/campaigns/{id}",
+            &[&cid],
+            Some(json!({ "name": "" })),
+        )
+        .await;
+    refused(&r, 422, "name");
+    let r = app
+        .call(
+            "PATCH",
+            "/api/campaigns/{id}",
+            &["nope"],
+            Some(json!({ "name": "x" })),
+        )
+        .await;
+    assert_eq!(r.status, 404, "{}", r.text);
+}
