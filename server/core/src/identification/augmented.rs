@@ -235,45 +235,17 @@ impl Predictor for AugmentedLpv {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identification::document::{LpvDoc, Method, ModelKind};
+    use crate::identification::tests::lpv_doc;
 
     fn doc(d_fast: f64) -> ModelDocument {
-        let point = |speed: f64, d: f64| LpvPoint {
-            load: None,
-            load_std: None,
-            speed_mps: speed,
-            m: vec![vec![100.0, 0.0], vec![0.0, 50.0]],
-            m_std: vec![vec![0.0; 2]; 2],
-            d_bar: vec![vec![d, 0.0], vec![0.0, 25.0]],
-            d_bar_std: vec![vec![0.0; 2]; 2],
-            a: vec![vec![0.0; 2]; 2],
-            a_std: vec![vec![0.0; 2]; 2],
-            b: vec![vec![0.0; 2]; 2],
-            b_std: vec![vec![0.0; 2]; 2],
-            n_samples: 0,
-            run_ids: vec![],
-            augmentation: None,
-        };
-        ModelDocument {
-            kind: ModelKind::Lpv,
-            method: Method::LambdaKf,
-            dofs: vec![Dof::Surge, Dof::Yaw],
-            inputs: vec![],
-            outputs: vec!["u".into(), "r".into()],
-            restoring: None,
-            lpv: Some(LpvDoc {
-                t_lambda_s: 0.5,
-                structure: "diagonal".into(),
-                coupling: vec![],
-                points: vec![point(0.5, 50.0), point(1.5, d_fast)],
-                logged_controller: None,
-            }),
-            dp_ship: None,
-            state_space: None,
-            parameters: vec![],
-            structure_findings: vec![],
-            notes: vec![],
-        }
+        let m = vec![vec![100.0, 0.0], vec![0.0, 50.0]];
+        let d = |d: f64| vec![vec![d, 0.0], vec![0.0, 25.0]];
+        let mut doc = lpv_doc(
+            vec![Dof::Surge, Dof::Yaw],
+            vec![(0.5, m.clone(), d(50.0)), (1.5, m, d(d_fast))],
+        );
+        doc.outputs = vec!["u".into(), "r".into()];
+        doc
     }
 
     /// A run that steps from 0.5 to 1.5 m/s half way: u = [τ | η], y = ν.

@@ -92,49 +92,20 @@ pub fn discretize(doc: &ModelDocument, h: f64) -> Result<DiscreteModel, String> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identification::document::{LpvDoc, LpvPoint, Method};
+    use crate::identification::tests::lpv_doc;
     use crate::planning::dof::Dof;
 
     #[test]
     fn scalar_lpv_points_match_the_analytic_zoh() {
         // ν̇ = −(D/M) ν + γ/M: Φ = e^{−Dh/M}, Γ = (1 − Φ)/D.
         let (m, d, h) = (2000.0, 500.0, 0.1);
-        let point = |speed: f64, d: f64| LpvPoint {
-            load: None,
-            load_std: None,
-            speed_mps: speed,
-            m: vec![vec![m]],
-            m_std: vec![vec![0.0]],
-            d_bar: vec![vec![d]],
-            d_bar_std: vec![vec![0.0]],
-            a: vec![vec![-d / m]],
-            a_std: vec![vec![0.0]],
-            b: vec![vec![1.0 / m]],
-            b_std: vec![vec![0.0]],
-            n_samples: 1,
-            run_ids: vec![],
-            augmentation: None,
-        };
-        let doc = ModelDocument {
-            kind: ModelKind::Lpv,
-            method: Method::LambdaKf,
-            dofs: vec![Dof::Surge],
-            inputs: vec![],
-            outputs: vec![],
-            restoring: None,
-            lpv: Some(LpvDoc {
-                t_lambda_s: 1.0,
-                structure: "diagonal".into(),
-                coupling: vec![vec![true]],
-                points: vec![point(0.5, d), point(1.0, 2.0 * d)],
-                logged_controller: None,
-            }),
-            dp_ship: None,
-            state_space: None,
-            parameters: vec![],
-            structure_findings: vec![],
-            notes: vec![],
-        };
+        let doc = lpv_doc(
+            vec![Dof::Surge],
+            vec![
+                (0.5, vec![vec![m]], vec![vec![d]]),
+                (1.0, vec![vec![m]], vec![vec![2.0 * d]]),
+            ],
+        );
         let dm = discretize(&doc, h).unwrap();
         for (p, d) in dm.points.iter().zip([d, 2.0 * d]) {
             let phi = (-d * h / m).exp();

@@ -258,69 +258,52 @@ pub fn matlab_script(doc: &ModelDocument, name: &str, version: i64) -> String {
 mod tests {
     use super::*;
     use crate::estimation::restoring::RestoringParams;
-    use crate::identification::document::{
-        LoggedController, LpvDoc, LpvPoint, Method, ModelKind, ParameterRow, RestoringDoc,
-    };
+    use crate::identification::document::{LoggedController, ParameterRow, RestoringDoc};
+    use crate::identification::tests::lpv_doc;
     use crate::planning::dof::Dof;
 
     fn doc() -> ModelDocument {
-        let point = |u: f64| LpvPoint {
-            speed_mps: u,
-            m: vec![vec![512.25, -3.5e-7], vec![-3.5e-7, 61.0]],
-            m_std: vec![vec![2.0, 0.1], vec![0.1, 0.5]],
-            d_bar: vec![vec![100.0 * u, 0.0], vec![1e-300, 25.0]],
-            d_bar_std: vec![vec![1.0; 2]; 2],
-            a: vec![vec![-0.2, 0.0], vec![0.0, -0.4]],
-            a_std: vec![vec![0.01; 2]; 2],
-            b: vec![vec![1.0 / 512.25, 0.0], vec![0.0, 1.0 / 61.0]],
-            b_std: vec![vec![1e-5; 2]; 2],
-            load: Some(vec![3.0, -0.25]),
-            load_std: Some(vec![0.1, 0.01]),
-            n_samples: 100,
-            run_ids: vec![],
-            augmentation: None,
-        };
-        ModelDocument {
-            kind: ModelKind::Lpv,
-            method: Method::LambdaKf,
-            dofs: vec![Dof::Surge, Dof::Yaw],
-            inputs: vec!["tau_X".into(), "tau_N".into()],
-            outputs: vec!["u".into(), "r".into()],
-            restoring: Some(RestoringDoc {
-                parameters: vec![],
-                evidence: vec![],
-                params: RestoringParams {
-                    weight_minus_buoyancy_n: 67.5,
-                    zg_weight_minus_zb_buoyancy_nm: 275.25,
-                    tether_pitch_moment_nm: 0.0,
-                },
-            }),
-            lpv: Some(LpvDoc {
-                t_lambda_s: 0.5,
-                structure: "diagonal".into(),
-                coupling: vec![],
-                points: vec![point(0.5), point(1.5)],
-                logged_controller: Some(LoggedController {
-                    rate_hz: 20.0,
-                    log_h_s: 0.1,
-                    c_s: 0.025,
-                    k_nu: vec![vec![-400.0, 0.0], vec![0.0, -60.0]],
-                    k_attitude: vec![vec![0.0; 2]; 2],
-                }),
-            }),
-            dp_ship: None,
-            state_space: None,
-            parameters: vec![ParameterRow {
-                group: "M".into(),
-                symbol: "M[surge,surge]".into(),
-                grid_speed_mps: Some(0.5),
-                value: 512.25,
-                std: None,
-                unit: "kg".into(),
-            }],
-            structure_findings: vec![],
-            notes: vec!["the pilot's note: it's fine".into()],
+        let m = vec![vec![512.25, -3.5e-7], vec![-3.5e-7, 61.0]];
+        let d = |u: f64| vec![vec![100.0 * u, 0.0], vec![1e-300, 25.0]];
+        let mut doc = lpv_doc(
+            vec![Dof::Surge, Dof::Yaw],
+            vec![(0.5, m.clone(), d(0.5)), (1.5, m, d(1.5))],
+        );
+        doc.inputs = vec!["tau_X".into(), "tau_N".into()];
+        doc.outputs = vec!["u".into(), "r".into()];
+        doc.restoring = Some(RestoringDoc {
+            parameters: vec![],
+            evidence: vec![],
+            params: RestoringParams {
+                weight_minus_buoyancy_n: 67.5,
+                zg_weight_minus_zb_buoyancy_nm: 275.25,
+                tether_pitch_moment_nm: 0.0,
+            },
+        });
+        let lpv = doc.lpv.as_mut().unwrap();
+        for p in &mut lpv.points {
+            p.m_std = vec![vec![2.0, 0.1], vec![0.1, 0.5]];
+            p.b_std = vec![vec![1e-5; 2]; 2];
+            p.load = Some(vec![3.0, -0.25]);
+            p.load_std = Some(vec![0.1, 0.01]);
         }
+        lpv.logged_controller = Some(LoggedController {
+            rate_hz: 20.0,
+            log_h_s: 0.1,
+            c_s: 0.025,
+            k_nu: vec![vec![-400.0, 0.0], vec![0.0, -60.0]],
+            k_attitude: vec![vec![0.0; 2]; 2],
+        });
+        doc.parameters = vec![ParameterRow {
+            group: "M".into(),
+            symbol: "M[surge,surge]".into(),
+            grid_speed_mps: Some(0.5),
+            value: 512.25,
+            std: None,
+            unit: "kg".into(),
+        }];
+        doc.notes = vec!["the pilot's note: it's fine".into()];
+        doc
     }
 
     /// Reads `name = [..; ..];` back into rows of numbers.

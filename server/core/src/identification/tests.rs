@@ -298,3 +298,58 @@ fn a_stored_model_validates_on_a_run_as_it_did_at_identification() {
         }
     }
 }
+
+/// A λ LPV document over `dofs` with one sub-model per (speed, M, D̄):
+/// A = −M⁻¹D̄, B = M⁻¹ (zero when M is singular), zero stds, no loads, no
+/// restoring — the fixture tests adjust what they need.
+pub(crate) fn lpv_doc(
+    dofs: Vec<crate::planning::dof::Dof>,
+    points: Vec<(f64, super::document::Matrix, super::document::Matrix)>,
+) -> super::document::ModelDocument {
+    use super::document::{LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, from_rows, to_rows};
+    let n = dofs.len();
+    let zeros = vec![vec![0.0; n]; n];
+    let points = points
+        .into_iter()
+        .map(|(speed, m, d_bar)| {
+            let (mm, dm) = (from_rows(&m).unwrap(), from_rows(&d_bar).unwrap());
+            let b = mm.try_inverse().unwrap_or_else(|| DMatrix::zeros(n, n));
+            LpvPoint {
+                speed_mps: speed,
+                a: to_rows(&(-&b * dm)),
+                b: to_rows(&b),
+                m,
+                d_bar,
+                m_std: zeros.clone(),
+                d_bar_std: zeros.clone(),
+                a_std: zeros.clone(),
+                b_std: zeros.clone(),
+                load: None,
+                load_std: None,
+                n_samples: 1,
+                run_ids: vec![],
+                augmentation: None,
+            }
+        })
+        .collect();
+    ModelDocument {
+        kind: ModelKind::Lpv,
+        method: Method::LambdaKf,
+        dofs,
+        inputs: vec![],
+        outputs: vec![],
+        restoring: None,
+        lpv: Some(LpvDoc {
+            t_lambda_s: 1.0,
+            structure: "diagonal".into(),
+            coupling: vec![],
+            points,
+            logged_controller: None,
+        }),
+        dp_ship: None,
+        state_space: None,
+        parameters: vec![],
+        structure_findings: vec![],
+        notes: vec![],
+    }
+}
