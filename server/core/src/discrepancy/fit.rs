@@ -184,6 +184,19 @@ impl<'a> Prepared<'a> {
         self
     }
 
+    /// Columns of row `r` a fit of `rows` frees: the baseline's free
+    /// entries, or with `hold` only those in the columns of the refitted
+    /// rows (an entry coupling `r` to a DOF whose row is not refitted then
+    /// stays at the baseline's value).
+    fn freed(&self, r: usize, rows: &[usize], hold: bool) -> (Vec<usize>, Vec<usize>) {
+        let (mf, df) = &self.structure[r];
+        let keep = |j: &&usize| !hold || rows.contains(j);
+        (
+            mf.iter().filter(keep).copied().collect(),
+            df.iter().filter(keep).copied().collect(),
+        )
+    }
+
     /// Rows touched by `specs` plus `extra`, sorted.
     pub fn rows_of(&self, specs: &[Spec], extra: &[usize]) -> Vec<usize> {
         let mut rows: Vec<usize> = extra.to_vec();
@@ -204,24 +217,45 @@ impl<'a> Prepared<'a> {
         runs: &[usize],
         hac: bool,
     ) -> Option<FitOut> {
+        self.fit_holding(specs, extra, runs, hac, false)
+    }
+
+    /// [`Self::fit`] for the model that is kept: the refitted rows'
+    /// couplings to DOFs whose rows are not refitted stay at the baseline's
+    /// values ([`Self::freed`]). Free couplings let a term borrow from its
+    /// neighbours, which serves the search (the term's evidence is judged
+    /// with the most flexible row) but through M⁻¹ moves the predictions of
+    /// DOFs the hypothesis never touched.
+    pub fn fit_for_model(&self, specs: &[Spec], runs: &[usize], hac: bool) -> Option<FitOut> {
+        self.fit_holding(specs, &[], runs, hac, true)
+    }
+
+    fn fit_holding(
+        &self,
+        specs: &[Spec],
+        extra: &[usize],
+        runs: &[usize],
+        hac: bool,
+        hold: bool,
+    ) -> Option<FitOut> {
         let current = specs.iter().any(|s| s.effect == Effect::Current);
         let coriolis = specs.iter().any(|s| s.effect == Effect::CoriolisFromM);
         let (mut m, mut d) = (self.baseline.m.clone(), self.baseline.d_bar.clone());
         if !current && !coriolis {
-            return self.fit_with(specs, extra, runs, hac, &m, &d);
+            return self.fit_with(&m, &d, specs, extra, runs, hac, hold);
         }
         // The current acts through D̄ and M on ν − ν_c, and C(ν) is built from M:
         // their regressors need the D̄ and M being fitted. A baseline
         // identified with the effect present has them biased (it absorbed
         // the effect's linear part), so iterate to the fixed point.
-        let mut f = self.fit_with(specs, extra, runs, false, &m, &d)?;
+        let mut f = self.fit_with(&m, &d, specs, extra, runs, false, hold)?;
         for pass in 0..3 {
             let (m_new, d_new) = self.refitted(specs, &f, &m, &d);
             m = m_new;
             if current {
                 d = d_new;
             }
-            f = self.fit_with(specs, extra, runs, hac && pass == 2, &m, &d)?;
+            f = self.fit_with(&m, &d, specs, extra, runs, hac && pass == 2, hold)?;
         }
         Some(f)
     }
@@ -257,14 +291,16 @@ impl<'a> Prepared<'a> {
         (m, d)
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn fit_with(
         &self,
+        m_ref: &DMatrix<f64>,
+        d_ref: &DMatrix<f64>,
         specs: &[Spec],
         extra: &[usize],
         runs: &[usize],
         hac: bool,
-        m_ref: &DMatrix<f64>,
-        d_ref: &DMatrix<f64>,
+        hold: bool,
     ) -> Option<FitOut> {
         let rows = self.rows_of(specs, extra);
         if rows.is_empty() {
@@ -276,11 +312,13 @@ impl<'a> Prepared<'a> {
             .filter_map(|s| s.shape.map(|v| (s.effect, v)))
             .collect();
         // Parameter layout: base entries of each row, then the specs' θ.
+        let freed: Vec<(Vec<usize>, Vec<usize>)> =
+            rows.iter().map(|&r| self.freed(r, &rows, hold)).collect();
         let mut base_index = Vec::with_capacity(rows.len());
         let mut p = 0;
-        for &r in &rows {
+        for (mf, df) in &freed {
             base_index.push(p);
-            p += self.structure[r].0.len() + self.structure[r].1.len();
+            p += mf.len() + df.len();
         }
         let mut theta_index = Vec::with_capacity(specs.len());
         for s in specs {
@@ -313,13 +351,15 @@ impl<'a> Prepared<'a> {
                 } else {
                     pr.lam_tau[r].clone()
                 };
+                let (mf, df) = &freed[ri];
                 let held = |k: usize| {
-                    if !self.frozen {
-                        return 0.0;
-                    }
                     let (m, d) = (&self.baseline.m, &self.baseline.d_bar);
                     (0..dofs.len())
-                        .map(|j| m[(r, j)] * pr.dlam_nu[j][k] + d[(r, j)] * pr.lam_nu[j][k])
+                        .map(|j| {
+                            let mh = if mf.contains(&j) { 0.0 } else { m[(r, j)] };
+                            let dh = if df.contains(&j) { 0.0 } else { d[(r, j)] };
+                            mh * pr.dlam_nu[j][k] + dh * pr.lam_nu[j][k]
+                        })
                         .sum::<f64>()
                 };
                 let y: Vec<f64> = (self.skip..len)
@@ -327,7 +367,6 @@ impl<'a> Prepared<'a> {
                     .collect();
                 let mut idx = Vec::new();
                 let mut cols: Vec<Vec<f64>> = Vec::new();
-                let (mf, df) = &self.structure[r];
                 let mut q = base_index[ri];
                 for &j in mf {
                     idx.push(q);
@@ -425,11 +464,22 @@ impl<'a> Prepared<'a> {
             .iter()
             .enumerate()
             .map(|(ri, &r)| {
+                // Every free entry of the row: fitted, or held at the baseline.
                 let (mf, df) = &self.structure[r];
+                let (fm, fd) = &freed[ri];
                 let i0 = base_index[ri];
+                let value = |free: &[usize], j: usize, at: usize, held: f64| {
+                    free.iter()
+                        .position(|&x| x == j)
+                        .map_or(held, |k| theta_all[at + k])
+                };
                 (
-                    theta_all[i0..i0 + mf.len()].to_vec(),
-                    theta_all[i0 + mf.len()..i0 + mf.len() + df.len()].to_vec(),
+                    mf.iter()
+                        .map(|&j| value(fm, j, i0, self.baseline.m[(r, j)]))
+                        .collect(),
+                    df.iter()
+                        .map(|&j| value(fd, j, i0 + fm.len(), self.baseline.d_bar[(r, j)]))
+                        .collect(),
                 )
             })
             .collect();

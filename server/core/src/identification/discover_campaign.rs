@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::augmented::{baseline_at, pieces_by_speed};
 use super::dataset::{RunInput, segments};
+use super::discover_gate::compare_held_out;
 use super::document::{Method, ModelDocument, ModelKind, ParameterRow, PointAugmentation, to_rows};
 use super::error::IdentifyError;
 use super::intersample::vehicle_from_logged;
@@ -341,12 +342,12 @@ pub fn discover_campaign(
     }
 
     let effects = effects_across(&points);
-    let summary = summarize(&points, &effects, &skipped);
+    let mut summary = summarize(&points, &effects, &skipped);
     progress.update(0.92, "validating the augmented model")?;
     let augmented = if effects.is_empty() {
         None
     } else {
-        Some(augmented_model(
+        let candidate = augmented_model(
             doc,
             &points,
             &summary,
@@ -356,7 +357,19 @@ pub fn discover_campaign(
             val_ids,
             settings,
             dset.k_step,
-        )?)
+        )?;
+        // The baseline through the same validation, on the same runs.
+        let mut before = Vec::new();
+        for r in runs.iter().filter(|r| val_ids.contains(&r.run_id)) {
+            before.push(RunValidation {
+                run_id: r.run_id.clone(),
+                run_name: r.name.clone(),
+                report: validate_on_run(doc, r, forces, dset.k_step)?,
+            });
+        }
+        let verdict = compare_held_out(&before, &candidate.validation);
+        summary.push(verdict.text);
+        verdict.keep.then_some(candidate)
     };
     Ok(CampaignDiscovery {
         report: DiscrepancyReport {
@@ -826,7 +839,10 @@ mod tests {
             let s = p.report.findings[0].shape.as_ref().unwrap();
             assert!((s.value - 900.0).abs() < 3.0 * s.std.unwrap(), "{s:?}");
         }
-        let aug = out.augmented.as_ref().unwrap();
+        let aug = out
+            .augmented
+            .as_ref()
+            .unwrap_or_else(|| panic!("{:#?}", out.report.summary.last()));
         for (b, a) in sim_fits(&base.validation, "w")
             .iter()
             .zip(sim_fits(&aug.validation, "w"))

@@ -31,6 +31,7 @@ pub mod dataset;
 pub mod describe;
 pub mod description;
 pub mod discover_campaign;
+pub mod discover_gate;
 pub mod discrete;
 pub mod document;
 pub mod ekf_campaign;

@@ -1,0 +1,259 @@
+//! Only a better model is kept: an augmented model found by discovery is
+//! stored as a new version only when, on the held-out runs, it improves the
+//! baseline's fit beyond noise in some channel and worsens none — 1-step,
+//! k-step and the 10 s restarted free run — and simulates wherever the
+//! baseline did.
+
+use crate::identification::outcome::RunValidation;
+use crate::validation::ChannelValidation;
+
+pub use crate::discrepancy::discover::FIT_NOISE;
+
+/// Whether the augmented model is kept, and why, in a sentence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeldOutVerdict {
+    /// Store it.
+    pub keep: bool,
+    /// The reason, with the deciding numbers.
+    pub text: String,
+}
+
+/// One compared number: run, channel, metric, baseline, augmented.
+struct Change {
+    run: String,
+    channel: String,
+    metric: &'static str,
+    before: Option<f64>,
+    after: Option<f64>,
+}
+
+impl Change {
+    /// Positive when the augmented model fits better; −∞ when it lost a fit
+    /// the baseline had. Fits below 0 (worse than the record's mean) count
+    /// as 0: two predictions that both miss are not ranked by how badly.
+    fn gain(&self) -> f64 {
+        match (self.before, self.after) {
+            (Some(b), Some(a)) => a.max(0.0) - b.max(0.0),
+            (Some(_), None) => f64::NEG_INFINITY,
+            (None, Some(_)) => 0.0,
+            (None, None) => 0.0,
+        }
+    }
+
+    fn text(&self) -> String {
+        let f = |v: Option<f64>| v.map_or("no fit".to_string(), |x| format!("{x:.3}"));
+        format!(
+            "{} on '{}' ({} fit {} → {})",
+            self.channel,
+            self.run,
+            self.metric,
+            f(self.before),
+            f(self.after)
+        )
+    }
+}
+
+fn changes(run: &str, b: &ChannelValidation, a: &ChannelValidation) -> Vec<Change> {
+    let c = |metric, before, after| Change {
+        run: run.to_string(),
+        channel: b.output.clone(),
+        metric,
+        before,
+        after,
+    };
+    vec![
+        c("1-step", b.fit_one_step, a.fit_one_step),
+        c("k-step", b.fit_k_step, a.fit_k_step),
+        c("10 s restarted free-run", b.fit_restarted, a.fit_restarted),
+    ]
+}
+
+/// Compares the augmented model's held-out validation with the baseline's
+/// on the same runs (matched by run id and channel name).
+pub fn compare_held_out(baseline: &[RunValidation], augmented: &[RunValidation]) -> HeldOutVerdict {
+    let mut all = Vec::new();
+    let mut diverged = Vec::new();
+    for a in augmented {
+        let Some(b) = baseline.iter().find(|b| b.run_id == a.run_id) else {
+            continue;
+        };
+        for ca in &a.report.channels {
+            let Some(cb) = b.report.channels.iter().find(|c| c.output == ca.output) else {
+                continue;
+            };
+            if let (None, Some(d)) = (&cb.diverged.simulation, &ca.diverged.simulation) {
+                diverged.push(format!(
+                    "its free run on '{}' diverged at t = {:.1} s in {}",
+                    a.run_name, d.t_s, ca.output
+                ));
+            }
+            all.extend(changes(&a.run_name, cb, ca));
+        }
+    }
+    if all.is_empty() {
+        return HeldOutVerdict {
+            keep: false,
+            text: "The augmented model was not stored: there is no held-out run to show that it is better than the baseline.".into(),
+        };
+    }
+    if !diverged.is_empty() {
+        return HeldOutVerdict {
+            keep: false,
+            text: format!(
+                "The augmented model was not stored: {} (the baseline's did not).",
+                diverged.join("; ")
+            ),
+        };
+    }
+    let mut worse: Vec<&Change> = all.iter().filter(|c| c.gain() < -FIT_NOISE).collect();
+    worse.sort_by(|x, y| x.gain().total_cmp(&y.gain()));
+    if !worse.is_empty() {
+        let shown: Vec<String> = worse.iter().take(3).map(|c| c.text()).collect();
+        return HeldOutVerdict {
+            keep: false,
+            text: format!(
+                "The augmented model was not stored: on the held-out runs it is worse than the baseline in {}{}.",
+                shown.join(", "),
+                if worse.len() > 3 {
+                    format!(" and {} more", worse.len() - 3)
+                } else {
+                    String::new()
+                }
+            ),
+        };
+    }
+    let mut better: Vec<&Change> = all.iter().filter(|c| c.gain() > FIT_NOISE).collect();
+    better.sort_by(|x, y| y.gain().total_cmp(&x.gain()));
+    match better.first() {
+        None => HeldOutVerdict {
+            keep: false,
+            text: format!(
+                "The augmented model was not stored: on the held-out runs no fit changes by more than {FIT_NOISE} from the baseline's."
+            ),
+        },
+        Some(best) => HeldOutVerdict {
+            keep: true,
+            text: format!(
+                "The augmented model was stored: on the held-out runs it improves {} of {} fits by more than {FIT_NOISE} and worsens none (largest gain: {}).",
+                better.len(),
+                all.len(),
+                best.text()
+            ),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::estimation::NoProgress;
+    use crate::identification::lambda_campaign::{
+        LambdaCampaignSettings, identify_lambda_campaign,
+    };
+    use crate::identification::tests::{force_columns, simulate, to_run};
+    use crate::planning::campaign::ExperimentFamily;
+    use crate::planning::examples::surveyor_rov;
+    use crate::simulation::rov::RovTruth;
+    use crate::validation::{Divergence, DivergenceReason};
+
+    /// A real held-out validation: a λ model of a simulated ROV at one
+    /// speed, validated on its own held-out run.
+    fn held_out() -> Vec<RunValidation> {
+        let truth = RovTruth::surveyor_like();
+        let runs: Vec<_> = (0..3u64)
+            .map(|r| {
+                let rec = simulate(&truth, vec![0.5; 2000], 500 + r);
+                let family = if r < 2 {
+                    ExperimentFamily::Recursive
+                } else {
+                    ExperimentFamily::Validation
+                };
+                to_run(&format!("run-{r}"), family, Some(0.5), &rec)
+            })
+            .collect();
+        let profile = surveyor_rov();
+        let settings = LambdaCampaignSettings {
+            estimate_restoring: false,
+            ..LambdaCampaignSettings::default()
+        };
+        identify_lambda_campaign(
+            &profile,
+            &[0.5],
+            &force_columns(&profile),
+            &runs,
+            &settings,
+            &mut NoProgress,
+        )
+        .unwrap()
+        .validation
+    }
+
+    fn shift(v: &mut [RunValidation], channel: &str, by: f64) {
+        for r in v.iter_mut() {
+            for c in r.report.channels.iter_mut().filter(|c| c.output == channel) {
+                c.fit_one_step = c.fit_one_step.map(|f| f + by);
+            }
+        }
+    }
+
+    #[test]
+    fn only_a_model_better_somewhere_and_worse_nowhere_is_kept() {
+        let base = held_out();
+        assert!(!base.is_empty());
+        let same = compare_held_out(&base, &base);
+        assert!(
+            !same.keep && same.text.contains("no fit changes"),
+            "{}",
+            same.text
+        );
+
+        let mut better = base.clone();
+        shift(&mut better, "v", 0.05);
+        let v = compare_held_out(&base, &better);
+        assert!(
+            v.keep && v.text.contains("v on 'run-2' (1-step fit"),
+            "{}",
+            v.text
+        );
+
+        let mut mixed = better.clone();
+        shift(&mut mixed, "r", -0.02);
+        let v = compare_held_out(&base, &mixed);
+        assert!(!v.keep, "{}", v.text);
+        assert!(
+            v.text
+                .contains("worse than the baseline in r on 'run-2' (1-step fit"),
+            "{}",
+            v.text
+        );
+
+        let mut within_noise = better.clone();
+        shift(&mut within_noise, "r", -0.5 * FIT_NOISE);
+        assert!(compare_held_out(&base, &within_noise).keep);
+    }
+
+    #[test]
+    fn a_model_whose_free_run_diverges_is_not_kept() {
+        let base = held_out();
+        let mut worse = base.clone();
+        shift(&mut worse, "u", 0.1);
+        let c = &mut worse[0].report.channels[0];
+        c.diverged.simulation = Some(Divergence {
+            t_s: 42.0,
+            after_s: 42.0,
+            output: c.output.clone(),
+            dof: None,
+            reason: DivergenceReason::NonFinite,
+            plausible: [-1.0, 1.0],
+            text: "diverged".into(),
+        });
+        let v = compare_held_out(&base, &worse);
+        assert!(!v.keep);
+        assert!(v.text.contains("diverged at t = 42.0 s"), "{}", v.text);
+        assert!(
+            compare_held_out(&[], &base)
+                .text
+                .contains("no held-out run")
+        );
+    }
+}
