@@ -11,6 +11,10 @@
 //! consistent (Newey–West, Bartlett weights): filtered residuals are far
 //! from white, and OLS standard errors would call noise significant.
 
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::rc::Rc;
+
 use nalgebra::DMatrix;
 
 use super::candidates::{Effect, TermContext};
@@ -54,7 +58,13 @@ pub(crate) struct Prepared<'a> {
     pub kappa: f64,
     /// Bartlett lags of the HAC covariance.
     pub hac_lags: usize,
+    /// Filtered regressors that depend on the data alone, by (term,
+    /// coefficient, row, run).
+    regressors: RegressorCache,
 }
+
+/// Filtered regressors by (term, coefficient, row, run).
+type RegressorCache = RefCell<HashMap<(Effect, usize, usize, usize), Rc<Vec<f64>>>>;
 
 /// One (row, run) block of the stacked regression: global parameter
 /// indices, their weighted columns, the weighted target.
@@ -74,7 +84,8 @@ pub(crate) struct FitOut {
     pub sse: f64,
     /// Stacked samples.
     pub n: usize,
-    /// HAC covariance over all parameters, if asked for.
+    /// HAC covariance of the terms' coefficients (every spec's θ, in
+    /// parameter order from `theta_index[0]`), if asked for.
     pub cov: Option<DMatrix<f64>>,
     /// Weighted residuals per (row, run) block.
     pub resid: Vec<Vec<f64>>,
@@ -89,7 +100,7 @@ impl FitOut {
     pub fn theta_cov(&self, s: usize) -> Option<DMatrix<f64>> {
         let cov = self.cov.as_ref()?;
         let k = self.theta.get(s)?.len();
-        let i = self.theta_index[s];
+        let i = self.theta_index[s] - self.theta_index[0];
         Some(cov.view((i, i), (k, k)).into_owned())
     }
 }
@@ -154,6 +165,7 @@ impl<'a> Prepared<'a> {
             weights: vec![1.0; n],
             kappa: 1.0,
             hac_lags,
+            regressors: RefCell::new(HashMap::new()),
         };
         let all: Vec<usize> = (0..records.len()).collect();
         let mut weights = vec![1.0; n];
@@ -182,6 +194,43 @@ impl<'a> Prepared<'a> {
             *s = (vec![], vec![]);
         }
         self
+    }
+
+    /// [λφ_p,r] of term `effect`, coefficient `pi`, row `r` on run `run`.
+    /// Regressors that do not depend on the model's M and D̄ (all but C(ν)ν
+    /// from M and the current) are computed once per run and kept: the
+    /// search fits each hypothesis many times (folds, shape profiles).
+    fn filtered_regressor(
+        &self,
+        effect: Effect,
+        pi: usize,
+        r: usize,
+        run: usize,
+        ctx: &TermContext<'_>,
+    ) -> Rc<Vec<f64>> {
+        let compute = || {
+            let rec = &self.records[run];
+            let mut nu = vec![0.0; rec.nu.ncols()];
+            let raw: Vec<f64> = (0..rec.len())
+                .map(|k| {
+                    for (j, v) in nu.iter_mut().enumerate() {
+                        *v = rec.nu[(k, j)];
+                    }
+                    effect.regressor(pi, r, ctx, &nu, &rec.eta_at(k))
+                })
+                .collect();
+            Rc::new(self.svf.foh(&raw))
+        };
+        if matches!(effect, Effect::CoriolisFromM | Effect::Current) {
+            return compute();
+        }
+        let key = (effect, pi, r, run);
+        if let Some(f) = self.regressors.borrow().get(&key) {
+            return Rc::clone(f);
+        }
+        let f = compute();
+        self.regressors.borrow_mut().insert(key, Rc::clone(&f));
+        f
     }
 
     /// Columns of row `r` a fit of `rows` frees: the baseline's free
@@ -392,13 +441,7 @@ impl<'a> Prepared<'a> {
                         continue;
                     }
                     for pi in 0..nl {
-                        let raw: Vec<f64> = (0..len)
-                            .map(|k| {
-                                let nu: Vec<f64> = rec.nu.row(k).iter().copied().collect();
-                                s.effect.regressor(pi, r, &ctx, &nu, &rec.eta_at(k))
-                            })
-                            .collect();
-                        let f = self.svf.foh(&raw);
+                        let f = self.filtered_regressor(s.effect, pi, r, run, &ctx);
                         idx.push(theta_index[si] + pi);
                         cols.push(f[self.skip..].iter().map(|x| w * x).collect());
                     }
@@ -436,29 +479,41 @@ impl<'a> Prepared<'a> {
             sse += dot(&e, &e);
             resid.push(e);
         }
+        // Sandwich H⁻¹ S H⁻¹ on the θ block only: with C = H⁻¹[θ, :] the
+        // block is C S Cᵀ = Σ_l w_l Σ_k h_k h_{k−l}ᵀ over the projected
+        // scores h_k = C φ_k e_k, which costs t² per lag instead of p².
+        let t0 = theta_index.first().copied().unwrap_or(p);
         let cov = hac.then(|| {
-            let mut s = DMatrix::<f64>::zeros(p, p);
+            let t = p - t0;
+            let mut s = DMatrix::<f64>::zeros(t, t);
             for ((idx, cols, _), e) in blocks.iter().zip(&resid) {
-                let q = idx.len();
                 let len = e.len();
+                let mut h = vec![vec![0.0; len]; t];
+                for (a, &ia) in idx.iter().enumerate() {
+                    for (ti, hv) in h.iter_mut().enumerate() {
+                        let c = h_inv[(t0 + ti, ia)];
+                        if c != 0.0 {
+                            for k in 0..len {
+                                hv[k] += c * cols[a][k] * e[k];
+                            }
+                        }
+                    }
+                }
                 for l in 0..=self.hac_lags.min(len.saturating_sub(1)) {
                     let wl = 1.0 - l as f64 / (self.hac_lags as f64 + 1.0);
-                    for a in 0..q {
-                        for b in 0..q {
-                            let mut acc = 0.0;
-                            for k in l..len {
-                                acc += cols[a][k] * e[k] * cols[b][k - l] * e[k - l];
-                            }
+                    for a in 0..t {
+                        for b in 0..t {
+                            let acc = dot(&h[a][l..], &h[b][..len - l]);
                             let v = if l == 0 { acc } else { wl * acc };
-                            s[(idx[a], idx[b])] += v;
+                            s[(a, b)] += v;
                             if l > 0 {
-                                s[(idx[b], idx[a])] += v;
+                                s[(b, a)] += v;
                             }
                         }
                     }
                 }
             }
-            &h_inv * s * &h_inv
+            s
         });
         let base = rows
             .iter()

@@ -1,1 +1,2 @@
 pub mod open_world;
+pub mod open_world_discovery;

@@ -10,6 +10,7 @@
 use nalgebra::DMatrix;
 use nalgebra::DVector;
 use seatrial_core::estimation::NoProgress;
+use seatrial_core::identification::outcome::Identified;
 use seatrial_core::identification::predictor::validate_on_run_with;
 use seatrial_core::identification::{
     LambdaCampaignSettings, RunInput, identify_lambda_campaign, lambda_campaign::StructureChoice,
@@ -188,6 +189,50 @@ fn fitted_linearization(
     effective_linearization(vessel, &runs)
 }
 
+/// A flown campaign as the service identifies it.
+pub struct Identification {
+    pub profile: VesselProfile,
+    pub inputs: Vec<RunInput>,
+    /// The force columns, one per DOF.
+    pub columns: Vec<String>,
+    pub out: Identified,
+}
+
+/// Reads `campaign`'s runs through the parser and identifies them on its
+/// grid with `settings`.
+pub fn identify(
+    campaign: &Campaign,
+    described: bool,
+    settings: &LambdaCampaignSettings,
+) -> Identification {
+    let profile = profile_for(campaign);
+    let inputs: Vec<RunInput> = campaign
+        .runs
+        .iter()
+        .map(|r| to_input(&profile, r, described))
+        .collect();
+    let columns: Vec<String> = profile
+        .dofs
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
+    let out = identify_lambda_campaign(
+        &profile,
+        &campaign.spec.grid_speeds,
+        &columns,
+        &inputs,
+        settings,
+        &mut NoProgress,
+    )
+    .expect("identification succeeds");
+    Identification {
+        profile,
+        inputs,
+        columns,
+        out,
+    }
+}
+
 pub fn evaluate(seed: u64, described: bool, settings: &LambdaCampaignSettings) -> SeedReport {
     evaluate_with(seed, described, settings, &CampaignSpec::default())
 }
@@ -201,27 +246,12 @@ pub fn evaluate_with(
 ) -> SeedReport {
     let vessel = Vessel::draw(seed);
     let campaign = fly_campaign(&vessel, spec, seed);
-    let profile = profile_for(&campaign);
-    let inputs: Vec<RunInput> = campaign
-        .runs
-        .iter()
-        .map(|r| to_input(&profile, r, described))
-        .collect();
-    let columns: Vec<String> = profile
-        .dofs
-        .iter()
-        .map(|d| d.force_column().to_string())
-        .collect();
-    let grid: Vec<f64> = spec.grid_speeds.clone();
-    let out = identify_lambda_campaign(
-        &profile,
-        &grid,
-        &columns,
-        &inputs,
-        settings,
-        &mut NoProgress,
-    )
-    .expect("identification succeeds");
+    let Identification {
+        inputs,
+        columns,
+        out,
+        ..
+    } = identify(&campaign, described, settings);
     let doc = &out.document;
     let lpv = doc.lpv.as_ref().expect("an LPV model");
 
