@@ -172,6 +172,22 @@ async fn position_only_logs_are_accepted_and_bad_jobs_are_refused_at_submit() {
     // Nothing was queued by the refusals.
     let jobs_after = app.call("GET", "/api/jobs", &[], None).await.json;
     assert_eq!(jobs_before, jobs_after);
+
+    // A velocity-based method fits the derived u, v, r and says so.
+    let mut runs = estimation.clone();
+    runs.push(id(&ids, "VAL"));
+    let job = common::run_job(
+        &app,
+        json!({ "kind": "identify", "campaign_id": cid, "method": "n4sid", "run_ids": runs }),
+    )
+    .await;
+    let mid = job["result"]["model_id"].as_str().unwrap();
+    let m = app.call("GET", "/api/models/{id}", &[mid], None).await;
+    let notes = m.json["document"]["notes"].to_string();
+    assert!(
+        notes.contains("7 of the 7 runs logged no body velocities"),
+        "{notes}"
+    );
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

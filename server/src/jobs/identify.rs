@@ -170,6 +170,7 @@ impl JobHandler for Identify {
                 .iter()
                 .map(|r| (r.id.clone(), r.name.clone()))
                 .collect();
+            let derived = derived_note(&chosen);
             let stored = run_inputs::describe(cx, &cid, chosen).await?;
             let method = req
                 .method
@@ -221,6 +222,9 @@ impl JobHandler for Identify {
                 out.document
                     .notes
                     .extend(clocks.iter().map(run_inputs::RunClock::note));
+                if method != "parallel_ekf" {
+                    out.document.notes.extend(derived);
+                }
                 let model = NewModel {
                     lineage,
                     campaign_id,
@@ -294,6 +298,31 @@ fn check_parallel_ekf(
             .position(|id| field == format!("runs[{id}]"))
             .map_or(field, |i| format!("run_ids[{i}]"));
         ApiError::invalid(field, e.to_string())
+    })
+}
+
+/// A note naming the runs whose velocities were derived from their pose
+/// (position-only DP logs): a velocity-based method fits those, not
+/// measured velocities. `None` when every run logged its velocities.
+fn derived_note(runs: &[crate::storage::runs::Run]) -> Option<String> {
+    let names: Vec<&str> = runs
+        .iter()
+        .filter(|r| {
+            r.summary
+                .as_ref()
+                .and_then(|s| s.get("derived_channels"))
+                .and_then(|d| d.as_array())
+                .is_some_and(|d| !d.is_empty())
+        })
+        .map(|r| r.name.as_str())
+        .collect();
+    (!names.is_empty()).then(|| {
+        format!(
+            "{} of the {} runs logged no body velocities: their u, v, r were derived from the measured pose (local linear fit, rotated into the body frame), so this fit is on differentiated positions: {}",
+            names.len(),
+            runs.len(),
+            names.join(", ")
+        )
     })
 }
 
