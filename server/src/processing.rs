@@ -15,10 +15,11 @@ use seatrial_core::alignment::{
 };
 use seatrial_core::identification::{InferredDescription, RunRole, RunSignal, infer_description};
 use seatrial_core::logs::Gap;
+use seatrial_core::logs::measurements::derive_body_velocities;
 use seatrial_core::logs::{
     LogRole, ParseOptions, ParsedLog, input_columns, output_columns, parse_log, to_uniform,
 };
-use seatrial_core::planning::vessel::InputChannels;
+use seatrial_core::planning::vessel::{HeadingUnit, InputChannels, VesselKind};
 use seatrial_core::planning::{Dof, Schedule, VesselProfile};
 use seatrial_core::quality::{Adherence, DofVerdict};
 use seatrial_core::quality::{DofChannels, PlannedReference, QualitySpec, quality_report};
@@ -57,6 +58,8 @@ pub struct RunMeta {
     pub signal: Option<RunSignal>,
     /// Free notes (at most 2000 characters).
     pub notes: Option<String>,
+    /// Unit of the logged heading `psi` (default: the vessel profile's, else radians).
+    pub heading_unit: Option<HeadingUnit>,
 }
 
 impl RunMeta {
@@ -71,6 +74,9 @@ impl RunMeta {
                 .and_then(|v| v.as_str())
                 .map(str::to_string),
             rate_hz: summary.get("sample_rate_hz").and_then(|v| v.as_f64()),
+            heading_unit: summary
+                .get("heading_unit")
+                .and_then(|v| serde_json::from_value(v.clone()).ok()),
             ..RunMeta::default()
         }
     }
@@ -112,6 +118,15 @@ pub struct RunSummary {
     pub verdicts: Vec<DofVerdict>,
     /// How the run followed its planned schedule.
     pub adherence: Vec<Adherence>,
+    /// Unit `psi` was read in.
+    #[serde(default)]
+    pub heading_unit: HeadingUnit,
+    /// Channels of the record identification reads, derived ones included.
+    #[serde(default)]
+    pub channels: Vec<String>,
+    /// Channels derived from others (a DP log's u, v, r from its pose).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub derived_channels: Vec<String>,
 }
 
 /// Why a run was rejected: which file, where, what.
@@ -183,12 +198,14 @@ fn parse(
     role: LogRole,
     file: &str,
     shared: Option<&str>,
+    heading_unit: HeadingUnit,
 ) -> Result<ParsedLog, ProcessError> {
     let f = File::open(path)
         .map_err(|e| ProcessError::new(file, format!("stored file unreadable: {e}")))?;
     let opts = ParseOptions {
         file: file.to_string(),
         max_rows: MAX_ROWS,
+        heading_unit,
         ..ParseOptions::for_vessel(vessel, role, shared)
     };
     Ok(parse_log(BufReader::with_capacity(1 << 20, f), &opts)?)
@@ -309,8 +326,13 @@ pub fn load_record(
             .ignored_columns
             .insert(file.into(), p.ignored_columns.clone());
     };
+    let unit = meta
+        .heading_unit
+        .or(vessel.heading_unit)
+        .unwrap_or_default();
+    summary.heading_unit = unit;
     let mut rec = if let Some(p) = path("file") {
-        let parsed = parse(vessel, p, LogRole::Single, "file", None)?;
+        let parsed = parse(vessel, p, LogRole::Single, "file", None, unit)?;
         let (rec, _) = to_uniform(&parsed.table, meta.rate_hz)?;
         note("file", &parsed, summary);
         rec
@@ -322,8 +344,8 @@ pub fn load_record(
                 "a run needs 'file', or 'control' and 'nav'",
             ));
         };
-        let control = parse(vessel, cp, LogRole::Control, "control", Some(shared))?;
-        let nav = parse(vessel, np, LogRole::Nav, "nav", Some(shared))?;
+        let control = parse(vessel, cp, LogRole::Control, "control", Some(shared), unit)?;
+        let nav = parse(vessel, np, LogRole::Nav, "nav", Some(shared), unit)?;
         note("control", &control, summary);
         note("nav", &nav, summary);
         let (rec, report) = align_logs_with(
@@ -353,7 +375,39 @@ pub fn load_record(
         rec
     };
     add_thruster_forces(vessel, &mut rec);
+    velocities_from_pose(vessel, &mut rec, summary);
+    summary.channels = rec.names.clone();
     Ok(rec)
+}
+
+/// A DP log without body velocities: u, v, r derived from its pose for the
+/// quality report and the run description (see
+/// [`seatrial_core::logs::measurements`]), over ± a quarter of the
+/// shortest time constant of the profile (at least one sample), and said so.
+fn velocities_from_pose(vessel: &VesselProfile, rec: &mut UniformRecord, summary: &mut RunSummary) {
+    let velocities = output_columns(vessel);
+    if vessel.kind != VesselKind::Dp3 || velocities.iter().any(|c| rec.column(c).is_some()) {
+        return;
+    }
+    let half = vessel
+        .dofs
+        .iter()
+        .map(|&d| vessel.limit(d).time_constant_s / 4.0)
+        .fold(f64::INFINITY, f64::min);
+    if derive_body_velocities(rec, half).is_ok() {
+        summary.warnings.push(RunWarning {
+            file: "file".into(),
+            column: None,
+            message: format!(
+                "{} are not logged: derived from x, y, psi (local linear fit over ±{} s, rotated \
+                 into the body frame) for the quality report and the run description; \
+                 parallel_ekf identifies from the logged pose",
+                velocities.join(", "),
+                seatrial_core::numbers::sig3(half.max(1.0 / rec.sample_rate_hz))
+            ),
+        });
+        summary.derived_channels = velocities;
+    }
 }
 
 /// Parses, aligns (with `priors`, see [`load_record`]), resamples and

@@ -6,6 +6,7 @@
 
 use seatrial_core::estimation::Progress;
 use seatrial_core::identification::dataset::RunInput;
+use seatrial_core::identification::ekf_checks::{RunFacts, check_ekf_job};
 use seatrial_core::identification::{
     EkfCampaignSettings, Identified, IdentifyError, LambdaCampaignSettings, N4sidCampaignSettings,
     identify_ekf_campaign, identify_lambda_campaign, identify_n4sid_campaign,
@@ -109,8 +110,11 @@ impl JobHandler for Identify {
             check_method(&vessel.profile, method).map_err(|m| ApiError::invalid("method", m))?;
             check_settings(method, &req.settings)
                 .map_err(|(field, msg)| ApiError::invalid(field, msg))?;
+            let all = runs::list(&cx.db, cid).await?;
+            if method == "parallel_ekf" {
+                check_parallel_ekf(&vessel.profile, req, &all)?;
+            }
             if req.run_ids.is_empty() {
-                let all = runs::list(&cx.db, cid).await?;
                 let usable = all.iter().filter(|r| usable_by_default(r)).count();
                 if usable < 2 {
                     let excluded = all.iter().filter(|r| r.excluded).count();
@@ -166,6 +170,7 @@ impl JobHandler for Identify {
                 .iter()
                 .map(|r| (r.id.clone(), r.name.clone()))
                 .collect();
+            let derived = derived_note(&chosen);
             let stored = run_inputs::describe(cx, &cid, chosen).await?;
             let method = req
                 .method
@@ -217,6 +222,9 @@ impl JobHandler for Identify {
                 out.document
                     .notes
                     .extend(clocks.iter().map(run_inputs::RunClock::note));
+                if method != "parallel_ekf" {
+                    out.document.notes.extend(derived);
+                }
                 let model = NewModel {
                     lineage,
                     campaign_id,
@@ -240,6 +248,82 @@ impl JobHandler for Identify {
             }))
         })
     }
+}
+
+/// A parallel-EKF job that cannot run is refused at submission, naming what
+/// is missing ([`check_ekf_job`]): the profile's L or thruster layout, a
+/// run's pose channels or thruster columns (from the channels recorded at
+/// upload), a held-out run, a manoeuvre. A run's field `runs[<id>]` is
+/// named as the request's `run_ids[i]` when the request lists the runs.
+fn check_parallel_ekf(
+    profile: &VesselProfile,
+    req: &JobRequest,
+    all: &[crate::storage::runs::Run],
+) -> Result<(), ApiError> {
+    let chosen: Vec<&crate::storage::runs::Run> = if req.run_ids.is_empty() {
+        all.iter().filter(|r| usable_by_default(r)).collect()
+    } else {
+        req.run_ids
+            .iter()
+            .filter_map(|id| all.iter().find(|r| &r.id == id))
+            .collect()
+    };
+    let channels: Vec<Option<Vec<String>>> = chosen
+        .iter()
+        .map(|r| {
+            r.summary
+                .as_ref()
+                .and_then(|s| s.get("channels"))
+                .and_then(|c| serde_json::from_value(c.clone()).ok())
+                .filter(|c: &Vec<String>| !c.is_empty())
+        })
+        .collect();
+    let facts: Vec<RunFacts<'_>> = chosen
+        .iter()
+        .zip(&channels)
+        .map(|(r, c)| RunFacts {
+            run_id: &r.id,
+            name: &r.name,
+            family: r.description.family,
+            channels: c.as_deref(),
+        })
+        .collect();
+    let settings: EkfCampaignSettings =
+        parse_settings(&req.settings).map_err(|(field, msg)| ApiError::invalid(field, msg))?;
+    check_ekf_job(profile, &facts, &settings).map_err(|e| {
+        let field = e.field().to_string();
+        let field = req
+            .run_ids
+            .iter()
+            .position(|id| field == format!("runs[{id}]"))
+            .map_or(field, |i| format!("run_ids[{i}]"));
+        ApiError::invalid(field, e.to_string())
+    })
+}
+
+/// A note naming the runs whose velocities were derived from their pose
+/// (position-only DP logs): a velocity-based method fits those, not
+/// measured velocities. `None` when every run logged its velocities.
+fn derived_note(runs: &[crate::storage::runs::Run]) -> Option<String> {
+    let names: Vec<&str> = runs
+        .iter()
+        .filter(|r| {
+            r.summary
+                .as_ref()
+                .and_then(|s| s.get("derived_channels"))
+                .and_then(|d| d.as_array())
+                .is_some_and(|d| !d.is_empty())
+        })
+        .map(|r| r.name.as_str())
+        .collect();
+    (!names.is_empty()).then(|| {
+        format!(
+            "{} of the {} runs logged no body velocities: their u, v, r were derived from the measured pose (local linear fit, rotated into the body frame), so this fit is on differentiated positions: {}",
+            names.len(),
+            runs.len(),
+            names.join(", ")
+        )
+    })
 }
 
 /// Runs identification uses when the request names none: accepted and not excluded.

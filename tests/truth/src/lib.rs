@@ -11,12 +11,16 @@
 //! or `seatrial-core` (nalgebra and std only): its own RNG, kinematics,
 //! forces and RK4.
 //!
+//! [`dp_ship`] adds a DP surface vessel (Fossen, Sagatun & Sørensen 1995)
+//! flown through decoupled manoeuvres and logged position-only at 1 Hz.
+//!
 //! Conventions: NED/body frames, SI and radians; z and w positive down;
 //! g(η) on the left-hand side (a heavy vessel, W − B > 0, has g_Z < 0);
 //! clock offset: nav t + offset = control t; ψ is logged wrapped to (−π, π].
 
 pub mod campaign;
 pub mod controller;
+pub mod dp_ship;
 pub mod forces;
 pub mod json;
 pub mod kinematics;

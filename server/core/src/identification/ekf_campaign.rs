@@ -12,13 +12,16 @@
 //! validation is reported in m and rad (see [`super::bis`]).
 
 use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
-use serde::{Deserialize, Serialize};
 
 use super::bis::{BisScale, SiDpShip, unwrap_heading};
 use super::dataset::{RunInput, segments};
 use super::document::{
     DpNoiseDoc, DpShipDoc, Method, ModelDocument, ModelKind, ParameterRow, to_rows,
 };
+use super::ekf_checks::{every_stage, stage_of};
+use super::ekf_init::{InitBlock, WITHOUT_PRIOR_FINDING, ls_start, without_prior_note};
+pub use super::ekf_settings::EkfCampaignSettings;
+use super::ekf_settings::{check_settings, nine};
 use super::error::IdentifyError;
 use super::outcome::{Identified, RunValidation};
 use super::roles::assign_roles;
@@ -28,7 +31,6 @@ use crate::estimation::ekf::{
 };
 use crate::estimation::{Progress, SubProgress};
 use crate::numbers::sig3;
-use crate::planning::campaign::ExperimentFamily;
 use crate::planning::dof::Dof;
 use crate::planning::vessel::{InputChannels, ThrusterKind, VesselKind, VesselProfile};
 use crate::simulation::dp_ship::{Matrix3x6, N_THETA, THETA_NAMES};
@@ -36,91 +38,6 @@ use crate::validation::{ValidationRecord, ValidationSettings, validate};
 
 /// Shortest block of a run the EKF uses (samples).
 const MIN_SAMPLES: usize = 50;
-
-/// Settings of a parallel-EKF identification (JSON `settings` of the job).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
-#[serde(deny_unknown_fields)]
-pub struct EkfCampaignSettings {
-    /// Sweeps through SI1 → SI2 → SI3 (≥ 1): each further sweep restarts
-    /// every stage from the previous sweep's θ̂.
-    #[serde(default = "default_sweeps")]
-    pub sweeps: usize,
-    /// Standard deviation of the measured x and y (m).
-    #[serde(default = "default_position_noise")]
-    pub position_noise_std_m: f64,
-    /// Standard deviation of the measured heading (degrees).
-    #[serde(default = "default_heading_noise")]
-    pub heading_noise_std_deg: f64,
-    /// Initial guess of θ″1 … θ″9 (Bis: A″_h11, A″_h22, A″_h23, A″_h32,
-    /// A″_h33, K″1 = K″2, K″3 = K″4, K″5, K″6); default: A″_h,ii = −√(L/g)/T_i
-    /// from the profile's time constants, no coupling, K″ = 5·10⁻³.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub theta_init: Option<Vec<f64>>,
-    /// Standard deviation of that guess (P(0) of θ″); default 0.1 (0.3 for
-    /// A″_h33, or 1.2·|guess| if larger) for A″_h, 5·10⁻³ for K″.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub theta_init_std: Option<Vec<f64>>,
-    /// Random-walk step of the bias b_h per sample (Bis force, surge, sway, yaw).
-    #[serde(default = "default_bias_walk")]
-    pub bias_walk_std_bis: [f64; 3],
-    /// Standard deviation of the initial bias (Bis force).
-    #[serde(default = "default_bias_initial")]
-    pub bias_initial_std_bis: [f64; 3],
-    /// Process noise on the momentum per sample (Bis); a little keeps the
-    /// filter from locking on biased θ″ under position noise.
-    #[serde(default = "default_momentum_noise")]
-    pub momentum_noise_std_bis: f64,
-    /// Parameter random walk per sample (eq. 38); 0 for constant θ″.
-    #[serde(default)]
-    pub q_theta: f64,
-    /// Held-out runs; default: the plan's validation runs.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub validation_run_ids: Option<Vec<String>>,
-    /// Horizon of the k-step predictions of validation.
-    #[serde(default = "default_k")]
-    pub k: usize,
-}
-
-fn default_sweeps() -> usize {
-    2
-}
-fn default_position_noise() -> f64 {
-    1.0
-}
-fn default_heading_noise() -> f64 {
-    0.2
-}
-fn default_bias_walk() -> [f64; 3] {
-    [3e-6, 3e-6, 6e-7]
-}
-fn default_bias_initial() -> [f64; 3] {
-    [1e-3, 1e-3, 2e-4]
-}
-fn default_momentum_noise() -> f64 {
-    1e-5
-}
-fn default_k() -> usize {
-    10
-}
-
-impl Default for EkfCampaignSettings {
-    fn default() -> Self {
-        EkfCampaignSettings {
-            sweeps: default_sweeps(),
-            position_noise_std_m: default_position_noise(),
-            heading_noise_std_deg: default_heading_noise(),
-            theta_init: None,
-            theta_init_std: None,
-            bias_walk_std_bis: default_bias_walk(),
-            bias_initial_std_bis: default_bias_initial(),
-            momentum_noise_std_bis: default_momentum_noise(),
-            q_theta: 0.0,
-            validation_run_ids: None,
-            k: default_k(),
-        }
-    }
-}
 
 /// The thruster kinds the θ″ parameterization of eq. 47 assumes, in column
 /// order: two main propellers (K1 = K2), three tunnels (the two stern ones
@@ -134,8 +51,24 @@ const LAYOUT: [ThrusterKind; 6] = [
     ThrusterKind::Azimuth,
 ];
 
-/// M″, T″ and the Bis scale of a profile, or the field that lacks them.
-fn known(profile: &VesselProfile) -> Result<(Matrix3<f64>, Matrix3x6, BisScale), IdentifyError> {
+/// The thruster group (K″ index 0–3: θ″6 … θ″9) of each column of T″.
+const GROUPS: [usize; 6] = [0, 0, 1, 1, 2, 3];
+
+/// The pose columns the EKF measures (Fossen et al. eq. 39: z = [x, y, ψ]).
+pub const EKF_POSE: [&str; 3] = ["x", "y", "psi"];
+
+/// Checks that `profile` can be identified by the parallel EKF: a DP vessel
+/// with surge, sway, yaw, a ship length L, and thrusters in the layout of
+/// the θ″ parameterization; the field that is wrong is named.
+pub fn check_ekf_profile(profile: &VesselProfile) -> Result<(), IdentifyError> {
+    known(profile).map(|_| ())
+}
+
+/// M″ (when the profile gives it), T″ and the Bis scale of a profile, or
+/// the field that lacks them.
+fn known(
+    profile: &VesselProfile,
+) -> Result<(Option<Matrix3<f64>>, Matrix3x6, BisScale), IdentifyError> {
     if profile.kind != VesselKind::Dp3 || profile.dofs != Dof::HORIZONTAL {
         return Err(IdentifyError::invalid(
             "method",
@@ -144,8 +77,8 @@ fn known(profile: &VesselProfile) -> Result<(Matrix3<f64>, Matrix3x6, BisScale),
     }
     let prior = profile.dp_prior.as_ref().ok_or_else(|| {
         IdentifyError::invalid(
-            "vessel.dp_prior",
-            "the parallel EKF needs the inertia M″ and the ship length L (Bis scale) in the vessel profile",
+            "vessel.dp_prior.length_m",
+            "the parallel EKF needs the ship length L (the Bis scale) in the vessel profile's dp_prior; the inertia M″ is optional",
         )
     })?;
     let InputChannels::Thrusters {
@@ -155,17 +88,28 @@ fn known(profile: &VesselProfile) -> Result<(Matrix3<f64>, Matrix3x6, BisScale),
     else {
         return Err(IdentifyError::invalid(
             "vessel.inputs",
-            "the parallel EKF needs thruster commands and the configuration matrix T″",
+            "the parallel EKF's θ″ (eq. 47) are thrust coefficients of six thrusters; a vessel logging generalized forces τ is identified by n4sid",
         ));
     };
     let kinds: Vec<ThrusterKind> = thrusters.iter().map(|t| t.kind).collect();
     if kinds != LAYOUT {
         return Err(IdentifyError::invalid(
             "vessel.inputs.thrusters",
-            "the θ″ parameterization (eq. 47) needs six thrusters in the order main, main, tunnel (stern), tunnel (stern), tunnel (bow), azimuth",
+            format!(
+                "the θ″ parameterization (eq. 47) needs six thrusters in the order main, main, tunnel (stern), tunnel (stern), tunnel (bow), azimuth; the profile has {} ({})",
+                kinds.len(),
+                kinds
+                    .iter()
+                    .map(|k| format!("{k:?}").to_lowercase())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
         ));
     }
-    let m = Matrix3::from_fn(|i, j| prior.inertia_bis[i][j]);
+    let m = prior
+        .inertia_bis
+        .as_ref()
+        .map(|m| Matrix3::from_fn(|i, j| m[i][j]));
     let t = Matrix3x6::from_fn(|i, j| configuration[i][j]);
     Ok((m, t, BisScale::of(prior)))
 }
@@ -195,85 +139,6 @@ fn default_theta_std(theta: &[f64; N_THETA]) -> [f64; N_THETA] {
             base[i]
         }
     })
-}
-
-fn nine(field: &str, v: &Option<Vec<f64>>) -> Result<Option<[f64; N_THETA]>, IdentifyError> {
-    let Some(v) = v else { return Ok(None) };
-    let arr: [f64; N_THETA] = v.as_slice().try_into().map_err(|_| {
-        IdentifyError::invalid(
-            field,
-            format!("θ″ has nine entries (θ″1 … θ″9), got {}", v.len()),
-        )
-    })?;
-    if let Some(i) = arr.iter().position(|x| !x.is_finite()) {
-        return Err(IdentifyError::invalid(
-            format!("{field}[{i}]"),
-            "must be a finite number",
-        ));
-    }
-    Ok(Some(arr))
-}
-
-fn check_settings(s: &EkfCampaignSettings) -> Result<(), IdentifyError> {
-    let pos = |field: &str, v: f64| {
-        if v.is_finite() && v > 0.0 {
-            Ok(())
-        } else {
-            Err(IdentifyError::invalid(
-                format!("settings.{field}"),
-                format!("must be a positive number, got {v}"),
-            ))
-        }
-    };
-    let nonneg = |field: &str, v: f64| {
-        if v.is_finite() && v >= 0.0 {
-            Ok(())
-        } else {
-            Err(IdentifyError::invalid(
-                format!("settings.{field}"),
-                format!("must be a number ≥ 0, got {v}"),
-            ))
-        }
-    };
-    if s.sweeps == 0 || s.sweeps > 20 {
-        return Err(IdentifyError::invalid(
-            "settings.sweeps",
-            format!("must be 1–20, got {}", s.sweeps),
-        ));
-    }
-    if s.k == 0 {
-        return Err(IdentifyError::invalid(
-            "settings.k",
-            "the horizon k must be ≥ 1",
-        ));
-    }
-    pos("position_noise_std_m", s.position_noise_std_m)?;
-    pos("heading_noise_std_deg", s.heading_noise_std_deg)?;
-    for (i, &v) in s.bias_walk_std_bis.iter().enumerate() {
-        nonneg(&format!("bias_walk_std_bis[{i}]"), v)?;
-    }
-    for (i, &v) in s.bias_initial_std_bis.iter().enumerate() {
-        pos(&format!("bias_initial_std_bis[{i}]"), v)?;
-    }
-    nonneg("momentum_noise_std_bis", s.momentum_noise_std_bis)?;
-    nonneg("q_theta", s.q_theta)?;
-    if let Some(std) = nine("settings.theta_init_std", &s.theta_init_std)? {
-        for (i, &v) in std.iter().enumerate() {
-            pos(&format!("theta_init_std[{i}]"), v)?;
-        }
-    }
-    nine("settings.theta_init", &s.theta_init)?;
-    Ok(())
-}
-
-/// Stage of a planned DP family.
-fn stage_of(family: Option<ExperimentFamily>) -> Option<usize> {
-    match family? {
-        ExperimentFamily::DpSurge => Some(0),
-        ExperimentFamily::DpSwayYaw => Some(1),
-        ExperimentFamily::DpAzimuth => Some(2),
-        _ => None,
-    }
 }
 
 /// One run's blocks as Bis EKF data: u (commands), z = (x/L, y/L, ψ unwrapped).
@@ -381,7 +246,7 @@ pub fn identify_ekf_campaign(
     settings: &EkfCampaignSettings,
     progress: &mut dyn Progress,
 ) -> Result<Identified, IdentifyError> {
-    let (m, t, scale) = known(profile)?;
+    let (prior_m, t, scale) = known(profile)?;
     check_settings(settings)?;
     if inputs.len() != 6 {
         return Err(IdentifyError::invalid(
@@ -394,32 +259,13 @@ pub fn identify_ekf_campaign(
     }
     let roles = assign_roles(runs, settings.validation_run_ids.as_deref())?;
     if let Some(r) = roles.statics.first() {
-        return Err(IdentifyError::invalid(
-            format!("runs[{}]", r.run_id),
-            "a static run has no place in the DP manoeuvres SI1–SI3",
-        ));
+        stage_of(&r.run_id, r.family)?;
     }
     let mut staged: [Vec<Block>; 3] = Default::default();
     for r in &roles.estimation {
-        let s = stage_of(r.family).ok_or_else(|| {
-            IdentifyError::invalid(
-                format!("runs[{}]", r.run_id),
-                "the parallel EKF stages runs by their planned DP manoeuvre (dp_surge → SI1, dp_sway_yaw → SI2, dp_azimuth → SI3); this run flew none — hold it out in settings.validation_run_ids or leave it out of run_ids",
-            )
-        })?;
-        staged[s].extend(blocks(r, inputs, &scale)?);
+        staged[stage_of(&r.run_id, r.family)?].extend(blocks(r, inputs, &scale)?);
     }
-    for (s, fam) in ["dp_surge", "dp_sway_yaw", "dp_azimuth"].iter().enumerate() {
-        if staged[s].is_empty() {
-            return Err(IdentifyError::invalid(
-                "run_ids",
-                format!(
-                    "no {fam} run for SI{}: every θ″ needs its manoeuvre (Fossen et al. sec. 4.2, N ≥ 2 recommended)",
-                    s + 1
-                ),
-            ));
-        }
-    }
+    every_stage(&staged.each_ref().map(Vec::len))?;
     let h_s = staged[0][0].h_s;
     if let Some(b) = staged
         .iter()
@@ -434,9 +280,30 @@ pub fn identify_ekf_campaign(
             ),
         ));
     }
+    let start = match prior_m {
+        Some(_) => None,
+        None => {
+            let b: Vec<InitBlock<'_>> = staged
+                .iter()
+                .flatten()
+                .map(|b| InitBlock { u: &b.u, z: &b.z })
+                .collect();
+            Some(ls_start(&b, h_s / scale.time_unit_s, &t, &GROUPS).map_err(|e| {
+                IdentifyError::invalid(
+                    "vessel.dp_prior.inertia_bis",
+                    format!(
+                        "the profile gives no M″ and the runs do not determine it: {e}; give M″ in the profile"
+                    ),
+                )
+            })?)
+        }
+    };
+    let m = prior_m.unwrap_or_else(|| start.as_ref().map_or(Matrix3::identity(), |s| s.m));
     let theta_init = match nine("settings.theta_init", &settings.theta_init)? {
         Some(t) => t,
-        None => default_theta(profile, &scale),
+        None => start
+            .as_ref()
+            .map_or_else(|| default_theta(profile, &scale), |s| s.theta),
     };
     let theta_init_std = match nine("settings.theta_init_std", &settings.theta_init_std)? {
         Some(s) => s,
@@ -515,7 +382,17 @@ pub fn identify_ekf_campaign(
         });
     }
     progress.update(1.0, "done")?;
-    let document = document(&id, &cfg, &scale, inputs, &staged);
+    let mut document = document(&id, &cfg, &scale, inputs, &staged);
+    if let Some(st) = &start {
+        document.notes[2] = without_prior_note(&st.m);
+        document
+            .structure_findings
+            .push(WITHOUT_PRIOR_FINDING.to_string());
+        document.notes.push(format!(
+            "EKF started from the least-squares fit: θ″ = [{}].",
+            st.theta.map(sig3).join(", ")
+        ));
+    }
     let mut used = settings.clone();
     used.theta_init = Some(theta_init.to_vec());
     used.theta_init_std = Some(theta_init_std.to_vec());

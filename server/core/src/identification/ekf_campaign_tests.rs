@@ -7,6 +7,7 @@
 use super::*;
 use crate::estimation::NoProgress;
 use crate::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
+use crate::planning::campaign::ExperimentFamily;
 use crate::planning::examples::{supply_vessel, supply_vessel_trial_campaign};
 use crate::planning::generate_plan;
 use crate::simulation::dp_ship::{DpFlightSettings, DpShip, fly_dp_campaign, paper};
@@ -55,7 +56,10 @@ fn supply_vessel_profile_carries_the_papers_m_and_t() {
     let prior = p.dp_prior.as_ref().unwrap();
     assert_eq!(prior.length_m, paper::LENGTH_M);
     for i in 0..3 {
-        assert_eq!(prior.inertia_bis[i].as_slice(), &paper::M_INERTIA[i]);
+        assert_eq!(
+            prior.inertia_bis.as_ref().unwrap()[i].as_slice(),
+            &paper::M_INERTIA[i]
+        );
     }
     let InputChannels::Thrusters { configuration, .. } = &p.inputs else {
         panic!("thrusters")
@@ -167,7 +171,7 @@ fn bad_settings_and_runs_name_the_field() {
     let e = go(&EkfCampaignSettings::default(), &no_si3);
     assert_eq!(e.field(), "run_ids");
     assert!(e.to_string().contains("SI3"), "{e}");
-    // A ROV profile is refused naming the method; a DP profile without M″ names it.
+    // A ROV profile is refused naming the method; a DP profile without L names it.
     let rov = crate::planning::examples::surveyor_rov();
     let e = identify_ekf_campaign(&rov, &inputs, &runs, &Default::default(), &mut NoProgress)
         .unwrap_err();
@@ -176,7 +180,7 @@ fn bad_settings_and_runs_name_the_field() {
     bare.dp_prior = None;
     let e = identify_ekf_campaign(&bare, &inputs, &runs, &Default::default(), &mut NoProgress)
         .unwrap_err();
-    assert_eq!(e.field(), "vessel.dp_prior");
+    assert_eq!(e.field(), "vessel.dp_prior.length_m");
 }
 
 #[test]

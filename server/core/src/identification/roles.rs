@@ -40,11 +40,7 @@ pub fn assign_roles<'a>(
     }
     let mut roles = Roles::default();
     for r in runs {
-        let held_out = match validation_run_ids {
-            Some(ids) => ids.contains(&r.run_id),
-            None => r.family == Some(ExperimentFamily::Validation),
-        };
-        if held_out {
+        if held_out(&r.run_id, r.family, validation_run_ids) {
             roles.validation.push(r);
         } else if r.family == Some(ExperimentFamily::Static) {
             roles.statics.push(r);
@@ -53,10 +49,7 @@ pub fn assign_roles<'a>(
         }
     }
     if roles.validation.is_empty() {
-        return Err(IdentifyError::invalid(
-            "settings.validation_run_ids",
-            "no validation run: fly the plan's validation experiment, set a run's role to validation (PATCH /api/runs/{id}), or name held-out runs in settings.validation_run_ids",
-        ));
+        return Err(no_validation_run());
     }
     if roles.estimation.is_empty() {
         return Err(IdentifyError::invalid(
@@ -65,6 +58,27 @@ pub fn assign_roles<'a>(
         ));
     }
     Ok(roles)
+}
+
+/// The error of a job without a held-out run.
+pub fn no_validation_run() -> IdentifyError {
+    IdentifyError::invalid(
+        "settings.validation_run_ids",
+        "no validation run: fly the plan's validation experiment, set a run's role to validation (PATCH /api/runs/{id}), or name held-out runs in settings.validation_run_ids",
+    )
+}
+
+/// Whether a run is held out: named in `validation_run_ids` when given,
+/// else its family is validation.
+pub fn held_out(
+    run_id: &str,
+    family: Option<ExperimentFamily>,
+    validation_run_ids: Option<&[String]>,
+) -> bool {
+    match validation_run_ids {
+        Some(ids) => ids.iter().any(|i| i == run_id),
+        None => family == Some(ExperimentFamily::Validation),
+    }
 }
 
 /// Index of the grid speed nearest `speed`.

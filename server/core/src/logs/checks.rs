@@ -81,9 +81,9 @@ pub fn plausibility_warnings(table: &LogTable) -> Vec<LogWarning> {
             "theta" => degrees(FRAC_PI_2 + ANGLE_SLACK),
             "psi" if amax > TAU + HEADING_SLACK || max - min > TAU + HEADING_SLACK => {
                 Some(format!(
-                    "psi looks like degrees (max {}, range {}); the contract is radians: convert \
-                 before identification (if it is a heading in radians unwrapped over more \
-                 than a full turn, ignore this)",
+                    "psi looks like degrees (max {}, range {}); the contract is radians: declare \
+                 heading_unit deg (vessel profile or upload meta) or convert (if it is a \
+                 heading in radians unwrapped over more than a full turn, ignore this)",
                     short(max),
                     short(max - min)
                 ))

@@ -16,7 +16,9 @@
 //!
 //! A vessel's file carries the columns of its modeled DOFs only (a 3-DOF DP
 //! vessel: `tau_X tau_Y tau_N` or `thr_*`; `u v r`; `x y psi`); see
-//! [`schema::required_columns`]. Missing required columns are an error; other
+//! [`schema::required_columns`]; a DP vessel needs its pose or its
+//! velocities, not necessarily both. The heading may be declared in degrees
+//! (`HeadingUnit`). Missing required columns are an error; other
 //! columns are kept when fully numeric and ignored otherwise.
 //!
 //! A run may instead come as two files from unsynchronized computers: a
@@ -36,6 +38,7 @@
 pub mod checks;
 pub mod error;
 pub mod gaps;
+pub mod measurements;
 pub mod parse;
 pub mod schema;
 pub mod uniform;
@@ -44,5 +47,8 @@ pub use checks::LogWarning;
 pub use error::{LogError, LogErrorKind};
 pub use gaps::{Gap, MAX_BRIDGE_SAMPLES};
 pub use parse::{DEFAULT_MAX_COLUMNS, DEFAULT_MAX_ROWS, ParseOptions, ParsedLog, parse_log};
-pub use schema::{LogRole, input_columns, output_columns, pose_columns, required_columns};
+pub use schema::{
+    LogRole, input_columns, measurement_groups, output_columns, pose_columns, required_columns,
+    strict_columns,
+};
 pub use uniform::{MAX_RATE_HZ, MIN_RATE_HZ, check_rate_hz, to_uniform, zoh};

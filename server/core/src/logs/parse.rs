@@ -19,9 +19,10 @@ use csv::{ByteRecord, ReaderBuilder, Terminator};
 use super::checks::{LogWarning, plausibility_warnings};
 use super::error::{LogError, LogErrorKind};
 use super::gaps::{Gap, find_gaps};
-use super::schema::{LogRole, TIME_COLUMN, describe_vessel, required_columns};
+use super::measurements::{check_groups, heading_from_degrees};
+use super::schema::{LogRole, TIME_COLUMN, describe_vessel, measurement_groups, strict_columns};
 use crate::numbers::{echoed, escape_controls};
-use crate::planning::vessel::VesselProfile;
+use crate::planning::vessel::{HeadingUnit, VesselProfile};
 use crate::timeseries::LogTable;
 
 /// Default limit on data rows (a 10 Hz log of almost 58 days).
@@ -48,6 +49,11 @@ pub struct ParseOptions {
     /// Who needs the required columns, for the missing-columns message, e.g.
     /// `the 6-DOF ROV 'Surveyor ROV'`.
     pub needed_by: Option<String>,
+    /// Groups of columns of which at least one must be complete (a DP
+    /// vessel's velocities or pose); empty: no such condition.
+    pub one_of: Vec<Vec<String>>,
+    /// Unit of `psi` in the file; degrees are converted to radians.
+    pub heading_unit: HeadingUnit,
 }
 
 impl ParseOptions {
@@ -59,15 +65,21 @@ impl ParseOptions {
             max_rows: DEFAULT_MAX_ROWS,
             max_columns: DEFAULT_MAX_COLUMNS,
             needed_by: None,
+            one_of: Vec::new(),
+            heading_unit: HeadingUnit::Rad,
         }
     }
 
     /// Options for a file of `role` of `vessel` (see
-    /// [`required_columns`]), named after the role.
+    /// [`required_columns`](super::schema::required_columns);
+    /// a DP vessel's pose or velocities suffice), named after the role,
+    /// with the profile's heading unit.
     pub fn for_vessel(vessel: &VesselProfile, role: LogRole, shared: Option<&str>) -> Self {
         ParseOptions {
             needed_by: Some(describe_vessel(vessel)),
-            ..ParseOptions::new(role.label(), required_columns(vessel, role, shared))
+            one_of: measurement_groups(vessel, role),
+            heading_unit: vessel.heading_unit.unwrap_or_default(),
+            ..ParseOptions::new(role.label(), strict_columns(vessel, role, shared))
         }
     }
 }
@@ -295,6 +307,9 @@ pub fn parse_log<R: Read>(reader: R, opts: &ParseOptions) -> Result<ParsedLog, L
             ),
         });
     }
+    if opts.heading_unit == HeadingUnit::Deg {
+        warnings.extend(heading_from_degrees(&mut table));
+    }
     warnings.extend(plausibility_warnings(&table));
     let gaps = table
         .median_dt()
@@ -374,7 +389,7 @@ fn check_header(
         .filter(|w| !first_at.contains_key(w))
         .collect();
     if missing.is_empty() {
-        return Ok(());
+        return check_groups(&first_at, line, opts);
     }
     let mut msg = if let [one] = missing.as_slice() {
         format!("column {one} is missing")

@@ -10,6 +10,12 @@
 //!   yaw→`psi` (m, rad) of the modeled DOFs.
 //!
 //! Within each group the order is that of the profile's `dofs`.
+//!
+//! A DP vessel (kind `dp3`) logs what its DP system records: the pose
+//! (x, y, ψ — what the parallel EKF of Fossen et al. 1995 identifies
+//! from), the body velocities (u, v, r), or both. Its files must carry at
+//! least one of the two groups complete ([`measurement_groups`]); a ROV's
+//! files carry both.
 
 use serde::{Deserialize, Serialize};
 
@@ -121,6 +127,29 @@ pub fn required_columns(
     cols
 }
 
+/// Columns a file of `role` must carry without exception: [`required_columns`]
+/// less the measurement groups of a DP vessel, of which one complete group
+/// suffices ([`measurement_groups`]).
+pub fn strict_columns(vessel: &VesselProfile, role: LogRole, shared: Option<&str>) -> Vec<String> {
+    let groups = measurement_groups(vessel, role);
+    let shared = shared.map(str::trim).filter(|s| !s.is_empty());
+    required_columns(vessel, role, shared)
+        .into_iter()
+        .filter(|c| Some(c.as_str()) == shared || !groups.iter().flatten().any(|g| g == c))
+        .collect()
+}
+
+/// Alternative measurement groups of a file of `role`, at least one of which
+/// must be complete: for a DP vessel's single or navigation file the body
+/// velocities (`u v r`) and the pose (`x y psi`); empty otherwise (a ROV
+/// needs both, and [`strict_columns`] lists them).
+pub fn measurement_groups(vessel: &VesselProfile, role: LogRole) -> Vec<Vec<String>> {
+    if vessel.kind != VesselKind::Dp3 || role == LogRole::Control {
+        return Vec::new();
+    }
+    vec![output_columns(vessel), pose_columns(vessel)]
+}
+
 /// The vessel in words for messages, e.g. `the 6-DOF ROV 'Surveyor ROV'`.
 pub fn describe_vessel(vessel: &VesselProfile) -> String {
     let kind = match vessel.kind {
@@ -194,5 +223,27 @@ mod tests {
         assert_eq!(strs(&control)[..2], ["t", "thr_1"]);
         assert_eq!(control.last().map(String::as_str), Some("psi"));
         assert_eq!(LogRole::Nav.label(), "nav");
+    }
+
+    #[test]
+    fn a_dp_vessel_needs_its_pose_or_its_velocities() {
+        let v = supply_vessel();
+        let strict = strict_columns(&v, LogRole::Single, None);
+        assert_eq!(strict.len(), 7, "{strict:?}");
+        assert_eq!(strs(&strict)[..2], ["t", "thr_1"]);
+        let groups = measurement_groups(&v, LogRole::Nav);
+        assert_eq!(strs(&groups[0]), ["u", "v", "r"]);
+        assert_eq!(strs(&groups[1]), ["x", "y", "psi"]);
+        // A shared channel stays required even when it is a pose column.
+        assert_eq!(
+            strict_columns(&v, LogRole::Nav, Some("psi")),
+            ["t".to_string(), "psi".to_string()]
+        );
+        let rov = surveyor_rov();
+        assert!(measurement_groups(&rov, LogRole::Single).is_empty());
+        assert_eq!(
+            strict_columns(&rov, LogRole::Single, None),
+            required_columns(&rov, LogRole::Single, None)
+        );
     }
 }

@@ -48,6 +48,7 @@ pub fn surveyor_rov() -> VesselProfile {
         controller_rate_hz: 20.0,
         logger_rate_hz: 10.0,
         dp_prior: None,
+        heading_unit: None,
     }
 }
 
@@ -102,12 +103,13 @@ pub fn supply_vessel() -> VesselProfile {
         // M″ of eq. 30 (semi-empirical added mass, Faltinsen 1990).
         dp_prior: Some(DpPrior {
             length_m: 76.2,
-            inertia_bis: vec![
+            inertia_bis: Some(vec![
                 vec![1.1274, 0.0, 0.0],
                 vec![0.0, 1.8902, -0.0744],
                 vec![0.0, -0.0744, 0.1278],
-            ],
+            ]),
         }),
+        heading_unit: None,
     }
 }
 

@@ -104,8 +104,12 @@ pub struct DpPrior {
     /// Ship length L (m): the Bis length unit.
     pub length_m: f64,
     /// M″ = M/m (Bis), 3 × 3 in the DOF order surge, sway, yaw; symmetric
-    /// positive definite (eq. 27, 30).
-    pub inertia_bis: Vec<Vec<f64>>,
+    /// positive definite (eq. 27, 30). Without it the parallel EKF
+    /// estimates the shape of M″ by least squares on the runs and fixes its
+    /// scale at the rigid-body mass (M″11 = M″22 = 1); the model's notes say
+    /// what that leaves undetermined.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertia_bis: Option<Vec<Vec<f64>>>,
 }
 
 impl DpPrior {
@@ -124,7 +128,9 @@ impl DpPrior {
 
     fn validate(&self) -> Result<(), PlanError> {
         positive("dp_prior.length_m", self.length_m)?;
-        let m = &self.inertia_bis;
+        let Some(m) = &self.inertia_bis else {
+            return Ok(());
+        };
         if m.len() != 3 || m.iter().any(|r| r.len() != 3) {
             return Err(PlanError::invalid(
                 "dp_prior.inertia_bis",
@@ -147,6 +153,19 @@ impl DpPrior {
         }
         Ok(())
     }
+}
+
+/// Unit of the logged heading `psi` (the other angles are radians).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum HeadingUnit {
+    /// Radians (the log contract).
+    #[default]
+    Rad,
+    /// Degrees, as many DP systems and gyro compasses record it; converted
+    /// to radians on reading.
+    Deg,
 }
 
 /// A vessel as the planner needs it.
@@ -174,10 +193,14 @@ pub struct VesselProfile {
     pub controller_rate_hz: f64,
     /// Rate of the data logger (Hz); the thesis logged a 20 Hz controller at 10 Hz.
     pub logger_rate_hz: f64,
-    /// DP vessels: the known inertia M″ and the Bis scale, for the parallel
-    /// EKF identification (`parallel_ekf`).
+    /// DP vessels: the ship length L (Bis scale) and, when known, the
+    /// inertia M″, for the parallel EKF identification (`parallel_ekf`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dp_prior: Option<DpPrior>,
+    /// Unit of the logged heading `psi` (default radians); an upload's
+    /// `meta.heading_unit` overrides it for that run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heading_unit: Option<HeadingUnit>,
 }
 
 impl VesselProfile {
@@ -366,7 +389,7 @@ mod tests {
         assert_eq!(v.validate().unwrap_err().field, "dofs[3]");
 
         let mut v = supply_vessel();
-        v.dp_prior.as_mut().unwrap().inertia_bis[1][2] = 0.5;
+        v.dp_prior.as_mut().unwrap().inertia_bis.as_mut().unwrap()[1][2] = 0.5;
         assert_eq!(v.validate().unwrap_err().field, "dp_prior.inertia_bis");
         let mut v = surveyor_rov();
         v.dp_prior = supply_vessel().dp_prior;
