@@ -10,6 +10,7 @@ pub mod dof;
 pub mod error;
 pub mod examples;
 pub mod plan;
+pub mod revision;
 pub mod vessel;
 pub mod waveform;
 
