@@ -116,6 +116,16 @@ async fn ten_replans_of_an_unchanged_campaign_change_nothing() {
             + cov["repeat"].as_u64().unwrap(),
         5
     );
+    // As a plan stored before versioning would be (no identity, no
+    // fingerprints): the first re-plan computes them from what is stored.
+    for sql in [
+        "UPDATE experiment SET identity = NULL, fingerprint = NULL",
+        "UPDATE plan SET fingerprint = NULL",
+    ] {
+        sqlx::query(sql).execute(&app.state.db).await.unwrap();
+    }
+    let r = replan(&app, &cid, None).await;
+    assert_eq!(r.status, 200, "recognised as unchanged: {}", r.text);
     let before = footprint(&app).await;
 
     for _ in 0..10 {

@@ -12,7 +12,7 @@ use seatrial_core::planning::{CampaignSpec, Plan};
 use super::plans::{
     ChangeCounts, ExperimentChange, ExperimentRow, PlanChanges, StoredPlan, UnmatchedRun, encode,
     experiment_rows, fingerprint, latest_row, plan_fingerprint, schedule, stored_experiment,
-    stored_plan,
+    stored_fingerprint, stored_plan,
 };
 use super::{Db, lock_row, new_id, now};
 
@@ -72,7 +72,7 @@ async fn backfill(
         }
         let e = stored_experiment(r)?.experiment;
         let s = schedule(conn, &r.id).await?;
-        let (id, fp) = (identity(&e), fingerprint(&e, &s)?);
+        let (id, fp) = (identity(&e), stored_fingerprint(&r.detail, &s));
         sqlx::query("UPDATE experiment SET identity = $1, fingerprint = $2 WHERE id = $3")
             .bind(&id)
             .bind(&fp)

@@ -177,14 +177,38 @@ pub(crate) fn decode(r: ScheduleRow) -> anyhow::Result<Schedule> {
 /// SHA-256 (hex) of an experiment's content: its description without the
 /// run-order position, and its schedule (rate, column names, samples).
 pub fn fingerprint(e: &Experiment, s: &Schedule) -> anyhow::Result<String> {
-    let mut h = Sha256::new();
     let mut described = e.clone();
     described.seq = 0;
-    h.update(serde_json::to_vec(&described)?);
+    Ok(content_hash(&serde_json::to_string(&described)?, s))
+}
+
+/// [`fingerprint`] of a stored experiment from its `detail` text as stored
+/// (hashing the text itself, not a re-serialization of what it parses to,
+/// which need not give the same digits).
+pub(crate) fn stored_fingerprint(detail: &str, s: &Schedule) -> String {
+    // `seq` is the first field of the stored description.
+    let described = match detail.strip_prefix("{\"seq\":") {
+        Some(rest) => {
+            let digits = rest
+                .find(|c: char| !c.is_ascii_digit())
+                .unwrap_or(rest.len());
+            format!("{{\"seq\":0{}", &rest[digits..])
+        }
+        None => detail.to_string(),
+    };
+    content_hash(&described, s)
+}
+
+fn content_hash(described: &str, s: &Schedule) -> String {
+    let mut h = Sha256::new();
+    h.update(described.as_bytes());
     h.update(s.sample_rate_hz.to_le_bytes());
-    h.update(serde_json::to_vec(&s.columns)?);
+    for c in &s.columns {
+        h.update(c.as_bytes());
+        h.update([0]);
+    }
     h.update(encode(s));
-    Ok(hex::encode(h.finalize()))
+    hex::encode(h.finalize())
 }
 
 /// SHA-256 (hex) of a plan: its totals and its experiments' fingerprints
