@@ -11,6 +11,7 @@ pub mod error;
 pub mod examples;
 pub mod plan;
 pub mod revision;
+pub mod statics;
 pub mod vessel;
 pub mod waveform;
 
