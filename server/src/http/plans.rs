@@ -32,10 +32,10 @@ pub struct CampaignRevision {
     /// Repetitions.
     #[serde(default)]
     pub repetitions: Option<u32>,
-    /// Excitation settings (replaced as a whole).
+    /// Excitation settings (replaced as a whole: its absent fields take their defaults).
     #[serde(default)]
     pub excitation: Option<Excitation>,
-    /// Durations (replaced as a whole).
+    /// Durations (replaced as a whole: its absent fields take their defaults).
     #[serde(default)]
     pub durations: Option<Durations>,
     /// Seed of every pseudo-random sequence (0 … 2⁵³−1).

@@ -304,6 +304,16 @@ mod tests {
         let est = estimate_restoring(&records, &estimator).unwrap();
         let r = &truth.restoring;
         let bg = -r.r_b[2] * r.buoyancy;
+        eprintln!(
+            "z_G W − z_B B = {:.0} ± {:.0} N·m (truth {bg:.0}); W − B = {:.1} ± {:.1} N (truth {:.1}); τ_θ = {:.1} N·m; {} steady segments",
+            est.params.zg_weight_minus_zb_buoyancy_nm,
+            est.std.zg_weight_minus_zb_buoyancy_nm,
+            est.params.weight_minus_buoyancy_n,
+            est.std.weight_minus_buoyancy_n,
+            r.weight - r.buoyancy,
+            est.params.tether_pitch_moment_nm,
+            est.segments.len()
+        );
         let got = est.params.zg_weight_minus_zb_buoyancy_nm;
         assert!(
             (got - bg).abs() < 0.02 * bg,
