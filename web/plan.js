@@ -65,6 +65,31 @@ function excitationText(c) {
   return parts.join(' · ') || 'defaults';
 }
 
+/** "3 added, 3 removed, 1 changed, 17 unchanged; 1 run no longer matched" */
+function changeWords(ch) {
+  const n = ch.counts;
+  const runs = ch.unmatched_runs.length;
+  const tail = runs ? `; ${runs} run${runs === 1 ? '' : 's'} no longer matched` : '';
+  return `${n.added} added, ${n.removed} removed, ${n.changed} changed, ${n.unchanged} unchanged against v${ch.previous_version}${tail}`;
+}
+
+/** What this plan version changed against the previous one (none for v1). */
+function changesPanel(ch) {
+  if (!ch) return null;
+  const list = (label, items) => (items.length
+    ? h('li', null, `${label}: `, h('span', { class: 'mono' }, items.map((e) => e.code).join(', ')))
+    : null);
+  return h('details', { class: 'plan-changes', 'data-testid': 'plan-changes' },
+    h('summary', null, changeWords(ch)),
+    h('ul', null,
+      list('added', ch.added),
+      list('removed', ch.removed),
+      list('changed (new schedule, new id)', ch.changed),
+      ch.unmatched_runs.map((r) => h('li', { 'data-testid': 'unmatched-run' },
+        `run “${r.name}” was flown for ${r.code}, which was ${r.reason}`,
+        r.replaced_by ? ' (fly the new schedule again)' : ''))));
+}
+
 /** The campaign page. Returns a controller the router reuses for experiment routes. */
 export async function campaignPage(view, id) {
   const campaign = await api.campaign(id);
@@ -114,7 +139,10 @@ export async function campaignPage(view, id) {
     const t0 = performance.now();
     try {
       plan = await api.generatePlan(id);
-      banner(`Plan v${plan.version} generated: ${plan.totals.experiments} experiments in ${fmt((performance.now() - t0) / 1000, 1)} s.`, 'ok');
+      const took = `${fmt((performance.now() - t0) / 1000, 1)} s`;
+      if (plan.created === false) banner(`Plan v${plan.version} unchanged: the inputs give the same plan, nothing stored (${took}).`, 'ok');
+      else if (plan.changes) banner(`Plan v${plan.version} generated: ${changeWords(plan.changes)} (${took}).`, 'ok');
+      else banner(`Plan v${plan.version} generated: ${plan.totals.experiments} experiments in ${took}.`, 'ok');
       selected = null;
       if (location.hash !== `#/campaigns/${id}`) history.replaceState(null, '', `#/campaigns/${id}`);
       renderPlan();
@@ -172,6 +200,7 @@ export async function campaignPage(view, id) {
         h('div', { class: 'tot' }, h('b', null, hms(t.run_time_s)), h('span', null, 'run time')),
         h('div', { class: 'tot' }, h('b', null, hms(t.setup_time_s)), h('span', null, 'set-up')),
         h('div', { class: 'tot main' }, h('b', { 'data-testid': 'total-time' }, hms(t.total_time_s)), h('span', null, 'total trial time'))),
+      changesPanel(plan.changes),
       h('div', { class: 'plan-layout' },
         h('div', { class: 'plan-list' },
           h('div', { class: 'filters', role: 'group', 'aria-label': 'Filter experiments' },

@@ -45,7 +45,7 @@ pub async fn seed_if_empty(db: &Db, blobs: &BlobStore) -> anyhow::Result<bool> {
         let plan = tokio::task::spawn_blocking(move || generate_plan(&p, &s)).await??;
         let v = vessels::insert(db, profile.clone()).await?;
         let c = campaigns::insert(db, &v.id, spec).await?;
-        let stored = plans::insert(db, &c.id, &plan).await?;
+        let stored = crate::storage::plan_revision::insert(db, &c.id, &plan).await?;
         match v.profile.kind {
             VesselKind::Rov6 => fly_rov_trials(db, blobs, &c.id, &profile, plan, &stored).await?,
             VesselKind::Dp3 => fly_dp_trials(db, blobs, &c.id, &profile, plan, &stored).await?,

@@ -103,6 +103,30 @@ test('ROV: vessel from template → campaign on a filled grid → plan → exper
     await page.selectOption(tid('filter-speed'), '');
     assert.equal(await rows(page), 119);
 
+    // Re-planning the unchanged campaign stores nothing: still version 1.
+    const firstId = await page.locator(tid('plan-row')).first().getAttribute('data-eid');
+    await page.click(tid('generate-plan'));
+    await page.locator(tid('banner-ok')).filter({ hasText: 'Plan v1 unchanged' }).waitFor();
+    assert.match(await page.textContent(tid('plan-totals')), /Plan v1/);
+    assert.equal(await page.locator(tid('plan-changes')).count(), 0);
+    assert.equal(await page.locator(tid('plan-row')).first().getAttribute('data-eid'), firstId);
+
+    // A re-plan with a second repetition (through the API): the page shows
+    // version 2 and what changed against version 1.
+    const status = await page.evaluate(async () => {
+      const id = location.hash.split('/')[2];
+      const r = await fetch(`/api/campaigns/${id}/plan`, {
+        method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify({ repetitions: 2 }),
+      });
+      return r.status;
+    });
+    assert.equal(status, 201);
+    await page.reload();
+    await waitRows(page, 238);
+    assert.match(await page.textContent(tid('plan-totals')), /Plan v2/);
+    assert.match(await page.textContent(tid('plan-changes')), /119 added, 0 removed, 0 changed, 119 unchanged against v1/);
+    assert.equal(await page.locator(`[data-testid="plan-row"][data-eid="${firstId}"]`).count(), 1);
+
     // Open a dynamic sway experiment.
     await page.click('[data-testid="plan-row"][data-code="DYN-1.5kn-sway-r1"]');
     await page.waitForURL(/\/experiments\/[0-9a-f-]{36}$/);

@@ -44,6 +44,28 @@ impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for ApiJson<T> {
     }
 }
 
+/// [`ApiJson`] for an optional body: an empty body is `None` (whatever its
+/// content type); a non-empty one must be JSON.
+pub struct OptionalApiJson<T>(pub Option<T>);
+
+impl<T: DeserializeOwned, S: Send + Sync> FromRequest<S> for OptionalApiJson<T> {
+    type Rejection = ApiError;
+
+    async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
+        let (parts, body) = req.into_parts();
+        let bytes = axum::body::to_bytes(body, MAX_JSON_BODY)
+            .await
+            .map_err(|_| ApiError::too_large("the JSON body", MAX_JSON_BODY as u64, ""))?;
+        if bytes.iter().all(u8::is_ascii_whitespace) {
+            return Ok(OptionalApiJson(None));
+        }
+        let req = Request::from_parts(parts, axum::body::Body::from(bytes));
+        ApiJson::from_request(req, state)
+            .await
+            .map(|ApiJson(v)| OptionalApiJson(Some(v)))
+    }
+}
+
 /// Largest magnitude below which every integer is exactly a double (2⁵³).
 const EXACT_INTEGER: f64 = 9_007_199_254_740_992.0;
 

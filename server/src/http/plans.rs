@@ -1,39 +1,135 @@
-//! Plans: generate, read, and export each experiment's schedule.
+//! Plans: generate and re-plan (versioned), read, and export each
+//! experiment's schedule.
 
 use axum::Json;
 use axum::extract::{Path, State};
 use axum::http::{StatusCode, header};
 use axum::response::{Html, IntoResponse};
 use seatrial_core::planning::analysis::schedule_spectrum;
-use serde::Serialize;
+use seatrial_core::planning::campaign::{Durations, Excitation};
+use seatrial_core::planning::{CampaignSpec, ExperimentFamily, SpeedGrid};
+use serde::{Deserialize, Serialize};
 
+use super::json::OptionalApiJson;
 use super::{AppState, blocking, export, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
+use crate::storage::plan_revision::{self, Fingerprinted};
 use crate::storage::plans::{self, StoredExperiment, StoredPlan};
 use crate::storage::{campaigns, vessels};
 
-/// Generate (or regenerate) the campaign's plan: a new version, stored with
-/// every schedule. Deterministic for the campaign's seed.
+/// Changes to the campaign for a re-plan; absent fields are kept. An empty
+/// body re-plans the campaign as it is.
+#[derive(Debug, Deserialize, utoipa::ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignRevision {
+    /// Forward-speed grid, in kn or m/s.
+    #[serde(default)]
+    pub grid: Option<SpeedGrid>,
+    /// Families to fly (at least one, each once).
+    #[serde(default)]
+    #[schema(min_items = 1)]
+    pub families: Option<Vec<ExperimentFamily>>,
+    /// Repetitions.
+    #[serde(default)]
+    pub repetitions: Option<u32>,
+    /// Excitation settings (replaced as a whole: its absent fields take their defaults).
+    #[serde(default)]
+    pub excitation: Option<Excitation>,
+    /// Durations (replaced as a whole: its absent fields take their defaults).
+    #[serde(default)]
+    pub durations: Option<Durations>,
+    /// Seed of every pseudo-random sequence (0 … 2⁵³−1).
+    #[serde(default)]
+    pub seed: Option<u64>,
+}
+
+impl CampaignRevision {
+    fn apply(self, spec: &CampaignSpec) -> CampaignSpec {
+        let mut s = spec.clone();
+        if let Some(g) = self.grid {
+            s.grid = g;
+        }
+        if let Some(f) = self.families {
+            s.families = f;
+        }
+        if let Some(r) = self.repetitions {
+            s.repetitions = Some(r);
+        }
+        if let Some(e) = self.excitation {
+            s.excitation = e;
+        }
+        if let Some(d) = self.durations {
+            s.durations = d;
+        }
+        if let Some(seed) = self.seed {
+            s.seed = seed;
+        }
+        s
+    }
+}
+
+/// A plan as (re-)planning returns it.
+#[derive(Debug, Serialize, utoipa::ToSchema)]
+pub struct PlanRevision {
+    /// The campaign's newest plan.
+    #[serde(flatten)]
+    pub plan: StoredPlan,
+    /// True when this call stored a new version; false when the plan came
+    /// out identical to the newest version, which is returned unchanged.
+    pub created: bool,
+}
+
+/// Plan or re-plan the campaign, optionally with changed settings (which
+/// then become the campaign's). Deterministic for the campaign's seed. A
+/// new version keeps the id of every experiment whose identity (family,
+/// grid speed, DOFs, static sign, repetition) and content (description and
+/// schedule) are unchanged, so uploaded runs stay matched; `changes` lists
+/// what was added, removed and changed, and the runs flown for removed or
+/// changed experiments. A plan identical to the newest version is not
+/// stored again: that version is returned with 200.
 #[utoipa::path(post, path = "/api/campaigns/{id}/plan", tag = "planning",
     params(("id" = String, Path, description = "Campaign id")),
+    request_body(content = Option<CampaignRevision>, description = "Optional changes to the campaign", content_type = "application/json"),
     responses(
-        (status = 201, description = "The new plan", body = StoredPlan),
+        (status = 200, description = "Identical to the newest version: nothing stored", body = PlanRevision),
+        (status = 201, description = "A new version", body = PlanRevision),
+        (status = 400, description = "Malformed JSON; `field` names the JSON path", body = ErrorBody),
         (status = 404, description = "No such campaign", body = ErrorBody),
-        (status = 422, description = "The campaign cannot be planned", body = ErrorBody)))]
+        (status = 413, description = "Body too large", body = ErrorBody),
+        (status = 415, description = "A body that is not JSON", body = ErrorBody),
+        (status = 422, description = "The campaign cannot be planned: `field` and `limit` name what and why", body = ErrorBody)))]
 pub async fn generate_plan(
     State(s): State<AppState>,
     Path(id): Path<String>,
-) -> ApiResult<(StatusCode, Json<StoredPlan>)> {
+    OptionalApiJson(change): OptionalApiJson<CampaignRevision>,
+) -> ApiResult<(StatusCode, Json<PlanRevision>)> {
     let campaign = found(campaigns::get(&s.db, &id).await?, "campaign", &id)?;
     let vessel = vessels::get(&s.db, &campaign.vessel_id)
         .await?
         .ok_or_else(|| ApiError::Internal(anyhow::anyhow!("campaign {id} has no vessel")))?;
-    let spec = campaign.spec;
-    let plan =
-        blocking(move || seatrial_core::planning::generate_plan(&vessel.profile, &spec)).await??;
+    let spec = change.map(|c| c.apply(&campaign.spec));
+    let planned = spec.clone().unwrap_or(campaign.spec);
+    let new = blocking(move || -> ApiResult<Fingerprinted> {
+        let plan = seatrial_core::planning::generate_plan(&vessel.profile, &planned)?;
+        Ok(Fingerprinted::new(plan)?)
+    })
+    .await??;
+    let stored = found(
+        plan_revision::store(&s.db, &id, &new, spec.as_ref()).await?,
+        "campaign",
+        &id,
+    )?;
+    let status = if stored.created {
+        StatusCode::CREATED
+    } else {
+        StatusCode::OK
+    };
     Ok((
-        StatusCode::CREATED,
-        Json(plans::insert(&s.db, &id, &plan).await?),
+        status,
+        Json(PlanRevision {
+            plan: stored.plan,
+            created: stored.created,
+        }),
     ))
 }
 

@@ -8,6 +8,7 @@ pub mod clock_offsets;
 pub mod discrepancies;
 pub mod jobs;
 pub mod models;
+pub mod plan_revision;
 pub mod plans;
 pub mod runs;
 pub mod vessels;

@@ -23,6 +23,7 @@ pub fn surveyor_rov() -> VesselProfile {
         max_force_rate: f / 2.0,
         max_accel: Some(0.3),
         time_constant_s: t,
+        max_angle: None,
     };
     let ang = |f: f64, t: f64| DofLimits {
         max_velocity: 0.3,
@@ -30,6 +31,7 @@ pub fn surveyor_rov() -> VesselProfile {
         max_force_rate: f / 2.0,
         max_accel: Some(0.3),
         time_constant_s: t,
+        max_angle: None,
     };
     let limits = BTreeMap::from([
         (Dof::Surge, lin(4.3 * KNOT, 10_000.0, 4.0)),
@@ -66,6 +68,7 @@ pub fn supply_vessel() -> VesselProfile {
         max_force_rate: f / 10.0,
         max_accel: None,
         time_constant_s: time_unit / a_ii,
+        max_angle: None,
     };
     let limits = BTreeMap::from([
         (Dof::Surge, dof(4.0, 1.3e6, 0.0318)),

@@ -10,6 +10,8 @@ pub mod dof;
 pub mod error;
 pub mod examples;
 pub mod plan;
+pub mod revision;
+pub mod statics;
 pub mod vessel;
 pub mod waveform;
 

@@ -153,22 +153,22 @@ fn run_seed(seed: u64, family: ExperimentFamily, grid: usize, dof: usize, rep: u
 }
 
 /// A channel before sampling.
-struct ChannelSpec {
-    plan: ChannelPlan,
-    duration_s: f64,
+pub(super) struct ChannelSpec {
+    pub(super) plan: ChannelPlan,
+    pub(super) duration_s: f64,
 }
 
 /// Shared context while planning.
-struct Ctx<'a> {
-    vessel: &'a VesselProfile,
-    spec: &'a CampaignSpec,
-    speeds: Vec<f64>,
+pub(super) struct Ctx<'a> {
+    pub(super) vessel: &'a VesselProfile,
+    pub(super) spec: &'a CampaignSpec,
+    pub(super) speeds: Vec<f64>,
     fs: f64,
     decimation: usize,
 }
 
 impl Ctx<'_> {
-    fn speed_label(&self, i: usize) -> String {
+    pub(super) fn speed_label(&self, i: usize) -> String {
         let (v, unit) = match self.spec.grid.unit {
             SpeedUnit::Knots => (self.spec.grid.speeds[i], "kn"),
             SpeedUnit::MetersPerSecond => (self.spec.grid.speeds[i], "m/s"),
@@ -191,7 +191,7 @@ impl Ctx<'_> {
     }
 
     /// Column, unit, clip limit and slew limit of a DOF channel.
-    fn dof_channel(&self, d: Dof) -> (String, String, f64, Option<f64>, String) {
+    pub(super) fn dof_channel(&self, d: Dof) -> (String, String, f64, Option<f64>, String) {
         let l = self.vessel.limit(d);
         if d == Dof::Surge || self.quantity() == Quantity::Velocity {
             (
@@ -213,7 +213,7 @@ impl Ctx<'_> {
     }
 
     /// Amplitude of a non-surge DOF, checked against its limit.
-    fn amplitude(&self, d: Dof) -> Result<f64, PlanError> {
+    pub(super) fn amplitude(&self, d: Dof) -> Result<f64, PlanError> {
         let (_, unit, limit, _, _) = self.dof_channel(d);
         match self.override_of(d).and_then(|o| o.amplitude) {
             Some(a) => check_amplitude(
@@ -252,7 +252,7 @@ impl Ctx<'_> {
         }
     }
 
-    fn held(&self, d: Dof, u0: f64) -> ChannelPlan {
+    pub(super) fn held(&self, d: Dof, u0: f64) -> ChannelPlan {
         let (column, unit, limit, rate, _) = self.dof_channel(d);
         ChannelPlan {
             column,
@@ -376,7 +376,7 @@ pub fn generate_plan(vessel: &VesselProfile, spec: &CampaignSpec) -> Result<Plan
         VesselKind::Rov6 => {
             for gi in 0..ctx.speeds.len() {
                 if has(ExperimentFamily::Static) {
-                    rov_static(&ctx, gi, reps, &mut out)?;
+                    super::statics::rov_static(&ctx, gi, reps, &mut out)?;
                 }
                 if has(ExperimentFamily::Dynamic) {
                     rov_dynamic(&ctx, gi, reps, &mut out)?;
@@ -427,21 +427,22 @@ pub fn generate_plan(vessel: &VesselProfile, spec: &CampaignSpec) -> Result<Plan
     })
 }
 
-struct ExperimentHead {
-    code: String,
-    family: ExperimentFamily,
-    grid_index: Option<usize>,
-    dofs: Vec<Dof>,
-    sign: Option<i8>,
-    repetition: u32,
-    instruction: String,
-    pe_required: usize,
+/// What an experiment is, before its channels are sampled.
+pub(super) struct ExperimentHead {
+    pub(super) code: String,
+    pub(super) family: ExperimentFamily,
+    pub(super) grid_index: Option<usize>,
+    pub(super) dofs: Vec<Dof>,
+    pub(super) sign: Option<i8>,
+    pub(super) repetition: u32,
+    pub(super) instruction: String,
+    pub(super) pe_required: usize,
     /// Field to blame when the excitation is not persistent enough.
-    field: String,
+    pub(super) field: String,
 }
 
 /// Samples, shapes and checks the channels of one experiment.
-fn assemble(
+pub(super) fn assemble(
     ctx: &Ctx<'_>,
     head: ExperimentHead,
     channels: Vec<ChannelSpec>,
@@ -552,7 +553,7 @@ fn assemble(
     })
 }
 
-fn fmt_speed(ctx: &Ctx<'_>, gi: usize) -> String {
+pub(super) fn fmt_speed(ctx: &Ctx<'_>, gi: usize) -> String {
     format!(
         "{} ({:.3} m/s)",
         ctx.speed_label(gi)
@@ -560,96 +561,6 @@ fn fmt_speed(ctx: &Ctx<'_>, gi: usize) -> String {
             .replace("m/s", " m/s"),
         ctx.speeds[gi]
     )
-}
-
-/// Static runs (Tables 3.2–3.3): surge alone at u0, then ±level in each other DOF.
-fn rov_static(
-    ctx: &Ctx<'_>,
-    gi: usize,
-    reps: u32,
-    out: &mut Vec<PlannedExperiment>,
-) -> Result<(), PlanError> {
-    let u0 = ctx.speeds[gi];
-    let dofs = &ctx.vessel.dofs;
-    let hold = ctx.spec.durations.static_hold_s;
-    for &d in dofs {
-        let signs: &[i8] = if d == Dof::Surge { &[1] } else { &[1, -1] };
-        for &sign in signs {
-            for rep in 1..=reps {
-                let l = ctx.vessel.limit(d);
-                let settle = SQUARE_HOLD_TIME_CONSTANTS * l.time_constant_s;
-                let mut channels = Vec::new();
-                let (level, instruction) = if d == Dof::Surge {
-                    (
-                        0.0,
-                        format!(
-                            "Fly forward at {} with no other motion; hold until steady (≈ {settle:.0} s), then {hold:.0} s more.",
-                            fmt_speed(ctx, gi)
-                        ),
-                    )
-                } else {
-                    let a = ctx.amplitude(d)?;
-                    let (_, unit, ..) = ctx.dof_channel(d);
-                    (
-                        a,
-                        format!(
-                            "At {}, bring {} to {}{a:.3} {unit} and hold until steady (≈ {settle:.0} s), then {hold:.0} s more; no other motion.",
-                            fmt_speed(ctx, gi),
-                            d.name(),
-                            if sign > 0 { "+" } else { "−" }
-                        ),
-                    )
-                };
-                let (_, _, _, rate, _) = ctx.dof_channel(d);
-                let ramp = rate.map_or(0.0, |r| level / r);
-                let duration = ramp + settle + hold;
-                for &c in dofs {
-                    let mut p = ctx.held(c, u0);
-                    if c == d {
-                        p.excited = true;
-                        if d != Dof::Surge {
-                            p.waveform = Waveform::Step {
-                                sign: f64::from(sign),
-                            };
-                            p.amplitude = level;
-                        }
-                    }
-                    channels.push(ChannelSpec {
-                        plan: p,
-                        duration_s: duration,
-                    });
-                }
-                let code = format!(
-                    "STA-{}-{}{}-r{rep}",
-                    ctx.speed_label(gi),
-                    d.name(),
-                    if d == Dof::Surge {
-                        ""
-                    } else if sign > 0 {
-                        "+"
-                    } else {
-                        "-"
-                    }
-                );
-                out.push(assemble(
-                    ctx,
-                    ExperimentHead {
-                        code,
-                        family: ExperimentFamily::Static,
-                        grid_index: Some(gi),
-                        dofs: vec![d],
-                        sign: (d != Dof::Surge).then_some(sign),
-                        repetition: rep,
-                        instruction,
-                        pe_required: 1,
-                        field: format!("excitation.per_dof.{}", d.name()),
-                    },
-                    channels,
-                )?);
-            }
-        }
-    }
-    Ok(())
 }
 
 /// Dynamic runs (Tables 3.4–3.5): one DOF excited about the grid speed.

@@ -40,7 +40,14 @@ pub struct DofLimits {
     /// Expected dominant time constant T_i ≈ m_i/d_i of the DOF (s); it sets the
     /// square-wave period, the PRBS clock and the settling time of static runs.
     pub time_constant_s: f64,
+    /// Roll and pitch: the largest attitude the pilots accept in a static
+    /// hold (rad, at most 60°). Static runs hold 10°, or this when smaller.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_angle: Option<f64>,
 }
+
+/// Largest `max_angle` accepted (rad): 60°.
+pub const MAX_HOLD_ANGLE_RAD: f64 = std::f64::consts::FRAC_PI_3;
 
 /// What a thruster does, to assign it to the decoupled DP manoeuvres
 /// (sec. 4.2 of Fossen et al.).
@@ -277,6 +284,24 @@ impl VesselProfile {
             positive(&f("time_constant_s"), l.time_constant_s)?;
             if let Some(a) = l.max_accel {
                 positive(&f("max_accel"), a)?;
+            }
+            if let Some(a) = l.max_angle {
+                if !matches!(d, Dof::Roll | Dof::Pitch) {
+                    return Err(PlanError::invalid(
+                        f("max_angle"),
+                        "only roll and pitch hold an attitude",
+                    ));
+                }
+                positive(&f("max_angle"), a)?;
+                if a > MAX_HOLD_ANGLE_RAD {
+                    return Err(PlanError::over_limit(
+                        f("max_angle"),
+                        format!(
+                            "{a} rad is beyond 60°, where the Euler angles near their singularity"
+                        ),
+                        MAX_HOLD_ANGLE_RAD,
+                    ));
+                }
             }
             if l.time_constant_s > 3600.0 {
                 return Err(PlanError::over_limit(

@@ -11,6 +11,8 @@
 //!   controller, a PI per DOF ([`VelocityPi`]) at f_c producing the
 //!   commanded τ_i, slew-limited to the profile's `max_force_rate` and
 //!   clipped to `max_force`;
+//! - `phi_ref`, `theta_ref`: a roll or pitch attitude held by an attitude
+//!   loop that feeds the velocity PI its rate reference ([`AttitudeLoop`]);
 //! - `tau_X … tau_N`: an open-loop force, applied as scheduled (clipped to
 //!   `max_force`).
 //!
@@ -39,15 +41,14 @@ use super::rov::current::CurrentProcess;
 use super::rov::kinematics::rotation;
 use super::rov::{RovRecord, RovTruth, SimError};
 use crate::logs::schema::{LogRole, TIME_COLUMN, pose_column, required_columns};
-use crate::planning::vessel::{DofLimits, InputChannels, VesselKind};
+use crate::planning::statics::{attitude_column, holds_attitude};
+use crate::planning::vessel::{InputChannels, VesselKind};
 use crate::planning::{Dof, Experiment, ExperimentFamily, Plan, PlannedExperiment, VesselProfile};
 use crate::rng::{SplitMix64, mix};
 
-/// Closed-loop bandwidth ω_c of the velocity PI in units of 1/T̂: the nominal
-/// loop settles twice as fast as the open-loop DOF. Kept modest because the
-/// profile's limits give the mass only roughly (for the Surveyor, m̂ over-
-/// estimates the true roll inertia ≈ 9×, which raises the real loop gain).
-pub const BANDWIDTH_PER_TIME_CONSTANT: f64 = 2.0;
+mod control;
+pub use control::{ATTITUDE_TIME_CONSTANTS, AttitudeLoop, BANDWIDTH_PER_TIME_CONSTANT, VelocityPi};
+
 /// Default lead-in in units of the largest modeled time constant T̂ (≈ 99 %
 /// settled).
 pub const LEAD_IN_TIME_CONSTANTS: f64 = 5.0;
@@ -208,79 +209,6 @@ impl TrialSettings {
     }
 }
 
-/// The velocity controller of one DOF: a discrete PI designed on the nominal
-/// first-order model m̂ ν̇ + d̂ ν = τ taken from the profile's limits alone
-/// (truth-independent):
-///
-/// - d̂ = τ_max / ν_max (the force that holds the largest velocity),
-///   m̂ = T̂ d̂ with T̂ the profile's time constant;
-/// - τ = K_p e + K_i ∫e, e = ν_ref − ν, with K_p = m̂ ω_c and
-///   K_i = K_p / T̂ = ω_c d̂: the integral zero cancels the nominal pole, so
-///   the nominal loop is ω_c / s and ν follows a step in ν_ref as
-///   1 − e^{−ω_c t}, with zero steady-state error for any constant
-///   reference, ω_c = [`BANDWIDTH_PER_TIME_CONSTANT`] / T̂. The nominal
-///   damping d̂ thus enters as the integral gain; there is no separate
-///   feed-forward, which with a rough m̂ would only add overshoot;
-/// - τ is slew-limited to `max_force_rate` and clipped to `max_force`; the
-///   integrator is frozen while the output is limited in the direction e
-///   pushes it (conditional-integration anti-windup).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VelocityPi {
-    /// K_p (N·s/m or N·m·s/rad).
-    pub kp: f64,
-    /// K_i (N/m or N·m/rad).
-    pub ki: f64,
-    /// |τ| ≤ this (N or N·m).
-    pub max_force: f64,
-    /// |Δτ| ≤ this per controller interval (N or N·m).
-    pub max_step: f64,
-    /// Controller interval h = 1/f_c (s).
-    pub h: f64,
-    /// ∫e dt.
-    integral: f64,
-    /// τ of the previous interval.
-    last: f64,
-}
-
-impl VelocityPi {
-    /// The controller of a DOF with `limits` at controller interval `h`.
-    pub fn design(limits: &DofLimits, h: f64) -> Self {
-        let d_hat = limits.max_force / limits.max_velocity;
-        let m_hat = limits.time_constant_s * d_hat;
-        let omega_c = BANDWIDTH_PER_TIME_CONSTANT / limits.time_constant_s;
-        let kp = m_hat * omega_c;
-        VelocityPi {
-            kp,
-            ki: kp / limits.time_constant_s,
-            max_force: limits.max_force,
-            max_step: limits.max_force_rate * h,
-            h,
-            integral: 0.0,
-            last: 0.0,
-        }
-    }
-
-    /// Closed-loop bandwidth ω_c = K_i / d̂ of the nominal loop (rad/s).
-    pub fn bandwidth(&self, limits: &DofLimits) -> f64 {
-        self.ki * limits.max_velocity / limits.max_force
-    }
-
-    /// τ for this interval from the reference and the measured velocity.
-    pub fn step(&mut self, nu_ref: f64, nu: f64) -> f64 {
-        let e = nu_ref - nu;
-        let wanted = self.kp * e + self.ki * self.integral;
-        let tau = wanted
-            .clamp(self.last - self.max_step, self.last + self.max_step)
-            .clamp(-self.max_force, self.max_force);
-        // Integrate unless limited and e would drive the output further out.
-        if tau == wanted || e * (wanted - tau) < 0.0 {
-            self.integral += e * self.h;
-        }
-        self.last = tau;
-        tau
-    }
-}
-
 /// What drives one DOF during a run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Drive {
@@ -288,6 +216,9 @@ pub enum Drive {
     Velocity(usize),
     /// Open-loop τ (schedule column index).
     Force(usize),
+    /// Roll or pitch attitude reference η_ref (schedule column index),
+    /// flown by the attitude loop ([`AttitudeLoop`]) over the velocity PI.
+    Attitude(usize),
     /// Not modeled: τ = 0.
     Passive,
 }
@@ -305,7 +236,8 @@ pub struct FlownRun {
     pub grid_speed_mps: Option<f64>,
     /// How each DOF (index `Dof::index()`) was driven.
     pub drives: [Drive; 6],
-    /// ν_ref at the logged samples (N × 6; zero where not velocity-driven).
+    /// ν_ref at the logged samples (N × 6; an attitude loop's rate
+    /// reference where attitude-driven, zero where force-driven).
     pub nu_ref: DMatrix<f64>,
     /// The logged run at the logger rate, with the noise-free truth.
     pub record: RovRecord,
@@ -353,7 +285,17 @@ pub fn fly_experiment(
     let mut pis: Vec<Option<VelocityPi>> = Dof::ALL
         .iter()
         .map(|&d| match drives[d.index()] {
-            Drive::Velocity(_) => Some(VelocityPi::design(profile.limit(d), h)),
+            Drive::Velocity(_) | Drive::Attitude(_) => {
+                Some(VelocityPi::design(profile.limit(d), h))
+            }
+            _ => None,
+        })
+        .collect();
+
+    let attitude: Vec<Option<AttitudeLoop>> = Dof::ALL
+        .iter()
+        .map(|&d| match drives[d.index()] {
+            Drive::Attitude(_) => Some(AttitudeLoop::design(profile.limit(d))),
             _ => None,
         })
         .collect();
@@ -386,11 +328,17 @@ pub fn fly_experiment(
         let eta = Vector6::from_column_slice(&x[6..12]);
         let v_ned = current.ned();
         let nu = Vector6::from_column_slice(&x[0..6]) + body_current(&eta, &v_ned);
+        let mut rate_ref = [0.0; 6];
         for (i, d) in drives.iter().enumerate() {
+            rate_ref[i] = match (*d, &attitude[i]) {
+                (Drive::Velocity(c), _) => reference(c, k),
+                (Drive::Attitude(c), Some(a)) => a.rate_reference(reference(c, k), eta[i]),
+                _ => 0.0,
+            };
             tau_cmd[(k, i)] = match *d {
-                Drive::Velocity(c) => pis[i]
+                Drive::Velocity(_) | Drive::Attitude(_) => pis[i]
                     .as_mut()
-                    .map_or(0.0, |pi| pi.step(reference(c, k), nu[i])),
+                    .map_or(0.0, |pi| pi.step(rate_ref[i], nu[i])),
                 Drive::Force(c) => {
                     let l = profile.limit(Dof::ALL[i]).max_force;
                     reference(c, k).clamp(-l, l)
@@ -406,9 +354,7 @@ pub fn fly_experiment(
                 rec.eta_true[(j, i)] = eta[i];
                 rec.tau_commanded[(j, i)] = tau_cmd[(k, i)];
                 rec.tau_applied[(j, i)] = if lagged[i] { x[12 + i] } else { shaped[i] };
-                if let Drive::Velocity(c) = drives[i] {
-                    nu_ref[(j, i)] = reference(c, k);
-                }
+                nu_ref[(j, i)] = rate_ref[i];
             }
             for i in 0..3 {
                 rec.current_ned[(j, i)] = v_ned[i];
@@ -564,6 +510,8 @@ fn drives(profile: &VesselProfile, planned: &PlannedExperiment) -> Result<[Drive
         let drive = Dof::ALL.iter().find_map(|&d| {
             if *name == format!("{}_ref", d.velocity_symbol()) {
                 Some((d, Drive::Velocity(c)))
+            } else if holds_attitude(d) && name == attitude_column(d) {
+                Some((d, Drive::Attitude(c)))
             } else if name == d.force_column() {
                 Some((d, Drive::Force(c)))
             } else {
@@ -574,7 +522,7 @@ fn drives(profile: &VesselProfile, planned: &PlannedExperiment) -> Result<[Drive
             return Err(TrialError::invalid(
                 field,
                 format!(
-                    "'{name}' is neither a velocity reference (u_ref…r_ref) nor a force (tau_X…tau_N)"
+                    "'{name}' is neither a velocity reference (u_ref…r_ref), an attitude reference (phi_ref, theta_ref) nor a force (tau_X…tau_N)"
                 ),
             ));
         };

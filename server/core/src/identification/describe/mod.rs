@@ -11,8 +11,9 @@
 //!   score is above the noise floor [`NOISE_FLOOR`] and it is not *held
 //!   against coupling*; it is *excited dynamically* when its velocity also
 //!   switches at least twice (Schmitt trigger at mean ± σ/2) and one step
-//!   explains less than [`STEP_MAX_SHARE`] of its variance, otherwise it was
-//!   *stepped* once and held (a static run).
+//!   explains less than [`STEP_MAX_SHARE`] of its variance (roll, pitch with
+//!   a quiet rate: of its velocity's and of its attitude's), otherwise it was *stepped* once
+//!   and held (a static run: a speed, rate or attitude hold).
 //! - **Held against coupling.** A closed loop holding a DOF against the
 //!   coupling from an excited neighbour moves its input as much as the
 //!   excitation moves the neighbour's (more, on a small vehicle), and need
@@ -93,6 +94,14 @@ pub const RECURSIVE_MIN_DOFS: usize = 3;
 /// (a static run, even one the controller overshoots) ≥ 0.73.
 pub const STEP_MAX_SHARE: f64 = 0.67;
 
+/// Largest velocity level (fraction of the rate limit) of a roll or pitch
+/// whose attitude counts as held: bringing the attitude to a new level once
+/// moves the rate only while it slews (10° over a 50 s hold: ≈ 3 % of the
+/// Surveyor's 0.3 rad/s), a dynamic excitation by its amplitude (≈ 50 %),
+/// and under a rate excitation the attitude may wander to one side, which
+/// must not read as a hold.
+pub const ATTITUDE_HOLD_MAX_VELOCITY_LEVEL: f64 = 0.1;
+
 /// How much one DOF moved in a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
@@ -108,7 +117,10 @@ pub struct DofActivity {
     /// Times the velocity crossed from below mean − σ/2 to above mean + σ/2 or back.
     pub switches: usize,
     /// Share of the velocity's variance explained by one step (the best
-    /// single breakpoint between two constant levels).
+    /// single breakpoint between two constant levels); roll and pitch with
+    /// a quiet rate ([`ATTITUDE_HOLD_MAX_VELOCITY_LEVEL`]): of the velocity's
+    /// or the attitude's, whichever is larger (an attitude brought to a
+    /// level once and held is a static hold, though its rate only pulses).
     pub step_share: f64,
     /// Correlation of the input with the velocity, both averaged over 1 s
     /// (roll, pitch: the input beyond what holds the attitude against the
@@ -384,7 +396,12 @@ fn activity(
             velocity_level,
             score: (input_level * velocity_level).sqrt(),
             switches,
-            step_share: step_share(rec, nu),
+            step_share: match restored_attitude(d).and_then(|c| rec.column(c)) {
+                Some(att) if velocity_level <= ATTITUDE_HOLD_MAX_VELOCITY_LEVEL => {
+                    step_share(rec, nu).max(step_share(rec, att))
+                }
+                _ => step_share(rec, nu),
+            },
             input_work: input_work(
                 rec,
                 tau,
