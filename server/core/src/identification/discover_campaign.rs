@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::augmented::{baseline_at, pieces_by_speed};
 use super::dataset::{RunInput, segments};
-use super::discover_gate::compare_held_out;
+use super::discover_gate::{compare_held_out, inertia_verdict};
 use super::document::{Method, ModelDocument, ModelKind, ParameterRow, PointAugmentation, to_rows};
 use super::error::IdentifyError;
 use super::intersample::vehicle_from_logged;
@@ -367,7 +367,8 @@ pub fn discover_campaign(
                 report: validate_on_run(doc, r, forces, dset.k_step)?,
             });
         }
-        let verdict = compare_held_out(&before, &candidate.validation);
+        let verdict = inertia_verdict(&candidate.document)
+            .unwrap_or_else(|| compare_held_out(&before, &candidate.validation));
         summary.push(verdict.text);
         verdict.keep.then_some(candidate)
     };

@@ -4,7 +4,11 @@
 //! k-step and the 10 s restarted free run — and simulates wherever the
 //! baseline did.
 
+use nalgebra::DMatrix;
+
+use crate::identification::document::ModelDocument;
 use crate::identification::outcome::RunValidation;
+use crate::numbers::sig3;
 use crate::validation::ChannelValidation;
 
 pub use crate::discrepancy::discover::FIT_NOISE;
@@ -66,6 +70,37 @@ fn changes(run: &str, b: &ChannelValidation, a: &ChannelValidation) -> Vec<Chang
         c("k-step", b.fit_k_step, a.fit_k_step),
         c("10 s restarted free-run", b.fit_restarted, a.fit_restarted),
     ]
+}
+
+/// Refuses an augmented model whose inertia is not physical: at some grid
+/// speed the symmetric part of M, ½(M + Mᵀ), has an eigenvalue ≤ 0, so the
+/// kinetic energy ½νᵀMν is not positive. (Refitting rows leaves M
+/// slightly asymmetric; its symmetric part must still be positive.)
+pub fn inertia_verdict(doc: &ModelDocument) -> Option<HeldOutVerdict> {
+    let lpv = doc.lpv.as_ref()?;
+    let mut bad = Vec::new();
+    for p in &lpv.points {
+        let n = p.m.len();
+        if p.m.iter().any(|r| r.len() != n) {
+            continue;
+        }
+        let m = DMatrix::from_fn(n, n, |i, j| 0.5 * (p.m[i][j] + p.m[j][i]));
+        let low = m.symmetric_eigenvalues().min();
+        if !(low > 0.0) {
+            bad.push(format!(
+                "at {} m/s (smallest eigenvalue of ½(M + Mᵀ): {})",
+                sig3(p.speed_mps),
+                sig3(low)
+            ));
+        }
+    }
+    (!bad.is_empty()).then(|| HeldOutVerdict {
+        keep: false,
+        text: format!(
+            "The augmented model was not stored: its inertia M is not positive definite {}.",
+            bad.join(", ")
+        ),
+    })
 }
 
 /// Compares the augmented model's held-out validation with the baseline's
@@ -254,6 +289,34 @@ mod tests {
             compare_held_out(&[], &base)
                 .text
                 .contains("no held-out run")
+        );
+    }
+
+    #[test]
+    fn a_model_whose_inertia_is_not_positive_is_not_kept() {
+        use crate::identification::tests::lpv_doc;
+        use crate::planning::dof::Dof;
+        let m = vec![vec![100.0, 10.0], vec![10.0, 50.0]];
+        let d = vec![vec![20.0, 0.0], vec![0.0, 10.0]];
+        let ok = lpv_doc(
+            vec![Dof::Surge, Dof::Sway],
+            vec![(0.5, m.clone(), d.clone()), (1.0, m.clone(), d.clone())],
+        );
+        assert!(inertia_verdict(&ok).is_none());
+        // Positive diagonal, but the coupling makes νᵀMν < 0 along (1, −1).
+        let bad_m = vec![vec![100.0, 90.0], vec![90.0, 50.0]];
+        let bad = lpv_doc(
+            vec![Dof::Surge, Dof::Sway],
+            vec![(0.5, m, d.clone()), (1.0, bad_m, d)],
+        );
+        let v = inertia_verdict(&bad).expect("refused");
+        assert!(!v.keep);
+        assert!(
+            v.text.contains(
+                "not positive definite at 1 m/s (smallest eigenvalue of ½(M + Mᵀ): −18.4)"
+            ),
+            "{}",
+            v.text
         );
     }
 }
