@@ -86,7 +86,7 @@ pub fn inertia_verdict(doc: &ModelDocument) -> Option<HeldOutVerdict> {
         }
         let m = DMatrix::from_fn(n, n, |i, j| 0.5 * (p.m[i][j] + p.m[j][i]));
         let low = m.symmetric_eigenvalues().min();
-        if !(low > 0.0) {
+        if low.is_nan() || low <= 0.0 {
             bad.push(format!(
                 "at {} m/s (smallest eigenvalue of ½(M + Mᵀ): {})",
                 sig3(p.speed_mps),
