@@ -92,7 +92,8 @@ test('ROV: vessel from template → campaign on a filled grid → plan → exper
     await page.unroute('**/api/campaigns/*/plan');
     assert.equal(await page.textContent(tid('total-experiments')), '119');
     assert.match(await page.textContent(tid('total-time')), /^\d+:\d\d:\d\d$/);
-    assert.equal(await page.locator(tid('plan-loading')).isHidden(), true);
+    // The indicator goes once the answer is drawn (waitFor fails after its timeout).
+    await page.locator(tid('plan-loading')).waitFor({ state: 'hidden' });
     await page.selectOption(tid('filter-family'), 'dynamic');
     assert.equal(await rows(page), 42);
     await page.selectOption(tid('filter-family'), 'static');
