@@ -738,6 +738,18 @@ fn summary(
 /// A change of an NRMSE fit (1 − NRMSE) below this is noise.
 pub const FIT_NOISE: f64 = 0.005;
 
+/// The change of one fit from `before` to `after`: positive when better;
+/// −∞ when a fit the baseline had is lost. Fits below 0 (worse than the
+/// record's mean) count as 0: two predictions that both miss are not ranked
+/// by how badly.
+pub fn fit_gain(before: Option<f64>, after: Option<f64>) -> f64 {
+    match (before, after) {
+        (Some(b), Some(a)) => a.max(0.0) - b.max(0.0),
+        (Some(_), None) => f64::NEG_INFINITY,
+        (None, _) => 0.0,
+    }
+}
+
 /// How a model changes the channels' fits (1-step, k-step, free run; fits
 /// below 0 count as 0) from `base` on `runs`: (the worst loss beyond
 /// noise, 0 if none; the summed change). The kept model is the one of its
@@ -763,11 +775,8 @@ fn change_score(
             (b.k_step, a.k_step),
             (b.free_run, a.free_run),
         ] {
-            let d = match (x, y) {
-                (Some(x), Some(y)) => y.max(0.0) - x.max(0.0),
-                (Some(_), None) => -1.0,
-                _ => 0.0,
-            };
+            // A lost fit counts as the largest possible loss of a fit ≤ 1.
+            let d = fit_gain(x, y).max(-1.0);
             if d < -FIT_NOISE {
                 worst = worst.min(d);
             }

@@ -401,26 +401,31 @@ mod tests {
         assert!(lag.is_none(), "a surge lag must not act on sway");
     }
 
-    #[test]
-    fn first_order_dof_matches_its_exponential_and_k_step_is_exact() {
-        // m u̇ + d u = X with a step: u = X/d (1 − e^{−t d/m}).
-        let (m, d, x) = (100.0, 50.0, 10.0);
+    /// m u̇ + d u = X from rest with a step X: the surge-only baseline and
+    /// the exact record u = X/d (1 − e^{−t d/m}) of `n` samples every `h`.
+    fn step_response(m: f64, d: f64, x: f64, n: usize, h: f64) -> (Baseline, Record) {
         let b = Baseline {
             dofs: vec![Dof::Surge],
             m: DMatrix::from_element(1, 1, m),
             d_bar: DMatrix::from_element(1, 1, d),
             restoring: Restoring::default(),
         };
-        let n = 60;
-        let h = 0.1;
-        let nu = DMatrix::from_fn(n, 1, |k, _| x / d * (1.0 - (-(k as f64) * h * d / m).exp()));
         let rec = Record {
             name: "step".into(),
             h,
             tau: DMatrix::from_element(n, 1, x),
-            nu: nu.clone(),
+            nu: DMatrix::from_fn(n, 1, |k, _| x / d * (1.0 - (-(k as f64) * h * d / m).exp())),
             eta: DMatrix::zeros(n, 6),
         };
+        (b, rec)
+    }
+
+    #[test]
+    fn first_order_dof_matches_its_exponential_and_k_step_is_exact() {
+        // m u̇ + d u = X with a step: u = X/d (1 − e^{−t d/m}).
+        let n = 60;
+        let (b, rec) = step_response(100.0, 50.0, 10.0, n, 0.1);
+        let nu = rec.nu.clone();
         let model = AugmentedModel::from_baseline(&b);
         let sim = model.simulate(&rec);
         let k5 = model.predict_k_step(&rec, 5);
@@ -440,22 +445,9 @@ mod tests {
     /// u = X/d (1 − e^{−t d/m}) instead.
     #[test]
     fn a_stiff_dof_is_sub_stepped_not_blown_up() {
-        let (m, d, x) = (1.0, 200.0, 10.0);
-        let b = Baseline {
-            dofs: vec![Dof::Surge],
-            m: DMatrix::from_element(1, 1, m),
-            d_bar: DMatrix::from_element(1, 1, d),
-            restoring: Restoring::default(),
-        };
-        let (n, h) = (40, 0.1);
-        let nu = DMatrix::from_fn(n, 1, |k, _| x / d * (1.0 - (-(k as f64) * h * d / m).exp()));
-        let rec = Record {
-            name: "stiff".into(),
-            h,
-            tau: DMatrix::from_element(n, 1, x),
-            nu: nu.clone(),
-            eta: DMatrix::zeros(n, 6),
-        };
+        let (d, x, n) = (200.0, 10.0, 40);
+        let (b, rec) = step_response(1.0, d, x, n, 0.1);
+        let nu = rec.nu.clone();
         let sim = AugmentedModel::from_baseline(&b).simulate(&rec);
         for k in 0..n {
             assert!(

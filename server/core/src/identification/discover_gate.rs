@@ -12,6 +12,7 @@ use crate::numbers::sig3;
 use crate::validation::ChannelValidation;
 
 pub use crate::discrepancy::discover::FIT_NOISE;
+use crate::discrepancy::discover::fit_gain;
 
 /// Whether the augmented model is kept, and why, in a sentence.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,16 +33,9 @@ struct Change {
 }
 
 impl Change {
-    /// Positive when the augmented model fits better; −∞ when it lost a fit
-    /// the baseline had. Fits below 0 (worse than the record's mean) count
-    /// as 0: two predictions that both miss are not ranked by how badly.
+    /// See [`fit_gain`].
     fn gain(&self) -> f64 {
-        match (self.before, self.after) {
-            (Some(b), Some(a)) => a.max(0.0) - b.max(0.0),
-            (Some(_), None) => f64::NEG_INFINITY,
-            (None, Some(_)) => 0.0,
-            (None, None) => 0.0,
-        }
+        fit_gain(self.before, self.after)
     }
 
     fn text(&self) -> String {
