@@ -8,7 +8,7 @@ SHELL := /bin/bash
 DB ?= data/seatrial.db
 LISTEN ?= 127.0.0.1:8080
 
-.PHONY: run test deps web-deps browser spec-validator test-rust test-spec test-web fmt lint
+.PHONY: load-test run test deps web-deps browser spec-validator test-rust test-spec test-web fmt lint
 
 run: web-deps
 	cargo run --release --bin seatrial -- --demo --db $(DB) --listen $(LISTEN) --web-dir web
@@ -54,3 +54,14 @@ fmt:
 lint:
 	cargo fmt --all -- --check
 	cargo clippy --release --workspace --all-targets -- -D warnings
+
+# The bounded-cost figures (issue 17) on loopback: a demo server on a temporary
+# database, then 32 concurrent readers beside /api/health probes and an identify job.
+LOAD_PORT ?= 8199
+load-test:
+	cargo build --release --bin seatrial --example load_test
+	@tmp=$$(mktemp -d); \
+	target/release/seatrial --demo --db $$tmp/load.db --listen 127.0.0.1:$(LOAD_PORT) --web-dir web --job-workers 1 >$$tmp/server.log 2>&1 & pid=$$!; \
+	trap "kill $$pid 2>/dev/null; rm -rf $$tmp" EXIT; \
+	for i in $$(seq 1 300); do curl -sf http://127.0.0.1:$(LOAD_PORT)/api/health >/dev/null && break; sleep 1; done; \
+	target/release/examples/load_test --base http://127.0.0.1:$(LOAD_PORT) --clients 32 --seconds 20

@@ -11,4 +11,5 @@ pub mod http;
 pub mod intake;
 pub mod jobs;
 pub mod processing;
+pub mod runtime;
 pub mod storage;

@@ -53,8 +53,15 @@ struct Args {
     allowed_origins: Vec<String>,
 }
 
-#[tokio::main]
-async fn main() -> anyhow::Result<()> {
+/// Two runtimes (see `seatrial::runtime`): the job workers' own, built first
+/// from the main thread at its priority, and the HTTP one that runs `serve`.
+fn main() -> anyhow::Result<()> {
+    let jobs = seatrial::runtime::jobs()?;
+    let http = seatrial::runtime::http()?;
+    http.block_on(serve(jobs.handle().clone()))
+}
+
+async fn serve(jobs_rt: tokio::runtime::Handle) -> anyhow::Result<()> {
     tracing_subscriber::fmt()
         .with_env_filter(
             EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info")),
@@ -121,7 +128,18 @@ async fn main() -> anyhow::Result<()> {
         tokio::spawn(async move { debris.reprocess(&db, &blobs).await });
     }
     // Recovers jobs a previous server left running, then starts the workers.
-    let runner = seatrial::jobs::start(jobs.clone(), state.job_context()).await?;
+    // The job workers load, write and compute on their own runtime, over
+    // their own connections.
+    let mut cx = state.job_context();
+    cx.db = {
+        let path = args.db.clone();
+        jobs_rt
+            .spawn(async move { seatrial::storage::open(&path).await })
+            .await??
+    };
+    let runner = jobs_rt
+        .spawn(seatrial::jobs::start(jobs.clone(), cx))
+        .await??;
     let app = seatrial::http::app(state, args.web_dir);
     let addr = listener.local_addr()?;
     tracing::info!("seatrial listening on http://{addr}");
@@ -142,7 +160,9 @@ async fn main() -> anyhow::Result<()> {
         .await?;
     // Running jobs are neither cancelled nor failed: they unwind and are
     // queued again at once, no attempt spent (see seatrial::jobs, "Restarts").
-    runner.shutdown(Duration::from_secs(10)).await;
+    let _ = jobs_rt
+        .spawn(runner.shutdown(Duration::from_secs(10)))
+        .await;
     let _ = tokio::time::timeout(Duration::from_secs(5), db.close()).await;
     // A computation that ignored the stop still holds a blocking thread,
     // which the runtime would wait for; its job is safe in the database.

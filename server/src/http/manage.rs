@@ -152,6 +152,11 @@ pub async fn delete_model(
                 ""
             }
         ))),
-        models::Deleted::Gone(deleted) => Ok((StatusCode::OK, Json(DeletedModels { deleted }))),
+        models::Deleted::Gone(deleted) => {
+            for gone in &deleted {
+                s.model_cache.forget(gone);
+            }
+            Ok((StatusCode::OK, Json(DeletedModels { deleted })))
+        }
     }
 }

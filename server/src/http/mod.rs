@@ -12,7 +12,9 @@ pub mod health;
 pub mod jobs;
 pub mod json;
 pub mod manage;
+pub mod model_cache;
 pub mod models;
+pub mod offload;
 pub mod plans;
 pub mod query;
 pub mod run_description;
@@ -37,6 +39,9 @@ use crate::storage::Db;
 use crate::storage::blobs::BlobStore;
 use exposure::Exposure;
 
+/// Bytes of serialised model answers kept in memory.
+const MODEL_CACHE_BYTES: usize = 256 << 20;
+
 /// Shared state of the handlers.
 #[derive(Clone)]
 pub struct AppState {
@@ -50,6 +55,10 @@ pub struct AppState {
     pub jobs: Jobs,
     /// Host allow-list and allowed origins (default: local names only).
     pub exposure: Arc<Exposure>,
+    /// Models' GET answers, serialised and compressed once.
+    pub model_cache: Arc<model_cache::ModelCache>,
+    /// Blocking threads that may answer reads at once ([`offload`]).
+    pub read_permits: Arc<tokio::sync::Semaphore>,
 }
 
 impl AppState {
@@ -74,6 +83,8 @@ impl AppState {
             max_upload_bytes,
             jobs,
             exposure: Arc::new(Exposure::default()),
+            model_cache: Arc::new(model_cache::ModelCache::new(MODEL_CACHE_BYTES)),
+            read_permits: offload::permits(),
         })
     }
 
@@ -187,14 +198,17 @@ pub fn app(state: AppState, web_dir: PathBuf) -> Router {
         .method_not_allowed_fallback(method_not_allowed)
         .layer(DefaultBodyLimit::max(json::MAX_JSON_BODY));
     let guard = axum::middleware::from_fn_with_state(state.exposure.clone(), exposure::guard);
-    api.fallback(move |uri: Uri, req: axum::extract::Request| {
-        exposure::web_asset(web_dir.clone(), uri, req)
-    })
-    // Quality reports run to megabytes of JSON; ships share satellite links.
-    .layer(CompressionLayer::new())
-    .layer(guard)
-    .layer(TraceLayer::new_for_http())
-    .with_state(state)
+    let offload =
+        axum::middleware::from_fn_with_state(state.read_permits.clone(), offload::offload);
+    api.layer(offload)
+        .fallback(move |uri: Uri, req: axum::extract::Request| {
+            exposure::web_asset(web_dir.clone(), uri, req)
+        })
+        // Quality reports run to megabytes of JSON; ships share satellite links.
+        .layer(CompressionLayer::new())
+        .layer(guard)
+        .layer(TraceLayer::new_for_http())
+        .with_state(state)
 }
 
 /// Maps a missing row to a 404 naming what was looked for.

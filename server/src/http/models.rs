@@ -3,7 +3,7 @@
 
 use axum::Json;
 use axum::extract::{Path, State};
-use axum::http::header;
+use axum::http::{HeaderMap, header};
 use axum::response::{IntoResponse, Response};
 use seatrial_core::identification::discrete::{DiscreteModel, discretize};
 use seatrial_core::identification::document::ModelDocument;
@@ -11,6 +11,7 @@ use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv}
 use seatrial_core::identification::export_matlab::matlab_script;
 use serde::{Deserialize, Serialize};
 
+use super::model_cache::CachedModel;
 use super::query::{ApiQuery, Paging, with_total};
 use super::{AppState, blocking, campaign_and_vessel, found};
 use crate::clock::CampaignClocks;
@@ -111,13 +112,32 @@ pub async fn get_model(
     State(s): State<AppState>,
     Path(id): Path<String>,
     ApiQuery(q): ApiQuery<ModelQuery>,
-) -> ApiResult<Json<ModelView>> {
-    let m = found(models::get(&s.db, &id).await?, "model", &id)?;
-    let mut v = view(m)?;
+    request: HeaderMap,
+) -> ApiResult<Response> {
     if let Some(h) = q.h {
+        let m = found(models::get(&s.db, &id).await?, "model", &id)?;
+        let mut v = view(m)?;
         v.discrete = Some(discretize(&v.document, h).map_err(|msg| ApiError::invalid("h", msg))?);
+        return Ok(Json(v).into_response());
     }
-    Ok(Json(v))
+    let summary = found(models::summary(&s.db, &id).await?, "model", &id)?;
+    let key = serde_json::to_string(&summary)
+        .map_err(|e| ApiError::Internal(anyhow::anyhow!("model summary: {e}")))?;
+    if let Some(cached) = s.model_cache.get(&id, &key) {
+        return Ok(cached.respond(&request));
+    }
+    let m = found(models::get(&s.db, &id).await?, "model", &id)?;
+    let built = blocking(move || -> ApiResult<CachedModel> {
+        let key = serde_json::to_string(&m.summary)
+            .map_err(|e| ApiError::Internal(anyhow::anyhow!("model summary: {e}")))?;
+        let json = serde_json::to_vec(&view(m)?)
+            .map_err(|e| ApiError::Internal(anyhow::anyhow!("model view: {e}")))?;
+        Ok(CachedModel::new(key, json))
+    })
+    .await??;
+    let built = std::sync::Arc::new(built);
+    s.model_cache.put(&id, built.clone());
+    Ok(built.respond(&request))
 }
 
 /// Export format.

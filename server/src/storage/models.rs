@@ -182,15 +182,21 @@ struct Heavy {
     validation: String,
 }
 
+/// One model's metadata (name, notes, version, lineage), without its document.
+pub async fn summary(db: &Db, id: &str) -> anyhow::Result<Option<ModelSummary>> {
+    Ok(
+        sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
+            "SELECT {SUMMARY} FROM model WHERE id = $1"
+        )))
+        .bind(id)
+        .fetch_optional(db)
+        .await?,
+    )
+}
+
 /// One model with everything.
 pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<StoredModel>> {
-    let Some(summary) = sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
-        "SELECT {SUMMARY} FROM model WHERE id = $1"
-    )))
-    .bind(id)
-    .fetch_optional(db)
-    .await?
-    else {
+    let Some(summary) = summary(db, id).await? else {
         return Ok(None);
     };
     let h = sqlx::query_as::<_, Heavy>(
