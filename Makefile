@@ -8,7 +8,7 @@ SHELL := /bin/bash
 DB ?= data/seatrial.db
 LISTEN ?= 127.0.0.1:8080
 
-.PHONY: load-test run test deps web-deps browser spec-validator test-rust test-spec test-web fmt lint
+.PHONY: load-test schemathesis run test deps web-deps browser spec-validator test-rust test-spec test-web fmt lint
 
 run: web-deps
 	cargo run --release --bin seatrial -- --demo --db $(DB) --listen $(LISTEN) --web-dir web
@@ -35,7 +35,7 @@ spec-validator:
 
 deps: web-deps browser spec-validator
 
-test: deps test-spec test-rust test-web
+test: deps test-spec test-rust test-web schemathesis
 
 # The committed spec is valid OpenAPI (tests/openapi.rs holds it to the router).
 test-spec: spec-validator
@@ -65,3 +65,23 @@ load-test:
 	trap "kill $$pid 2>/dev/null; rm -rf $$tmp" EXIT; \
 	for i in $$(seq 1 300); do curl -sf http://127.0.0.1:$(LOAD_PORT)/api/health >/dev/null && break; sleep 1; done; \
 	target/release/examples/load_test --base http://127.0.0.1:$(LOAD_PORT) --clients 32 --seconds 20
+
+# Schemathesis against the running service (pinned, in a venv under target/): every
+# operation of openapi.yaml through its examples, coverage, fuzzing and stateful phases,
+# bounded in time; any 5xx, undocumented status, content type or response schema fails.
+SCHEMATHESIS := 4.32.5
+ST_VENV := target/py-schemathesis
+ST_PORT ?= 8198
+ST_SECONDS ?= 150
+schemathesis:
+	@[ -x $(ST_VENV)/bin/st ] && $(ST_VENV)/bin/st --version | grep -q "$(SCHEMATHESIS)" \
+	  || { python3 -m venv $(ST_VENV) && $(ST_VENV)/bin/pip install -q --disable-pip-version-check schemathesis==$(SCHEMATHESIS); }
+	cargo build --release --bin seatrial
+	@tmp=$$(mktemp -d); \
+	target/release/seatrial --db $$tmp/st.db --listen 127.0.0.1:$(ST_PORT) --web-dir web --job-workers 1 >$$tmp/server.log 2>&1 & pid=$$!; \
+	trap "kill $$pid 2>/dev/null; rm -rf $$tmp" EXIT; \
+	for i in $$(seq 1 60); do curl -sf http://127.0.0.1:$(ST_PORT)/api/health >/dev/null && break; sleep 1; done; \
+	cd $$tmp && $(CURDIR)/$(ST_VENV)/bin/st run $(CURDIR)/openapi.yaml --url http://127.0.0.1:$(ST_PORT) \
+	  --checks not_a_server_error,status_code_conformance,content_type_conformance,response_schema_conformance \
+	  --phases examples,coverage,fuzzing,stateful --max-examples 25 --max-time $(ST_SECONDS) --workers 2 \
+	  --seed 1 --no-color
