@@ -8,7 +8,7 @@ SHELL := /bin/bash
 DB ?= data/seatrial.db
 LISTEN ?= 127.0.0.1:8080
 
-.PHONY: load-test schemathesis run test deps web-deps browser spec-validator test-rust test-spec test-web fmt lint
+.PHONY: fuzz fuzz-merge load-test schemathesis run test deps web-deps browser spec-validator test-rust test-spec test-web fmt lint
 
 run: web-deps
 	cargo run --release --bin seatrial -- --demo --db $(DB) --listen $(LISTEN) --web-dir web
@@ -85,3 +85,20 @@ schemathesis:
 	  --checks not_a_server_error,status_code_conformance,content_type_conformance,response_schema_conformance \
 	  --phases examples,coverage,fuzzing,stateful --max-examples 25 --max-time $(ST_SECONDS) --workers 2 \
 	  --seed 1 --no-color
+
+# cargo-fuzz (libFuzzer, nightly toolchain) on the log reader and the clock alignment,
+# FUZZ_SECONDS each, seeded from the corpus kept in tests/fuzz/corpus; new finds go to
+# target/fuzz-corpus (`make fuzz-merge` adds those that reach new code to the kept corpus).
+CARGO_FUZZ := 0.13.1
+FUZZ_SECONDS ?= 60
+fuzz:
+	@cargo fuzz --version 2>/dev/null | grep -q "$(CARGO_FUZZ)" || cargo install cargo-fuzz --version $(CARGO_FUZZ) --locked
+	@for t in csv_reader alignment; do \
+	  mkdir -p target/fuzz-corpus/$$t; \
+	  cargo +nightly fuzz run --fuzz-dir tests/fuzz $$t target/fuzz-corpus/$$t tests/fuzz/corpus/$$t -- -max_total_time=$(FUZZ_SECONDS) -max_len=65536 || exit 1; \
+	done
+
+fuzz-merge:
+	@for t in csv_reader alignment; do \
+	  cargo +nightly fuzz run --fuzz-dir tests/fuzz $$t tests/fuzz/corpus/$$t target/fuzz-corpus/$$t -- -merge=1 || exit 1; \
+	done
