@@ -206,3 +206,59 @@ async fn a_valid_29_hour_log_in_seconds_is_not_called_milliseconds() {
         "{warnings:#?}"
     );
 }
+
+#[tokio::test]
+async fn a_log_in_milliseconds_and_degrees_is_check_units_not_fly_again() {
+    let app = TestApp::new().await;
+    let cid = rov_campaign(&app).await;
+    let csv = log();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let (t, phi) = (
+        header.iter().position(|c| *c == "t").unwrap(),
+        header.iter().position(|c| *c == "phi").unwrap(),
+    );
+    let mut out = format!("{}\n", header.join(","));
+    for l in lines {
+        let mut row: Vec<f64> = l.split(',').map(|v| v.parse().unwrap()).collect();
+        row[t] *= 1000.0;
+        row[phi] = (row[phi] + 0.2).to_degrees() * 20.0;
+        let row: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+        out.push_str(&row.join(","));
+        out.push('\n');
+    }
+    let r = upload(&app, &cid, &[("file", Some("ms_deg.csv"), &out)]).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    let s = &r.json["summary"];
+    assert_eq!(s["check_units"], json!(["t", "phi"]), "{:#}", s["warnings"]);
+    let units: Vec<&Value> = s["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|w| w["units"] == true)
+        .collect();
+    assert_eq!(units.len(), 2, "{units:#?}");
+    let verdicts = s["verdicts"].as_array().unwrap();
+    assert_eq!(verdicts.len(), 6);
+    for v in verdicts {
+        assert_eq!(v["verdict"], "check_units", "{v:#}");
+        let reason = v["reason"].as_str().unwrap();
+        assert!(reason.contains("check the log's units first"), "{reason}");
+        assert!(
+            reason.contains("milliseconds") && reason.contains("degrees"),
+            "{reason}"
+        );
+        assert!(!reason.contains("twice the amplitude"), "{reason}");
+    }
+    // A log in the contract's units carries no such doubt.
+    let r = upload(&app, &cid, &[("file", Some("ok.csv"), &csv)]).await;
+    assert_eq!(r.status, 201, "{}", r.text);
+    assert!(r.json["summary"].get("check_units").is_none());
+    assert!(
+        r.json["summary"]["verdicts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|v| v["verdict"] != "check_units")
+    );
+}

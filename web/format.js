@@ -146,13 +146,14 @@ export function bytes(n) {
 }
 
 /** Data-quality verdicts and coverage states. */
-export const VERDICT_ICON = { good: '✓', weak: '!', insufficient: '✗', rejected: '✗' };
+export const VERDICT_ICON = { good: '✓', weak: '!', insufficient: '✗', rejected: '✗', check_units: '⚠' };
 export const COVERAGE_LABEL = {
-  covered: 'covered', weak: 'weak', repeat: 'fly again', missing: 'not flown',
+  covered: 'covered', weak: 'weak', check_units: 'check units', repeat: 'fly again', missing: 'not flown',
 };
 export const COVERAGE_HELP = {
   covered: 'a good run in every DOF the experiment excites',
   weak: 'its best run is weak in some excited DOF: usable, but consider flying it again',
+  check_units: 'flown, but the log’s units look wrong (milliseconds, degrees): fix them and upload it again before deciding to fly',
   repeat: 'flown, but no run is usable: fly it again',
   missing: 'not flown yet',
 };

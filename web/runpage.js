@@ -11,7 +11,7 @@ import { bandText, bytes, fmt, fmtDate, secs } from './format.js';
 import { h, fill } from './forms.js';
 import { PALETTE, psdUnit } from './plots.js';
 import { spectrumPlot, singularValuePlot, syncX, exact } from './runplots.js';
-import { verdictBadge, statusBadge, coverageBadge, errorWhere, errorText, rawLinks } from './runs.js';
+import { verdictBadge, statusBadge, coverageBadge, errorWhere, errorText, rawLinks, unitWarnings } from './runs.js';
 import { runOffsetPanel } from './offsetpanel.js';
 import { descriptionSection } from './rundescribe.js';
 import { excludedBadge, runManageSection } from './manage.js';
@@ -157,7 +157,7 @@ export async function runPage(view, rid) {
   fill(view,
     h('div', { class: 'page-head' },
       h('div', null,
-        h('h1', { 'data-testid': 'run-title' }, run.name, statusBadge(run.status), excludedBadge(run)),
+        h('h1', { 'data-testid': 'run-title' }, run.name, statusBadge(run.status, run), excludedBadge(run)),
         h('div', { class: 'muted' },
           'Run of ', campaign ? h('a', { href: `#/campaigns/${campaign.id}`, 'data-testid': 'run-campaign-link' }, campaign.name) : run.campaign_id,
           run.experiment_id ? [' · experiment ',
@@ -173,6 +173,7 @@ export async function runPage(view, rid) {
       h('p', { class: 'err-message', 'data-testid': 'error-message' }, run.error && errorText(run.error.message)),
       h('p', { class: 'hint' }, 'Fix the file and upload it again; the bytes above are kept as received.')) : null,
     run.status === 'stored' ? h('p', { class: 'empty' }, 'Stored, not processed yet.') : null,
+    run.status === 'accepted' ? unitWarnings(run) : null,
 
     descriptionSection(run, { vessel }),
     runManageSection(run),

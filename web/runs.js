@@ -36,9 +36,25 @@ export function verdictList(verdicts) {
 }
 
 /** The status of a stored run: accepted / rejected / stored (not processed yet). */
-export function statusBadge(status) {
+export function statusBadge(status, run) {
+  const units = (run && run.summary && run.summary.check_units) || [];
+  if (status === 'accepted' && units.length) {
+    return h('span', {
+      class: 'badge check_units status', 'data-testid': 'run-status', 'data-status': 'check_units',
+      title: `stored, but the units of ${units.join(', ')} look wrong: fix the log and upload it again`,
+    }, '⚠ check units');
+  }
   const kind = status === 'accepted' ? 'good' : status === 'rejected' ? 'insufficient' : 'neutral';
   return h('span', { class: `badge ${kind} status`, 'data-testid': 'run-status', 'data-status': status }, status);
+}
+
+/** The unit doubts of a run, for the top of its result card (empty: none). */
+export function unitWarnings(run) {
+  const w = ((run.summary && run.summary.warnings) || []).filter((x) => x.units);
+  if (!w.length) return null;
+  return h('div', { class: 'units-alert', role: 'alert', 'data-testid': 'units-alert' },
+    h('b', null, '⚠ Check the log’s units before anything else'),
+    h('ul', null, w.map((x) => h('li', { 'data-testid': 'units-warning', 'data-column': x.column || '' }, x.message))));
 }
 
 export function coverageBadge(status) {
@@ -279,11 +295,14 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
 
   function showAccepted(run) {
     const v = (run.summary && run.summary.verdicts) || [];
-    const worst = v.some((x) => x.verdict === 'insufficient') ? 'insufficient' : v.some((x) => x.verdict === 'weak') ? 'weak' : 'good';
-    fill(resultBox, h('div', { class: `result-card ${worst}`, 'data-testid': 'upload-accepted', 'data-run-id': run.id },
+    const units = (run.summary && run.summary.check_units) || [];
+    const worst = units.length ? 'weak'
+      : v.some((x) => x.verdict === 'insufficient') ? 'insufficient' : v.some((x) => x.verdict === 'weak') ? 'weak' : 'good';
+    fill(resultBox, h('div', { class: `result-card ${worst}`, 'data-testid': 'upload-accepted', 'data-run-id': run.id, 'data-check-units': String(units.length > 0) },
       h('div', { class: 'result-head' },
-        h('b', null, `✓ Run “${run.name}” ${run.status}`),
+        h('b', null, units.length ? `⚠ Run “${run.name}” stored — check units (${units.join(', ')})` : `✓ Run “${run.name}” ${run.status}`),
         h('a', { class: 'btn small', href: urls.run(run.id), 'data-testid': 'upload-run-link' }, 'Open run page →')),
+      unitWarnings(run),
       v.length ? verdictList(v) : h('p', { class: 'muted' }, 'No verdicts.')));
   }
 
@@ -337,6 +356,7 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
         toFly ? h('b', null, `${toFly} of ${n} experiment${n === 1 ? '' : 's'} still to fly`) : h('b', null, 'Nothing missing'),
         toFly ? ` — ${c.repeat} to fly again (no usable run), ${c.missing} not flown yet` : '',
         c.weak ? `${toFly ? '; ' : ' — '}${c.weak} weak (usable, consider flying again)` : '',
+        c.check_units ? `; ${c.check_units} with units to check (fix the log and upload it again)` : '',
         '.');
     }
     const shown = c.experiments.filter((e) => covFilter === 'all'
@@ -368,6 +388,7 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
         chip('repeat', COVERAGE_LABEL.repeat, counts.repeat, 'cov-repeat', COVERAGE_HELP.repeat),
         chip('missing', COVERAGE_LABEL.missing, counts.missing, 'cov-missing', COVERAGE_HELP.missing),
         chip('weak', COVERAGE_LABEL.weak, counts.weak, 'cov-weak', COVERAGE_HELP.weak),
+        c.check_units ? chip('check_units', COVERAGE_LABEL.check_units, c.check_units, 'cov-check_units', COVERAGE_HELP.check_units) : null,
         chip('covered', COVERAGE_LABEL.covered, counts.covered, 'cov-covered', COVERAGE_HELP.covered),
         chip('all', 'all', n, 'all', 'every planned experiment'),
         h('span', { class: 'muted', 'data-testid': 'coverage-count' }, `${shown.length} of ${n} shown`)),
@@ -398,7 +419,7 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
         h('td', { class: 'mono nowrap' }, r.experiment_id ? codes.get(r.experiment_id) || h('span', { class: 'muted', title: r.experiment_id }, 'older plan') : h('span', { class: 'muted' }, '–')),
         h('td', { class: 'nowrap' }, describeCell(r)),
         h('td', null, r.layout === 'split' ? 'control + nav' : 'one log'),
-        h('td', null, statusBadge(r.status), r.excluded ? [' ', excludedBadge(r)] : null),
+        h('td', null, statusBadge(r.status, r), r.excluded ? [' ', excludedBadge(r)] : null),
         h('td', { class: 'badges' }, r.status === 'rejected'
           ? h('span', { class: 'error-text', 'data-testid': 'run-error' }, errorWhere(r.error, r.files), r.error && r.error.message ? h('span', { class: 'muted' }, ` — ${errorText(r.error.message)}`) : null)
           : v.map((x) => verdictBadge(x))),

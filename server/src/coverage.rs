@@ -16,6 +16,9 @@ pub enum CoverageStatus {
     Covered,
     /// Best run is weak in some excited DOF.
     Weak,
+    /// Runs exist, the best one's units look wrong (milliseconds,
+    /// degrees): fix the log and upload it again before deciding to fly.
+    CheckUnits,
     /// Runs exist but none is usable: fly it again.
     Repeat,
     /// Not flown yet.
@@ -61,6 +64,8 @@ pub struct Coverage {
     pub covered: usize,
     /// Experiments whose best run is weak.
     pub weak: usize,
+    /// Experiments whose best run's units look wrong (fix, upload again).
+    pub check_units: usize,
     /// Experiments to fly again.
     pub repeat: usize,
     /// Experiments not flown.
@@ -73,8 +78,9 @@ pub struct Coverage {
 
 fn rank(v: &str) -> u8 {
     match v {
-        "good" => 3,
-        "weak" => 2,
+        "good" => 4,
+        "weak" => 3,
+        "check_units" => 2,
         "insufficient" => 1,
         _ => 0,
     }
@@ -120,6 +126,7 @@ pub fn coverage(plan: &StoredPlan, runs: &[Run]) -> Coverage {
         plan_version: plan.version,
         covered: 0,
         weak: 0,
+        check_units: 0,
         repeat: 0,
         missing: 0,
         experiments: Vec::new(),
@@ -142,13 +149,15 @@ pub fn coverage(plan: &StoredPlan, runs: &[Run]) -> Coverage {
         let best = mine.iter().map(|r| rank(&r.verdict)).max();
         let status = match best {
             None => CoverageStatus::Missing,
-            Some(3) => CoverageStatus::Covered,
-            Some(2) => CoverageStatus::Weak,
+            Some(4) => CoverageStatus::Covered,
+            Some(3) => CoverageStatus::Weak,
+            Some(2) => CoverageStatus::CheckUnits,
             Some(_) => CoverageStatus::Repeat,
         };
         match status {
             CoverageStatus::Covered => out.covered += 1,
             CoverageStatus::Weak => out.weak += 1,
+            CoverageStatus::CheckUnits => out.check_units += 1,
             CoverageStatus::Repeat => out.repeat += 1,
             CoverageStatus::Missing => out.missing += 1,
         }

@@ -92,6 +92,10 @@ pub struct RunWarning {
     pub column: Option<String>,
     /// What to know, in plain words.
     pub message: String,
+    /// The doubt is about the log's units (milliseconds, degrees): its
+    /// verdicts say "check units" until the log is fixed.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub units: bool,
 }
 
 /// What processing found: sizes, rates, gaps, warnings, alignment, verdicts.
@@ -127,6 +131,11 @@ pub struct RunSummary {
     /// Channels derived from others (a DP log's u, v, r from its pose).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub derived_channels: Vec<String>,
+    /// Columns whose units look wrong (`t` in milliseconds, angles in
+    /// degrees, rates in deg/s): the run is stored and accepted, but every
+    /// verdict is `check_units` until a fixed log is uploaded.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub check_units: Vec<String>,
 }
 
 /// Why a run was rejected: which file, where, what.
@@ -319,6 +328,7 @@ pub fn load_record(
                 file: file.into(),
                 column: w.column.clone(),
                 message: w.message.clone(),
+                units: w.units,
             }));
         summary.rows.insert(file.into(), p.rows);
         summary.gaps.insert(file.into(), p.gaps.clone());
@@ -370,6 +380,7 @@ pub fn load_record(
                 file: "alignment".into(),
                 column: None,
                 message: w.clone(),
+                units: false,
             }));
         summary.alignment = Some(report);
         rec
@@ -405,6 +416,7 @@ fn velocities_from_pose(vessel: &VesselProfile, rec: &mut UniformRecord, summary
                 velocities.join(", "),
                 seatrial_core::numbers::sig3(half.max(1.0 / rec.sample_rate_hz))
             ),
+            units: false,
         });
         summary.derived_channels = velocities;
     }
@@ -429,6 +441,7 @@ pub fn process_run(
                 file: "description".into(),
                 column: None,
                 message: format!("nothing inferred about what the run is: {e}"),
+                units: false,
             })
         })
         .ok();
@@ -480,11 +493,25 @@ pub fn process_run(
             file: "quality".into(),
             column: None,
             message: m.clone(),
+            units: false,
         }));
     summary.sample_rate_hz = rec.sample_rate_hz;
     summary.duration_s = rec.len() as f64 / rec.sample_rate_hz;
     summary.valid_duration_s = rec.valid_duration_s();
     summary.verdicts = report.dofs;
+    let doubts: Vec<&str> = summary
+        .warnings
+        .iter()
+        .filter(|w| w.units)
+        .map(|w| w.message.as_str())
+        .collect();
+    seatrial_core::quality::units_first(&mut summary.verdicts, &doubts);
+    summary.check_units = summary
+        .warnings
+        .iter()
+        .filter(|w| w.units)
+        .filter_map(|w| w.column.clone())
+        .collect();
     summary.adherence = report.adherence;
     let summary =
         serde_json::to_value(&summary).map_err(|e| ProcessError::new("file", e.to_string()))?;

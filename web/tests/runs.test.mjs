@@ -335,3 +335,41 @@ test('control + nav logs from unsynchronized computers: alignment offset ≈ 5.3
     assert.equal(await page.locator(tid('adherence-empty')).count(), 1, 'not assigned: no plan to compare with');
   });
 });
+
+test('a log in milliseconds and degrees: the result card says check units, with the doubts on it and no fly-again verdict', async () => {
+  const run = simulate({ seed: 4, fs: 10, duration: 60, amp: [400, 800, 800, 0, 600, 600], clock: 3, noise: 1e-4 });
+  const lines = csv(run, ALL_COLUMNS).trim().split('\n');
+  const header = lines[0].split(',');
+  const [t, phi] = [header.indexOf('t'), header.indexOf('phi')];
+  const body = lines.slice(1).map((l) => {
+    const c = l.split(',').map(Number);
+    c[t] *= 1000;
+    c[phi] = (c[phi] + 0.2) * 180 / Math.PI * 20;
+    return c.join(',');
+  });
+  const log = [lines[0], ...body].join('\n') + '\n';
+
+  await H.withPage([], async (page) => {
+    await page.goto(`${H.base}/#/campaigns/${cid}`);
+    await page.locator(tid('upload-form')).waitFor();
+    await page.setInputFiles(tid('upload-file'), { name: 'ms_deg.csv', mimeType: 'text/csv', buffer: Buffer.from(log) });
+    await page.fill(tid('upload-name'), 'units e2e');
+    await page.click(tid('upload-submit'));
+    const card = page.locator(tid('upload-accepted'));
+    await card.waitFor();
+    assert.equal(await card.getAttribute('data-check-units'), 'true');
+    assert.match(await card.locator('.result-head b').textContent(), /check units \(t, phi\)/);
+    const doubts = await card.locator(tid('units-warning')).allTextContents();
+    assert.equal(doubts.length, 2, doubts.join(' | '));
+    assert.match(doubts[0], /t looks like milliseconds/);
+    assert.match(doubts[1], /phi looks like degrees/);
+    const verdicts = await card.locator(tid('verdict')).evaluateAll((els) => els.map((e) => e.dataset.verdict));
+    assert.ok(verdicts.length > 0 && verdicts.every((v) => v === 'check_units'), verdicts.join(','));
+    assert.doesNotMatch(await card.textContent(), /twice the amplitude|fly it again/);
+    // The units alert sits on the card above the verdicts: visible without scrolling the card.
+    const [alertBox, listBox] = await Promise.all([card.locator(tid('units-alert')).boundingBox(), card.locator(tid('verdict-list')).boundingBox()]);
+    assert.ok(alertBox.y < listBox.y);
+    // The runs list marks it too.
+    await page.locator(`${tid('run-status')}[data-status="check_units"]`).first().waitFor();
+  });
+});

@@ -29,6 +29,8 @@ export const POSE = ['x', 'y', 'z', 'phi', 'theta', 'psi'];
 export const ALL_COLUMNS = [...FORCES, ...VELS, ...POSE];
 export const TC = [4.0, 3.0, 3.0, 1.5, 1.5, 2.0];
 export const D = [2000, 4000, 4000, 3000, 3000, 3000];
+/** Righting moments of roll and pitch (N·m/rad): attitudes stay within a few degrees, as a real ROV's. */
+export const G = [0, 0, 0, 6000, 6000, 0];
 
 /**
  * Simulates `duration` s at `fs` Hz. `amp[i]` is the force amplitude of DOF i
@@ -57,7 +59,7 @@ export function simulate({ seed, fs, duration, amp, clock, noise, force = [], su
       tau[k] = f;
       nu[k] = v + noise * rng.normal();
       eta[k] = pos + noise * rng.normal();
-      v = a * v + (1 - a) * f / D[i];
+      v = a * v + (1 - a) * (f - G[i] * pos) / D[i];
       pos += v * h;
     }
     run.tau.push(tau);

@@ -43,6 +43,10 @@ pub struct LogWarning {
     pub column: Option<String>,
     /// What looks wrong and what to do, for people.
     pub message: String,
+    /// The doubt is about units (time in milliseconds, angles in degrees,
+    /// rates in deg/s): the log's numbers cannot be judged until it is fixed.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub units: bool,
 }
 
 impl LogWarning {
@@ -51,6 +55,15 @@ impl LogWarning {
         LogWarning {
             column: Some(column.into()),
             message: message.into(),
+            units: false,
+        }
+    }
+
+    /// A doubt about the units of one column.
+    pub fn units(column: impl Into<String>, message: impl Into<String>) -> Self {
+        LogWarning {
+            units: true,
+            ..LogWarning::column(column, message)
         }
     }
 }
@@ -96,7 +109,7 @@ pub fn plausibility_warnings(table: &LogTable) -> Vec<LogWarning> {
             _ => None,
         };
         if let Some(m) = msg {
-            out.push(LogWarning::column(name.as_str(), m));
+            out.push(LogWarning::units(name.as_str(), m));
         }
         if min == max {
             out.push(LogWarning::column(
@@ -115,7 +128,7 @@ pub fn plausibility_warnings(table: &LogTable) -> Vec<LogWarning> {
 fn time_warning(t: &[f64]) -> Option<LogWarning> {
     let dt = crate::timeseries::median_dt(t)?;
     if dt > MS_MEDIAN_DT_S {
-        Some(LogWarning::column(
+        Some(LogWarning::units(
             "t",
             format!(
                 "t looks like milliseconds (median step {}: a logger samples at 1 Hz or faster); \

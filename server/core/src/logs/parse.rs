@@ -305,6 +305,7 @@ pub fn parse_log<R: Read>(reader: R, opts: &ParseOptions) -> Result<ParsedLog, L
                  in the ignored columns)",
                 ignored_columns.len() - MAX_COLUMN_WARNINGS
             ),
+            units: false,
         });
     }
     if opts.heading_unit == HeadingUnit::Deg {

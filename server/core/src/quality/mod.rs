@@ -58,7 +58,7 @@ pub use regressor::{
 pub use report::{default_quality_nperseg, quality_report};
 pub use verdict::{
     FLAT_INPUT_RELATIVE_RMS, GOOD_COHERENCE, MIN_COHERENT_FRACTION, MIN_INPUT_SHARE,
-    MIN_MEDIAN_COHERENCE, MIN_PE_ORDER, MIN_SEGMENTS,
+    MIN_MEDIAN_COHERENCE, MIN_PE_ORDER, MIN_SEGMENTS, units_first,
 };
 
 // ---------------------------------------------------------------------------
@@ -377,6 +377,9 @@ pub enum Verdict {
     Weak,
     /// The log cannot identify this DOF; fly it again.
     Insufficient,
+    /// The log's units look wrong (milliseconds, degrees): fix them and
+    /// upload again before the excitation is judged.
+    CheckUnits,
 }
 
 /// The verdict on one DOF, its reason and the evidence behind it.
@@ -389,7 +392,7 @@ pub struct DofVerdict {
     pub input: String,
     /// Its output column.
     pub output: String,
-    /// `good`, `weak` or `insufficient`.
+    /// `good`, `weak`, `insufficient` or `check_units`.
     pub verdict: Verdict,
     /// Plain words naming the DOF, the evidence and the action.
     pub reason: String,

@@ -812,3 +812,34 @@ fn report_serializes_in_snake_case() {
     .unwrap();
     assert_eq!(spec, sway_spec());
 }
+
+/// Unit doubts replace every verdict by `check_units` naming them, keep the
+/// evidence; no doubts leave the verdicts as computed.
+#[test]
+fn unit_doubts_replace_every_verdict_and_none_leave_them() {
+    let report = quality_report(&sway_log(6000, 0.01, 3), &sway_spec()).unwrap();
+    let mut v = report.dofs.clone();
+    units_first(&mut v, &[]);
+    assert_eq!(v, report.dofs);
+    assert_eq!(v[0].verdict, Verdict::Good, "{}", v[0].reason);
+    units_first(
+        &mut v,
+        &["t looks like milliseconds", "phi looks like degrees"],
+    );
+    for (after, before) in v.iter().zip(&report.dofs) {
+        assert_eq!(after.verdict, Verdict::CheckUnits);
+        assert!(
+            after
+                .reason
+                .starts_with("sway: check the log's units first"),
+            "{}",
+            after.reason
+        );
+        assert!(
+            after
+                .reason
+                .contains("milliseconds; phi looks like degrees")
+        );
+        assert_eq!(after.evidence, before.evidence);
+    }
+}

@@ -403,6 +403,26 @@ pub(crate) fn judge(ctx: &DofContext<'_>) -> DofVerdict {
     }
 }
 
+/// The verdicts of a log whose units look wrong (`doubts`: the plausibility
+/// warnings about units, in words): every DOF becomes
+/// [`Verdict::CheckUnits`] with a reason that names the doubts, instead of
+/// a "fly it again" computed on numbers in the wrong units. The evidence
+/// stays as computed. No doubts: the verdicts are left as they are.
+pub fn units_first(verdicts: &mut [DofVerdict], doubts: &[&str]) {
+    if doubts.is_empty() {
+        return;
+    }
+    let doubts = doubts.join("; ");
+    for v in verdicts {
+        v.verdict = Verdict::CheckUnits;
+        v.reason = format!(
+            "{}: check the log's units first — {doubts}; fix them and upload the log again \
+             (its excitation is not judged until then)",
+            v.dof.name()
+        );
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
