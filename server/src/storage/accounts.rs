@@ -267,13 +267,20 @@ pub fn from_now(secs: i64) -> String {
         .unwrap_or_default()
 }
 
-/// Stores a new session for `user_id` under the hash of its cookie value.
+/// Stores a new session for `user_id` under the hash of its cookie value,
+/// and drops the user's expired ones (RFC 3339 UTC strings of one format
+/// order like their times, to within the second).
 pub async fn insert_session(
     db: &Db,
     user_id: &str,
     token_hash: &str,
     lifetime_secs: i64,
 ) -> anyhow::Result<()> {
+    sqlx::query("DELETE FROM session WHERE user_id = $1 AND expires_at < $2")
+        .bind(user_id)
+        .bind(now())
+        .execute(db)
+        .await?;
     sqlx::query(
         "INSERT INTO session (id, user_id, token_hash, created_at, expires_at) \
          VALUES ($1, $2, $3, $4, $5)",
