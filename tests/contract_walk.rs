@@ -112,6 +112,16 @@ async fn every_documented_operation_is_exercised_and_answers() {
     let mid = stored_model(&app, &cid, &vid).await;
     let did = stored_discrepancy(&app, &cid, &mid).await;
 
+    // An account, and a token of it (local mode: the local admin makes them).
+    let walker = json!({ "name": "walker", "role": "admin", "password": "walker-password" });
+    let r = app.call("POST", "/api/users", &[], Some(walker)).await;
+    let uid = r.json["id"].as_str().unwrap().to_string();
+    let token = |name: &str| json!({ "name": name, "user_id": uid });
+    let r = app
+        .call("POST", "/api/auth/tokens", &[], Some(token("walk")))
+        .await;
+    let bearer = format!("Bearer {}", r.json["token"].as_str().unwrap());
+
     let paths = app.spec["paths"].as_object().unwrap().clone();
     let mut walked = 0;
     for (template, ops) in &paths {
@@ -126,6 +136,8 @@ async fn every_documented_operation_is_exercised_and_answers() {
                 vec![&rid]
             } else if template.starts_with("/api/jobs/") {
                 vec![&jid]
+            } else if template.starts_with("/api/users/") {
+                vec![&uid]
             } else if template.starts_with("/api/discrepancies/") {
                 vec![&did]
             } else if template.starts_with("/api/models/") {
@@ -146,6 +158,46 @@ async fn every_documented_operation_is_exercised_and_answers() {
                         .await;
                     app.check_contract("POST", template, &r);
                     r
+                }
+                ("post", "/api/auth/login") => {
+                    let body = json!({ "name": "walker", "password": "walker-password" });
+                    app.call("POST", template, &[], Some(body)).await
+                }
+                // One's own password: the account's token, not the local admin.
+                ("post", "/api/auth/password") => {
+                    let body = json!({ "current_password": "walker-password",
+                                       "new_password": "walker-password" });
+                    let r = app
+                        .raw_with(
+                            "POST",
+                            template,
+                            &[("authorization", &bearer)],
+                            Some(("application/json", body.to_string())),
+                        )
+                        .await;
+                    app.check_contract("POST", template, &r);
+                    r
+                }
+                ("post", "/api/auth/tokens") => {
+                    app.call("POST", template, &[], Some(token("walked"))).await
+                }
+                ("get", "/api/auth/tokens") => {
+                    app.call("GET", "/api/auth/tokens?all=true", &[], None).await
+                }
+                ("delete", "/api/auth/tokens/{id}") => {
+                    let r = app
+                        .call("POST", "/api/auth/tokens", &[], Some(token("gone")))
+                        .await;
+                    let id = r.json["id"].as_str().unwrap().to_string();
+                    app.call("DELETE", template, &[&id], None).await
+                }
+                ("post", "/api/users") => {
+                    let body = json!({ "name": "walked", "role": "viewer", "password": "12345678" });
+                    app.call("POST", template, &[], Some(body)).await
+                }
+                ("patch", "/api/users/{id}") => {
+                    app.call("PATCH", template, &args, Some(json!({ "disabled": false })))
+                        .await
                 }
                 ("post", "/api/jobs") => {
                     app.call(

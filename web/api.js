@@ -17,7 +17,8 @@ export class ApiError extends Error {
 }
 
 async function request(method, path, body, rawBody) {
-  const init = { method, headers: { accept: 'application/json' } };
+  // The CSRF header every write with the session cookie must carry (see README).
+  const init = { method, headers: { accept: 'application/json', 'x-seatrial-csrf': '1' } };
   if (body !== undefined || rawBody !== undefined) {
     init.headers['content-type'] = 'application/json';
     init.body = rawBody !== undefined ? rawBody : JSON.stringify(body);
@@ -55,6 +56,10 @@ const many = (f) => (xs) => (Array.isArray(xs) ? xs.map(f) : xs);
 
 export const api = {
   health: () => request('GET', '/api/health'),
+  // Accounts: who is signed in (401: nobody, and the service requires it), sign in and out.
+  me: () => request('GET', '/api/auth/me'),
+  login: (name, password) => request('POST', '/api/auth/login', { name, password }),
+  logout: () => request('POST', '/api/auth/logout'),
   vessels: () => request('GET', '/api/vessels').then(many(flatVessel)),
   vessel: (id) => request('GET', `/api/vessels/${enc(id)}`).then(flatVessel),
   createVessel: (profile) => request('POST', '/api/vessels', profile).then(flatVessel),
@@ -135,6 +140,7 @@ export function uploadRun(id, { files, meta }, { onProgress, onSent } = {}) {
     xhr.addEventListener('abort', () => reject(new ApiError({ status: 0, message: 'upload cancelled' }, 0)));
     xhr.open('POST', `/api/campaigns/${enc(id)}/runs`);
     xhr.setRequestHeader('accept', 'application/json');
+    xhr.setRequestHeader('x-seatrial-csrf', '1');
     xhr.send(form);
   });
   return { promise, abort: () => xhr.abort() };

@@ -12,6 +12,7 @@ import { runPage } from './runpage.js';
 import { modelPage } from './modelpage.js';
 import { discoveryPage } from './discoverypage.js';
 import { destroyPlots } from './plots.js';
+import { whoAmI, loginForm } from './account.js';
 
 const view = document.getElementById('view');
 let current = null; // controller of the page shown (campaign page), if any
@@ -71,6 +72,12 @@ async function route() {
     if (ctl && parts[2] === 'experiments' && parts[3]) await ctl.select(parts[3]);
   } catch (err) {
     if (my !== seq) return;
+    // Signed out (or the session ended): sign in, then show the page asked for.
+    if (err instanceof ApiError && err.status === 401) {
+      await whoAmI().catch(() => null);
+      loginForm(view, route);
+      return;
+    }
     if (!(err instanceof ApiError)) console.error(err); // a bug, not an API answer
     fill(view, h('h1', null, 'Could not load this page'), h('p', { class: 'error-text' }, err.message));
     banner(`${err.status ? `${err.status} · ` : ''}${err.message}`);
@@ -91,5 +98,10 @@ async function health() {
 
 window.addEventListener('hashchange', route);
 if (!location.hash) history.replaceState(null, '', '#/campaigns');
-route();
+// Who is signed in decides what is shown: the sign-in form, or the page
+// with the controls of the role.
+whoAmI().then(
+  (me) => (me ? route() : loginForm(view, route)),
+  () => route(), // the page shows what is wrong
+);
 health();

@@ -32,7 +32,7 @@ export async function campaignList(view) {
   fill(view, 
     h('div', { class: 'page-head' },
       h('h1', null, 'Campaigns'),
-      h('a', { class: 'btn primary', href: '#/campaigns/new', 'data-testid': 'new-campaign' }, '+ New campaign')),
+      h('a', { class: 'btn primary', href: '#/campaigns/new', 'data-testid': 'new-campaign', 'data-needs': 'supervisor' }, '+ New campaign')),
     campaigns.length === 0
       ? h('p', { class: 'empty' }, vessels.length === 0
         ? h('span', null, 'No vessels yet: ', h('a', { href: '#/vessels/new' }, 'create a vessel'), ' first.')
@@ -92,7 +92,7 @@ export async function campaignForm(view, query) {
   const form = h('form', { class: 'card form', novalidate: true, 'data-testid': 'campaign-form', 'aria-label': 'New campaign' });
   const body = h('div');
   form.append(body, h('div', { class: 'form-actions' },
-    h('button', { type: 'submit', class: 'btn primary', 'data-testid': 'create-campaign' }, 'Create campaign'),
+    h('button', { type: 'submit', class: 'btn primary', 'data-testid': 'create-campaign', 'data-needs': 'supervisor' }, 'Create campaign'),
     h('a', { class: 'btn', href: '#/campaigns' }, 'Cancel'),
     h('span', { class: 'hint' }, 'The server dry-runs the plan: every limit violation is reported on its field.')));
   fill(view, h('div', { class: 'page-head' }, h('h1', null, 'New campaign')), form);

@@ -22,7 +22,7 @@ export async function discoveryPanel(model) {
   const status = h('div', { class: 'job-msg', 'data-testid': 'discover-status', role: 'status', 'aria-live': 'polite' });
   const physical = model.kind === 'lpv';
   const start = h('button', {
-    type: 'button', class: 'btn primary', 'data-testid': 'discover-start', disabled: !physical,
+    type: 'button', class: 'btn primary', 'data-testid': 'discover-start', 'data-needs': 'supervisor', disabled: !physical,
     title: physical ? 'Simulate the model on its runs, locate the misfit, name the left-out physics, store the augmented model as the next version' : 'Discovery augments a physical LPV model (M, D̄); this one has none',
     onClick: run,
   }, 'Discover missing physics');

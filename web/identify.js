@@ -67,7 +67,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
   [jobs, models] = await Promise.all([api.jobs(id), api.models(id)]);
 
   // ---- the form ---------------------------------------------------------------
-  const form = h('form', { class: 'card form identify', novalidate: true, 'data-testid': 'identify-form', 'aria-label': 'Identify a model', onSubmit: submit });
+  const form = h('form', { class: 'card form identify', novalidate: true, 'data-testid': 'identify-form', 'data-needs': 'supervisor', 'aria-label': 'Identify a model', onSubmit: submit });
   const methodHelp = h('p', { class: 'hint method-help', 'data-testid': 'identify-method-help', 'aria-live': 'polite' });
   const sweepsIn = h('input', { type: 'number', min: '1', max: '20', step: '1', value: '2', class: 'short', 'data-field': 'settings.sweeps', 'data-testid': 'identify-sweeps' });
   const sweepsFld = labelled('Sweeps', sweepsIn, 'passes through SI1 → SI2 → SI3');
@@ -253,10 +253,10 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
     fill(r.state, jobStateBadge(j.state), j.cancel_requested && !TERMINAL.has(j.state) ? h('span', { class: 'hint' }, ' cancelling…') : null);
     const acts = [];
     if (!TERMINAL.has(j.state)) {
-      acts.push(h('button', { type: 'button', class: 'btn small', 'data-testid': 'job-cancel', disabled: !!j.cancel_requested, onClick: () => cancel(j.id) }, 'Cancel'));
+      acts.push(h('button', { type: 'button', class: 'btn small', 'data-testid': 'job-cancel', 'data-needs': 'supervisor', disabled: !!j.cancel_requested, onClick: () => cancel(j.id) }, 'Cancel'));
     }
     if (RETRYABLE.has(j.state)) {
-      acts.push(h('button', { type: 'button', class: 'btn small', 'data-testid': 'job-retry', onClick: () => retry(j.id) }, 'Retry'));
+      acts.push(h('button', { type: 'button', class: 'btn small', 'data-testid': 'job-retry', 'data-needs': 'supervisor', onClick: () => retry(j.id) }, 'Retry'));
     }
     if (j.state === 'succeeded' && j.result && j.result.discrepancy_id) {
       acts.push(h('a', { class: 'btn small primary', href: urls.discrepancy(j.result.discrepancy_id), 'data-testid': 'job-report-link' }, 'Open report →'));

@@ -32,7 +32,7 @@ export function excludedBadge(run) {
 
 /** Run page: exclude/include and delete. */
 export function runManageSection(run) {
-  const host = h('section', { class: 'manage', 'aria-label': 'Manage this run', 'data-testid': 'run-manage' });
+  const host = h('section', { class: 'manage', 'aria-label': 'Manage this run', 'data-testid': 'run-manage', 'data-needs': 'supervisor' });
   const msg = h('div', { 'aria-live': 'polite' });
   function render(r) {
     const reason = h('input', {
@@ -85,7 +85,7 @@ export function modelDeleteControl(model) {
       }, 'Delete with the derived versions…'));
     }
   });
-  return h('div', { class: 'manage', 'data-testid': 'model-manage' },
+  return h('div', { class: 'manage', 'data-testid': 'model-manage', 'data-needs': 'engineer' },
     h('button', {
       type: 'button', class: 'btn danger small', 'data-testid': 'delete-model',
       onclick: () => confirmBox(msg, {

@@ -64,6 +64,8 @@ function offsetForm(label, current, save, prefix) {
   }, 'Clear');
   return h('form', {
     class: 'offset-form', 'data-testid': `${prefix}-form`,
+    // A campaign's offset re-aligns every run: an engineer's setting.
+    'data-needs': prefix === 'campaign-offset' ? 'engineer' : 'supervisor',
     onSubmit: (e) => {
       e.preventDefault();
       const raw = input.value.trim();

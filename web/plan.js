@@ -101,7 +101,7 @@ export async function campaignPage(view, id) {
   let selected = null;
   const filters = { family: '', speed: '', warn: false };
 
-  const genBtn = h('button', { type: 'button', class: 'btn primary', 'data-testid': 'generate-plan', onClick: generate }, plan ? 'Regenerate plan' : 'Generate plan');
+  const genBtn = h('button', { type: 'button', class: 'btn primary', 'data-testid': 'generate-plan', 'data-needs': 'supervisor', onClick: generate }, plan ? 'Regenerate plan' : 'Generate plan');
   const loading = h('span', { class: 'loading', hidden: true, role: 'status', 'aria-live': 'polite', 'data-testid': 'plan-loading' }, h('span', { class: 'spinner', 'aria-hidden': 'true' }), 'Generating plan…');
   const exportLinks = h('span', { class: 'actions' });
   const planHost = h('section', { class: 'plan', 'aria-label': 'Plan' });

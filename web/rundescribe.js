@@ -118,7 +118,7 @@ export function descriptionSection(run0, { vessel, onSaved }) {
     const d = run.description || {};
     const f = d[key];
     const reset = f && f.source === 'user' && key !== 'notes' ? h('button', {
-      type: 'button', class: 'link small', 'data-testid': 'desc-reset', 'data-field': key,
+      type: 'button', class: 'link small', 'data-testid': 'desc-reset', 'data-needs': 'supervisor', 'data-field': key,
       title: 'clear the user value: the plan’s or the inferred value applies again',
       onClick: () => send({ [key]: null }),
     }, '↺ back to plan / data') : null;
@@ -200,7 +200,7 @@ export function descriptionSection(run0, { vessel, onSaved }) {
     const d = run.description || {};
     const inferred = FIELDS.filter(([k]) => d[k] && d[k].source === 'inferred');
     const confirm = inferred.length ? h('button', {
-      type: 'button', class: 'btn small', 'data-testid': 'desc-confirm',
+      type: 'button', class: 'btn small', 'data-testid': 'desc-confirm', 'data-needs': 'supervisor',
       title: 'make the inferred values the supervisor’s',
       onClick: () => send(Object.fromEntries(inferred.map(([k]) => [k, d[k].value]))),
     }, `✓ Confirm inferred (${inferred.length})`) : null;
@@ -208,7 +208,7 @@ export function descriptionSection(run0, { vessel, onSaved }) {
       h('div', { class: 'desc-head' },
         h('h2', null, 'What the run is ', h('span', { class: 'hint' }, 'the supervisor’s word wins over the plan, the plan over what the data show')),
         editing ? null : h('div', { class: 'actions' }, confirm,
-          h('button', { type: 'button', class: 'btn small', 'data-testid': 'desc-edit', onClick: () => { editing = true; render(); } }, '✎ Edit'))),
+          h('button', { type: 'button', class: 'btn small', 'data-testid': 'desc-edit', 'data-needs': 'supervisor', onClick: () => { editing = true; render(); } }, '✎ Edit'))),
       editing ? form() : h('dl', { class: 'summary desc-list', 'data-testid': 'desc-list' },
         FIELDS.map(([k, label]) => row(k, label)),
         d.family ? [h('dt', null, 'Identified as'), h('dd', { 'data-testid': 'desc-family' }, FAMILY_LABEL[d.family] || d.family)] : null));

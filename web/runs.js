@@ -113,7 +113,7 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
   ]);
 
   // -- upload form
-  const form = h('form', { class: 'card form upload', novalidate: true, 'data-testid': 'upload-form', 'aria-label': 'Upload a run', onSubmit: submit });
+  const form = h('form', { class: 'card form upload', novalidate: true, 'data-testid': 'upload-form', 'data-needs': 'supervisor', 'aria-label': 'Upload a run', onSubmit: submit });
   const layoutBox = h('div', { class: 'seg', role: 'radiogroup', 'aria-label': 'Log layout' });
   const filesBox = h('div', { class: 'row files' });
   const expSel = h('select', { 'data-field': 'meta.experiment_id', 'data-testid': 'upload-experiment', onChange: (e) => { m.experiment = e.target.value; updateNameHint(); } });
@@ -376,7 +376,7 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
           }, `${VERDICT_ICON[r.verdict] || ''} ${r.name}`)) : h('span', { class: 'muted' }, '–'),
           why ? h('div', { class: 'why', 'data-testid': 'coverage-reason' }, why) : null),
         h('td', { class: 'nowrap' }, h('button', {
-          type: 'button', class: `btn small${e.status === 'repeat' || e.status === 'missing' ? ' attn' : ''}`, 'data-testid': 'coverage-upload',
+          type: 'button', class: `btn small${e.status === 'repeat' || e.status === 'missing' ? ' attn' : ''}`, 'data-testid': 'coverage-upload', 'data-needs': 'supervisor',
           title: `upload a run of ${e.code}`, onClick: () => uploadFor(e.experiment_id),
         }, '↑ run')));
     });

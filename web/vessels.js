@@ -30,7 +30,7 @@ export async function vesselList(view) {
   fill(view, 
     h('div', { class: 'page-head' },
       h('h1', null, 'Vessels'),
-      h('a', { class: 'btn primary', href: '#/vessels/new', 'data-testid': 'new-vessel' }, '+ New vessel')),
+      h('a', { class: 'btn primary', href: '#/vessels/new', 'data-testid': 'new-vessel', 'data-needs': 'engineer' }, '+ New vessel')),
     vessels.length === 0
       ? h('p', { class: 'empty' }, 'No vessels yet. Create one from a template.')
       : h('table', { class: 'grid-table', 'data-testid': 'vessel-table' },
@@ -89,8 +89,8 @@ export async function vesselPage(view, id) {
     h('div', { class: 'page-head' },
       h('h1', null, v.name, h('span', { class: 'tag' }, KIND_LABEL[v.kind] || v.kind)),
       h('div', { class: 'actions' },
-        h('a', { class: 'btn', href: `#/vessels/new?from=${encodeURIComponent(v.id)}` }, 'Copy as new vessel'),
-        h('a', { class: 'btn primary', href: `#/campaigns/new?vessel=${encodeURIComponent(v.id)}`, 'data-testid': 'new-campaign-for-vessel' }, '+ New campaign'))),
+        h('a', { class: 'btn', href: `#/vessels/new?from=${encodeURIComponent(v.id)}`, 'data-needs': 'engineer' }, 'Copy as new vessel'),
+        h('a', { class: 'btn primary', href: `#/campaigns/new?vessel=${encodeURIComponent(v.id)}`, 'data-testid': 'new-campaign-for-vessel', 'data-needs': 'supervisor' }, '+ New campaign'))),
     h('dl', { class: 'summary' },
       h('dt', null, 'DOFs'), h('dd', null, v.dofs.join(', ')),
       h('dt', null, 'Max forward speed'), h('dd', null, v.limits.surge ? `${fmt(knots(v.limits.surge.max_velocity), 2)} kn (${fmt(v.limits.surge.max_velocity)} m/s)` : '–'),
@@ -164,7 +164,7 @@ export async function vesselForm(view, query) {
   const sections = h('div');
   form.append(sections,
     h('div', { class: 'form-actions' },
-      h('button', { type: 'submit', class: 'btn primary', 'data-testid': 'create-vessel' }, 'Create vessel'),
+      h('button', { type: 'submit', class: 'btn primary', 'data-testid': 'create-vessel', 'data-needs': 'engineer' }, 'Create vessel'),
       h('a', { class: 'btn', href: '#/vessels' }, 'Cancel')));
 
   const load = (p, label) => {

@@ -82,12 +82,16 @@ pub enum ApiError {
         /// The stored run.
         run_id: String,
     },
-    /// A write from a page of another origin (403).
+    /// No valid credentials where they are required (401).
+    #[error("{0}")]
+    Unauthorized(String),
+    /// A write from a page of another origin, a role too low, a cookie
+    /// write without the CSRF header (403).
     #[error("{message}")]
     Forbidden {
         /// Message.
         message: String,
-        /// The header that decided it (`Origin`).
+        /// What decided it (`Origin`, `role`, `X-Seatrial-CSRF`).
         field: String,
     },
     /// A Host the service does not answer to: a DNS-rebinding guard (421).
@@ -178,6 +182,7 @@ impl ApiError {
             | ApiError::InvalidUpload { .. }
             | ApiError::Invalid { .. } => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Conflict(_) => StatusCode::CONFLICT,
+            ApiError::Unauthorized(_) => StatusCode::UNAUTHORIZED,
             ApiError::Forbidden { .. } => StatusCode::FORBIDDEN,
             ApiError::Misdirected(_) => StatusCode::MISDIRECTED_REQUEST,
             ApiError::MethodNotAllowed(_) => StatusCode::METHOD_NOT_ALLOWED,

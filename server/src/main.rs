@@ -51,6 +51,28 @@ struct Args {
     /// PATCH, DELETE) besides the service's own; other origins get 403.
     #[arg(long, env = "SEATRIAL_ALLOWED_ORIGINS", value_delimiter = ',')]
     allowed_origins: Vec<String>,
+    /// `required`: every request but health and sign-in needs credentials.
+    /// `auto` (default): required unless listening on a loopback address,
+    /// where requests without credentials act as the local admin.
+    #[arg(long, env = "SEATRIAL_AUTH", value_enum, default_value_t = AuthMode::Auto)]
+    auth: AuthMode,
+    /// File holding the password of the first admin (`admin`), made when
+    /// credentials are required and there is no account yet; without it a
+    /// one-time password is printed once.
+    #[arg(long, env = "SEATRIAL_ADMIN_PASSWORD_FILE")]
+    admin_password_file: Option<PathBuf>,
+    /// Mark the session cookie `Secure` (serve behind https).
+    #[arg(long, env = "SEATRIAL_COOKIE_SECURE")]
+    cookie_secure: bool,
+}
+
+/// Whether requests need credentials.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum AuthMode {
+    /// Required unless listening on loopback (local mode).
+    Auto,
+    /// Always required.
+    Required,
 }
 
 /// Two runtimes (see `seatrial::runtime`): the job workers' own, built first
@@ -116,6 +138,39 @@ async fn serve(jobs_rt: tokio::runtime::Handle) -> anyhow::Result<()> {
     }
     tracing::info!(hosts = ?exposure.hosts(), "answering to these host names");
     state.exposure = std::sync::Arc::new(exposure);
+    let mut auth =
+        seatrial::http::auth::AuthConfig::for_listen(args.auth == AuthMode::Required, args.listen);
+    auth.secure_cookie = args.cookie_secure;
+    if auth.required {
+        let password = match &args.admin_password_file {
+            Some(f) => Some(
+                std::fs::read_to_string(f)
+                    .map_err(|e| anyhow::anyhow!("--admin-password-file {}: {e}", f.display()))?
+                    .trim_end_matches(['\r', '\n'])
+                    .to_string(),
+            ),
+            None => None,
+        };
+        let generated = args.admin_password_file.is_none();
+        if let Some(pw) = seatrial::http::auth::users::bootstrap_admin(&db, password).await? {
+            if generated {
+                // Printed once, never logged elsewhere nor stored in clear.
+                println!(
+                    "created the first account: user 'admin', one-time password {pw} \
+                     (change it with POST /api/auth/password)"
+                );
+            } else {
+                tracing::info!("created the first account 'admin' with the password of the file");
+            }
+        }
+        tracing::info!("credentials required (sign in, or Authorization: Bearer <token>)");
+    } else {
+        tracing::warn!(
+            "local mode: requests without credentials act as the local admin \
+             (loopback only; --auth required to turn it off)"
+        );
+    }
+    state.auth = std::sync::Arc::new(auth);
     // A stopped server's debris: partial uploads go, runs it left `stored`
     // are processed in the background (listed now, before any new upload).
     let debris = seatrial::intake::sweep(&db, &state.blobs).await?;

@@ -4,6 +4,7 @@
 
 #![allow(dead_code)]
 
+pub mod auth;
 pub mod finite;
 pub mod flights;
 pub mod jobs;
@@ -118,12 +119,7 @@ impl TestApp {
         args: &[&str],
         body: Option<Value>,
     ) -> Resp {
-        let mut path = template.to_string();
-        for a in args {
-            let start = path.find('{').expect("more args than parameters");
-            let end = path[start..].find('}').unwrap() + start;
-            path.replace_range(start..=end, a);
-        }
+        let path = auth::fill(template, args);
         let r = self
             .raw(
                 method,
@@ -227,6 +223,13 @@ impl TestApp {
             assert!(
                 errors.is_empty(),
                 "{method} {template} {}: response violates its schema: {errors:#?}",
+                r.status
+            );
+        } else if r.text.is_empty() && r.content_type.is_empty() {
+            // No body (204): the documented answer must have no content either.
+            assert!(
+                doc["content"].as_object().is_none_or(|m| m.is_empty()),
+                "{method} {template} {}: answered without a body",
                 r.status
             );
         } else {

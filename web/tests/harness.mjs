@@ -27,7 +27,8 @@ export const tid = (id) => `[data-testid="${id}"]`;
 
 /** `extraArgs`: more server flags, e.g. ['--demo']. */
 export function harness({ extraArgs = [] } = {}) {
-  const h = { base: null, browser: null, serverLog: '' };
+  // `headers`: sent with every h.api call (credentials, when the server requires them).
+  const h = { base: null, browser: null, serverLog: '', headers: {} };
   let server;
   let tmp;
 
@@ -78,11 +79,11 @@ export function harness({ extraArgs = [] } = {}) {
   h.api = async (method, p, body) => {
     const res = await fetch(h.base + p, {
       method,
-      headers: body === undefined ? {} : { 'content-type': 'application/json' },
+      headers: { ...h.headers, ...(body === undefined ? {} : { 'content-type': 'application/json' }) },
       body: body === undefined ? undefined : JSON.stringify(body),
     });
     const text = await res.text();
-    return { status: res.status, json: text ? JSON.parse(text) : null };
+    return { status: res.status, json: text ? JSON.parse(text) : null, headers: res.headers };
   };
 
   /**

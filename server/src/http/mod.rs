@@ -3,6 +3,7 @@
 //! declared through utoipa, so `openapi.yaml` is generated from the router
 //! itself and a test holds the two together.
 
+pub mod auth;
 pub mod campaigns;
 pub mod clock_offsets;
 pub mod discrepancies;
@@ -59,6 +60,8 @@ pub struct AppState {
     pub model_cache: Arc<model_cache::ModelCache>,
     /// Blocking threads that may answer reads at once ([`offload`]).
     pub read_permits: Arc<tokio::sync::Semaphore>,
+    /// Whether credentials are required (default: local mode).
+    pub auth: Arc<auth::AuthConfig>,
 }
 
 impl AppState {
@@ -85,6 +88,7 @@ impl AppState {
             exposure: Arc::new(Exposure::default()),
             model_cache: Arc::new(model_cache::ModelCache::new(MODEL_CACHE_BYTES)),
             read_permits: offload::permits(),
+            auth: Arc::new(auth::AuthConfig::default()),
         })
     }
 
@@ -107,6 +111,7 @@ impl AppState {
     components(schemas(ErrorBody, JobEvent, models::ExportFormat, crate::storage::jobs::JobKind, crate::storage::jobs::IdentifyMethod)),
     tags(
         (name = "service", description = "Service health"),
+        (name = "accounts", description = "Sign-in, personal API tokens, users and roles, the audit trail"),
         (name = "planning", description = "Vessels, campaigns, excitation plans and their exports"),
         (name = "runs", description = "Uploaded logs, their alignment and data-quality reports"),
         (name = "jobs", description = "Background jobs (identification, discovery): submit, follow by polling or Server-Sent Events, cancel, retry"),
@@ -120,6 +125,18 @@ struct ApiDoc;
 pub fn api() -> OpenApiRouter<AppState> {
     OpenApiRouter::with_openapi(ApiDoc::openapi())
         .routes(routes!(health::health))
+        .routes(routes!(auth::session::login))
+        .routes(routes!(auth::session::logout))
+        .routes(routes!(auth::session::me))
+        .routes(routes!(auth::session::change_password))
+        .routes(routes!(
+            auth::tokens::create_token,
+            auth::tokens::list_tokens
+        ))
+        .routes(routes!(auth::tokens::revoke_token))
+        .routes(routes!(auth::users::create_user, auth::users::list_users))
+        .routes(routes!(auth::users::patch_user))
+        .routes(routes!(auth::users::list_audit))
         .routes(routes!(vessels::create_vessel, vessels::list_vessels))
         .routes(routes!(vessels::get_vessel))
         .routes(routes!(
@@ -171,9 +188,12 @@ pub fn api() -> OpenApiRouter<AppState> {
         )
 }
 
-/// The OpenAPI document of the service.
+/// The OpenAPI document of the service, with the role each route needs
+/// and the security schemes ([`auth::document`]).
 pub fn openapi() -> utoipa::openapi::OpenApi {
-    api().split_for_parts().1
+    let mut doc = api().split_for_parts().1;
+    auth::document(&mut doc);
+    doc
 }
 
 async fn api_not_found(uri: Uri) -> ApiError {
@@ -190,10 +210,13 @@ async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
 /// The whole application: `/api`, and the web UI's files from `web_dir`
 /// (uPlot from `web_dir/node_modules`, installed by `npm ci`), behind the
 /// Host allow-list, the Origin rule on writes and the security headers
-/// ([`exposure`]).
+/// ([`exposure`]); every `/api` route behind the accounts guard
+/// ([`auth::middleware`]).
 pub fn app(state: AppState, web_dir: PathBuf) -> Router {
     let (api, _) = api().split_for_parts();
+    let accounts = axum::middleware::from_fn_with_state(state.clone(), auth::middleware::guard);
     let api = api
+        .route_layer(accounts)
         .route("/api/{*rest}", axum::routing::any(api_not_found))
         .method_not_allowed_fallback(method_not_allowed)
         .layer(DefaultBodyLimit::max(json::MAX_JSON_BODY));

@@ -2,6 +2,8 @@
 //! Queries use `$N` placeholders and portable SQL so that the same code can
 //! later run on PostgreSQL (see the migration's header for the conventions).
 
+pub mod accounts;
+pub mod audit;
 pub mod blobs;
 pub mod campaigns;
 pub mod clock_offsets;
