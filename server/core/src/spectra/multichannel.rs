@@ -342,11 +342,11 @@ impl Accumulators {
             nf,
             n_channels,
             held: 0,
-            re: vec![0.0; slots * n_channels * nf],
-            im: vec![0.0; slots * n_channels * nf],
-            auto: vec![0.0; n_channels * nf],
-            cross_re: vec![0.0; pairs.len() * nf],
-            cross_im: vec![0.0; pairs.len() * nf],
+            re: scratch::zeroed(slots * n_channels * nf),
+            im: scratch::zeroed(slots * n_channels * nf),
+            auto: scratch::zeroed(n_channels * nf),
+            cross_re: scratch::zeroed(pairs.len() * nf),
+            cross_im: scratch::zeroed(pairs.len() * nf),
         }
     }
 
@@ -458,6 +458,9 @@ impl Accumulators {
                     .collect()
             })
             .collect();
+        for buffer in [self.re, self.im, self.auto, self.cross_re, self.cross_im] {
+            scratch::give_back(buffer);
+        }
         MultiSpectra {
             freqs,
             auto,
@@ -706,5 +709,54 @@ mod tests {
         let s = multi_welch(&[&x], &whole(64), &[(0, 0)], &WelchConfig::hann(1.0, 16)).unwrap();
         assert!(s.coherence(1).is_empty() && s.h1(7).is_empty());
         assert_eq!(s.coherence(0).len(), 9);
+    }
+}
+
+/// Accumulator buffers kept per thread between calls. A report's spectra
+/// need about 2 MB of zeroed sums; allocated afresh, each call would fault
+/// those pages in from the kernel again (a third of the time of a 1-hour
+/// report), reused they are only zeroed.
+mod scratch {
+    use std::cell::RefCell;
+
+    /// Buffers kept per thread.
+    const KEPT: usize = 8;
+
+    thread_local! {
+        static FREE: RefCell<Vec<Vec<f64>>> = const { RefCell::new(Vec::new()) };
+    }
+
+    /// A zeroed buffer of `len` values, reusing a kept one when there is.
+    pub(super) fn zeroed(len: usize) -> Vec<f64> {
+        let kept = FREE.with(|f| {
+            let mut f = f.borrow_mut();
+            // The smallest kept buffer that holds `len`, else the largest.
+            let best = f
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.capacity() >= len)
+                .min_by_key(|(_, v)| v.capacity())
+                .or_else(|| f.iter().enumerate().max_by_key(|(_, v)| v.capacity()))
+                .map(|(i, _)| i);
+            best.map(|i| f.swap_remove(i))
+        });
+        match kept {
+            Some(mut v) => {
+                v.clear();
+                v.resize(len, 0.0);
+                v
+            }
+            None => vec![0.0; len],
+        }
+    }
+
+    /// Keeps `buffer` for the next call on this thread.
+    pub(super) fn give_back(buffer: Vec<f64>) {
+        FREE.with(|f| {
+            let mut f = f.borrow_mut();
+            if f.len() < KEPT {
+                f.push(buffer);
+            }
+        });
     }
 }
