@@ -408,3 +408,20 @@ async fn dp_ship_model_exports_true_npz_and_state_space() {
     assert_eq!(units, ["m/s", "m/s", "rad/s"]);
     python_check(dir.path());
 }
+
+/// `tests/python/client_e2e.py` creates the Surveyor from this file; it
+/// stays the core's profile (`UPDATE_FIXTURES=1` rewrites it).
+#[test]
+fn the_client_script_uses_the_surveyor_profile() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/surveyor_rov.json");
+    let want = serde_json::to_string_pretty(&common::rov_profile()).unwrap() + "\n";
+    if std::env::var_os("UPDATE_FIXTURES").is_some() {
+        std::fs::write(&path, &want).unwrap();
+    }
+    let have = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        have == want,
+        "{} is stale: UPDATE_FIXTURES=1 cargo test --release --test api_exports",
+        path.display()
+    );
+}
