@@ -335,6 +335,25 @@ async fn rov_models_export_true_npz_and_state_space() {
     exported(&app, &lpv, "lpv", 0.05, dir.path()).await;
     let view = exported(&app, &n4sid, "n4sid", 0.1, dir.path()).await;
     assert_eq!(view["document"]["kind"], "state_space");
+    // Its channels carry the logs' names: in validation and in the CSV, which
+    // holds Φ, Γ, C, D, K and the operating point after the poles.
+    let outputs: Vec<&str> = view["validation"][0]["report"]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["output"].as_str().unwrap())
+        .collect();
+    assert_eq!(outputs, ["u", "v", "w", "p", "q", "r"]);
+    let csv = export(&app, &n4sid, "format=csv").await.text;
+    for needle in [
+        "\npoles,",
+        "\nΦ,\"Φ[x1,x1]\",,",
+        "\nC,\"C[u,x1]\",,",
+        "\nu0,u0[tau_X],,",
+        "\nK,\"K[x6,r]\",,",
+    ] {
+        assert!(csv.contains(needle), "{needle:?} not in\n{csv}");
+    }
     // An N4SID model is discrete at its own h: ss at another h is refused.
     let r = app
         .call(

@@ -19,6 +19,9 @@ pub(crate) fn csv_field(s: &str) -> String {
 }
 
 /// CSV of every estimated parameter: `group,symbol,grid_speed_mps,value,std,unit`.
+/// A subspace model's matrices follow its pole table, one entry per row
+/// named by its channels (`C[u,x1]`, `Γ[x2,tau_X]`), with the operating
+/// point `u0[tau_X]`, `y0[u]`.
 pub fn parameter_csv(doc: &ModelDocument) -> String {
     let mut out = String::from("group,symbol,grid_speed_mps,value,std,unit\n");
     for p in &doc.parameters {
@@ -32,6 +35,59 @@ pub fn parameter_csv(doc: &ModelDocument) -> String {
             p.std.map(|v| v.to_string()).unwrap_or_default(),
             q(&p.unit)
         ));
+    }
+    if doc.kind == ModelKind::StateSpace
+        && let Ok(e) = super::export_state_space::state_space_export(doc, "", 0, None)
+    {
+        out.push_str(&state_space_rows(&e));
+    }
+    out
+}
+
+/// The entries of a discrete state-space export as parameter rows.
+fn state_space_rows(e: &super::export_state_space::StateSpaceExport) -> String {
+    use super::export_state_space::Channel;
+    let mut out = String::new();
+    let mut row = |group: &str, symbol: String, value: f64, unit: String| {
+        out.push_str(&format!(
+            "{},{},,{value},,{}\n",
+            csv_field(group),
+            csv_field(&symbol),
+            csv_field(&unit)
+        ));
+    };
+    let per = |to: &Channel, from: &Channel| match (to.unit.as_str(), from.unit.as_str()) {
+        (t, "-") => t.to_string(),
+        ("-", f) => format!("1/({f})"),
+        (t, f) if t == f => "-".to_string(),
+        (t, f) => format!("({t})/({f})"),
+    };
+    for p in &e.points {
+        for (group, m, rows, cols) in [
+            ("Φ", &p.a, &e.states, &e.states),
+            ("Γ", &p.b, &e.states, &e.inputs),
+            ("C", &p.c, &e.outputs, &e.states),
+            ("D", &p.d, &e.outputs, &e.inputs),
+        ]
+        .into_iter()
+        .chain(p.k.as_ref().map(|k| ("K", k, &e.states, &e.outputs)))
+        {
+            for (r, vals) in m.iter().enumerate() {
+                for (c, v) in vals.iter().enumerate() {
+                    row(
+                        group,
+                        format!("{group}[{},{}]", rows[r].name, cols[c].name),
+                        *v,
+                        per(&rows[r], &cols[c]),
+                    );
+                }
+            }
+        }
+        for (group, v, ch) in [("u0", &p.u0, &e.inputs), ("y0", &p.y0, &e.outputs)] {
+            for (x, c) in v.iter().zip(ch) {
+                row(group, format!("{group}[{}]", c.name), *x, c.unit.clone());
+            }
+        }
     }
     out
 }
