@@ -144,6 +144,57 @@ async fn discovery_names_the_righting_moment_and_stores_the_augmented_model() {
         .await;
     assert_eq!(csv.status, 200);
     assert!(csv.text.contains("discovered: restoring"), "{}", csv.text);
+    // The Fossen export carries every discovered term of every grid point
+    // with its coefficients, std, unit and DOF; the state-space export
+    // lists them beside the linear part.
+    let fossen = app
+        .call(
+            "GET",
+            "/api/models/{id}/export?format=fossen",
+            &[&aug],
+            None,
+        )
+        .await;
+    assert_eq!(fossen.status, 200, "{}", fossen.text);
+    let stored = new.json["document"]["lpv"]["points"].as_array().unwrap();
+    let exported = fossen.json["points"].as_array().unwrap();
+    assert_eq!(exported.len(), stored.len());
+    let mut named = 0;
+    for (p, s) in exported.iter().zip(stored) {
+        let terms = p["terms"].as_array().unwrap();
+        let kept = s["augmentation"]["terms"].as_array().map_or(0, Vec::len);
+        assert_eq!(terms.len(), kept, "{p}");
+        for (t, k) in terms
+            .iter()
+            .zip(s["augmentation"]["terms"].as_array().unwrap())
+        {
+            assert_eq!(t["effect"], k["effect"]);
+            let values: Vec<&Value> = t["coefficients"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|c| &c["value"])
+                .collect();
+            let kept: Vec<&Value> = k["coefficients"].as_array().unwrap().iter().collect();
+            assert_eq!(values, kept);
+            for c in t["coefficients"].as_array().unwrap() {
+                assert!(c["std"].as_f64().is_some_and(|s| s >= 0.0), "{c}");
+                assert!(!c["unit"].as_str().unwrap().is_empty(), "{c}");
+            }
+            named += usize::from(t["dof"].is_string());
+        }
+    }
+    assert!(named > 0, "{}", fossen.text);
+    let ss = app
+        .call(
+            "GET",
+            "/api/models/{id}/export?format=ss_json",
+            &[&aug],
+            None,
+        )
+        .await;
+    assert_eq!(ss.status, 200, "{}", ss.text);
+    assert!(!ss.json["terms"].as_array().unwrap().is_empty());
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

@@ -83,6 +83,34 @@ async fn walk_model(app: &TestApp, mid: &str) {
         assert_eq!(r.status, 200, "{}", r.text);
         assert_finite_json(&r.json, "export fossen");
     }
+    // The state-space exports, continuous (or N4SID's own h) and ZOH.
+    let zoh = if m["document"]["kind"] == "state_space" {
+        ""
+    } else {
+        "&h=0.1"
+    };
+    for h in ["", zoh] {
+        let r = app
+            .call(
+                "GET",
+                &format!("/api/models/{{id}}/export?format=ss_json{h}"),
+                &[mid],
+                None,
+            )
+            .await;
+        assert_eq!(r.status, 200, "{}", r.text);
+        assert_finite_json(&r.json, "export ss_json");
+        let r = app
+            .call(
+                "GET",
+                &format!("/api/models/{{id}}/export?format=ss_csv{h}"),
+                &[mid],
+                None,
+            )
+            .await;
+        assert_eq!(r.status, 200, "{}", r.text);
+        assert_finite_csv(&r.text, "export ss_csv");
+    }
     get(app, "/api/models/{id}/discrepancies", &[mid]).await;
 }
 

@@ -33,6 +33,8 @@ pub struct Resp {
     pub headers: axum::http::HeaderMap,
     pub content_type: String,
     pub text: String,
+    /// The body as received (binary downloads such as `.npz`).
+    pub bytes: Vec<u8>,
     pub json: Value,
 }
 
@@ -184,13 +186,23 @@ impl TestApp {
         let bytes = axum::body::to_bytes(resp.into_body(), usize::MAX)
             .await
             .unwrap();
-        let text = String::from_utf8(bytes.to_vec()).unwrap();
+        let text = match std::str::from_utf8(&bytes) {
+            Ok(t) => t.to_string(),
+            Err(_) => {
+                assert!(
+                    content_type.starts_with("application/octet-stream"),
+                    "{path}: a {content_type} body that is not UTF-8"
+                );
+                String::from_utf8_lossy(&bytes).into_owned()
+            }
+        };
         let json = serde_json::from_str(&text).unwrap_or(Value::Null);
         Resp {
             status,
             headers,
             content_type,
             text,
+            bytes: bytes.to_vec(),
             json,
         }
     }

@@ -14,6 +14,7 @@ pub mod jobs;
 pub mod json;
 pub mod manage;
 pub mod model_cache;
+pub mod model_export;
 pub mod models;
 pub mod offload;
 pub mod plans;
@@ -108,7 +109,7 @@ impl AppState {
         description = "Sea-trial system identification of ROVs and dynamically positioned ships: plan trial campaigns, score runs, identify and validate models.",
         license(name = "MIT")
     ),
-    components(schemas(ErrorBody, JobEvent, models::ExportFormat, crate::storage::jobs::JobKind, crate::storage::jobs::IdentifyMethod)),
+    components(schemas(ErrorBody, JobEvent, model_export::ExportFormat, crate::storage::jobs::JobKind, crate::storage::jobs::IdentifyMethod)),
     tags(
         (name = "service", description = "Service health"),
         (name = "accounts", description = "Sign-in, personal API tokens, users and roles, the audit trail"),
@@ -177,7 +178,7 @@ pub fn api() -> OpenApiRouter<AppState> {
             manage::patch_model,
             manage::delete_model
         ))
-        .routes(routes!(models::export_model))
+        .routes(routes!(model_export::export_model))
         .routes(routes!(discrepancies::list_model_discrepancies))
         .routes(routes!(discrepancies::get_discrepancy))
         // Uploads stream to disk under their own limit (counted in the handler).

@@ -1,14 +1,12 @@
 //! Identified models: list, one model (document, validation, ZOH matrices at
-//! a chosen h), exports (JSON, parameter CSV, Fossen-form set).
+//! a chosen h), side-by-side comparison; the exports are in `model_export`.
 
 use axum::Json;
 use axum::extract::{Path, State};
-use axum::http::{HeaderMap, header};
+use axum::http::HeaderMap;
 use axum::response::{IntoResponse, Response};
 use seatrial_core::identification::discrete::{DiscreteModel, discretize};
 use seatrial_core::identification::document::ModelDocument;
-use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv};
-use seatrial_core::identification::export_matlab::matlab_script;
 use serde::{Deserialize, Serialize};
 
 use super::model_cache::CachedModel;
@@ -85,7 +83,7 @@ pub struct ModelQuery {
     pub h: Option<f64>,
 }
 
-fn view(m: StoredModel) -> ApiResult<ModelView> {
+pub(super) fn view(m: StoredModel) -> ApiResult<ModelView> {
     let document: ModelDocument = serde_json::from_value(m.document).map_err(|e| {
         ApiError::Internal(anyhow::anyhow!("stored model document unreadable: {e}"))
     })?;
@@ -138,118 +136,6 @@ pub async fn get_model(
     let built = std::sync::Arc::new(built);
     s.model_cache.put(&id, built.clone());
     Ok(built.respond(&request))
-}
-
-/// Export format.
-#[derive(Debug, Deserialize, utoipa::IntoParams)]
-#[into_params(parameter_in = Query)]
-pub struct ExportQuery {
-    /// `json` (default: the whole model with provenance), `csv` (parameter
-    /// table with standard deviations), `fossen` (M, D, g(η), T, K in Fossen
-    /// form for MSS / PythonVehicleSimulator) or `matlab` (a `.m` script
-    /// defining the struct `model`: every matrix with its std, g(η), the
-    /// logged controller, the parameter table).
-    #[param(value_type = Option<ExportFormat>)]
-    pub format: Option<String>,
-}
-
-/// The export formats (documentation of `format`; an unknown one is a 400 naming it).
-#[derive(utoipa::ToSchema)]
-#[schema(rename_all = "snake_case")]
-#[allow(dead_code)]
-pub enum ExportFormat {
-    /// The whole model with provenance.
-    Json,
-    /// The parameter table with standard deviations.
-    Csv,
-    /// M, D, g(η), T, K in Fossen form.
-    Fossen,
-    /// A MATLAB/Octave script defining the struct `model`.
-    Matlab,
-}
-
-/// What a JSON export holds: the whole model (`json`) or its Fossen-form
-/// parameter set (`fossen`). Documentation only.
-#[derive(Serialize, utoipa::ToSchema)]
-#[allow(dead_code)]
-#[serde(untagged)]
-pub enum JsonExport {
-    /// `format=json`.
-    Model(Box<ModelView>),
-    /// `format=fossen`.
-    Fossen(Box<seatrial_core::identification::export::FossenParameterSet>),
-}
-
-fn attachment(body: String, content_type: &str, filename: String) -> Response {
-    (
-        [
-            (header::CONTENT_TYPE, content_type.to_string()),
-            (
-                header::CONTENT_DISPOSITION,
-                super::exposure::attachment(&filename),
-            ),
-        ],
-        body,
-    )
-        .into_response()
-}
-
-/// Download a model.
-#[utoipa::path(get, path = "/api/models/{id}/export", tag = "models",
-    params(("id" = String, Path, description = "Model id"), ExportQuery),
-    responses(
-        (status = 200, description = "The export: JSON (`json`, `fossen`), CSV (`csv`) or a MATLAB script (`matlab`)", content(
-            (JsonExport = "application/json"),
-            (String = "text/csv"),
-            (String = "text/x-matlab"))),
-        (status = 400, description = "Unknown format", body = ErrorBody),
-        (status = 404, description = "No such model", body = ErrorBody),
-        (status = 422, description = "No Fossen form for a black-box model", body = ErrorBody)))]
-pub async fn export_model(
-    State(s): State<AppState>,
-    Path(id): Path<String>,
-    ApiQuery(q): ApiQuery<ExportQuery>,
-) -> ApiResult<Response> {
-    let m = found(models::get(&s.db, &id).await?, "model", &id)?;
-    let stem = format!(
-        "{}-v{}",
-        m.summary.name.replace([' ', '/', '"'], "_"),
-        m.summary.version
-    );
-    let v = view(m)?;
-    match q.format.as_deref().unwrap_or("json") {
-        "json" => Ok(attachment(
-            serde_json::to_string_pretty(&v).map_err(anyhow::Error::from)?,
-            "application/json",
-            format!("{stem}.json"),
-        )),
-        "csv" => Ok(attachment(
-            parameter_csv(&v.document),
-            "text/csv",
-            format!("{stem}.csv"),
-        )),
-        "fossen" => {
-            let set = fossen_parameter_set(&v.document)
-                .map_err(|msg| ApiError::invalid("format", msg))?;
-            Ok(attachment(
-                serde_json::to_string_pretty(&set).map_err(anyhow::Error::from)?,
-                "application/json",
-                format!("{stem}-fossen.json"),
-            ))
-        }
-        "matlab" => Ok(attachment(
-            matlab_script(&v.document, &v.model.name, v.model.version),
-            "text/x-matlab; charset=utf-8",
-            format!(
-                "{}.m",
-                stem.replace(|c: char| !c.is_ascii_alphanumeric(), "_")
-            ),
-        )),
-        other => Err(ApiError::bad_field(
-            "format",
-            format!("unknown export format '{other}'; use json, csv, fossen or matlab"),
-        )),
-    }
 }
 
 /// Which models to compare on which run.

@@ -137,6 +137,14 @@ impl JobError {
     }
 }
 
+/// The request of a stored job, as submitted: a `JobRequest` whose `kind`
+/// and `method` are those the server registers. Documentation only (its own
+/// name keeps generated clients from deriving a second `JobRequest` model).
+#[derive(utoipa::ToSchema)]
+#[schema(value_type = Object)]
+#[allow(dead_code)]
+pub struct SubmittedRequest(serde_json::Value);
+
 /// A stored job.
 #[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
 pub struct Job {
@@ -149,7 +157,7 @@ pub struct Job {
     /// The request as submitted: a `JobRequest` (its `kind` and `method`
     /// are those the server registers, which the `JobRequest` schema lists
     /// for this service).
-    #[schema(value_type = Object)]
+    #[schema(value_type = SubmittedRequest)]
     pub request: JobRequest,
     /// Lifecycle state.
     pub state: JobState,

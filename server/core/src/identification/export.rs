@@ -7,18 +7,25 @@
 use serde::Serialize;
 
 use super::document::{Matrix, ModelDocument, ModelKind, ParameterRow};
+use super::export_terms::{ExportedTerm, point_terms};
+
+/// A CSV field, quoted when it holds a comma, a quote or a line break.
+pub(crate) fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
 
 /// CSV of every estimated parameter: `group,symbol,grid_speed_mps,value,std,unit`.
+/// A subspace model's matrices follow its pole table, one entry per row
+/// named by its channels (`C[u,x1]`, `Γ[x2,tau_X]`), with the operating
+/// point `u0[tau_X]`, `y0[u]`.
 pub fn parameter_csv(doc: &ModelDocument) -> String {
     let mut out = String::from("group,symbol,grid_speed_mps,value,std,unit\n");
     for p in &doc.parameters {
-        let q = |s: &str| {
-            if s.contains([',', '"', '\n']) {
-                format!("\"{}\"", s.replace('"', "\"\""))
-            } else {
-                s.to_string()
-            }
-        };
+        let q = csv_field;
         out.push_str(&format!(
             "{},{},{},{},{},{}\n",
             q(&p.group),
@@ -28,6 +35,59 @@ pub fn parameter_csv(doc: &ModelDocument) -> String {
             p.std.map(|v| v.to_string()).unwrap_or_default(),
             q(&p.unit)
         ));
+    }
+    if doc.kind == ModelKind::StateSpace
+        && let Ok(e) = super::export_state_space::state_space_export(doc, "", 0, None)
+    {
+        out.push_str(&state_space_rows(&e));
+    }
+    out
+}
+
+/// The entries of a discrete state-space export as parameter rows.
+fn state_space_rows(e: &super::export_state_space::StateSpaceExport) -> String {
+    use super::export_state_space::Channel;
+    let mut out = String::new();
+    let mut row = |group: &str, symbol: String, value: f64, unit: String| {
+        out.push_str(&format!(
+            "{},{},,{value},,{}\n",
+            csv_field(group),
+            csv_field(&symbol),
+            csv_field(&unit)
+        ));
+    };
+    let per = |to: &Channel, from: &Channel| match (to.unit.as_str(), from.unit.as_str()) {
+        (t, "-") => t.to_string(),
+        ("-", f) => format!("1/({f})"),
+        (t, f) if t == f => "-".to_string(),
+        (t, f) => format!("({t})/({f})"),
+    };
+    for p in &e.points {
+        for (group, m, rows, cols) in [
+            ("Φ", &p.a, &e.states, &e.states),
+            ("Γ", &p.b, &e.states, &e.inputs),
+            ("C", &p.c, &e.outputs, &e.states),
+            ("D", &p.d, &e.outputs, &e.inputs),
+        ]
+        .into_iter()
+        .chain(p.k.as_ref().map(|k| ("K", k, &e.states, &e.outputs)))
+        {
+            for (r, vals) in m.iter().enumerate() {
+                for (c, v) in vals.iter().enumerate() {
+                    row(
+                        group,
+                        format!("{group}[{},{}]", rows[r].name, cols[c].name),
+                        *v,
+                        per(&rows[r], &cols[c]),
+                    );
+                }
+            }
+        }
+        for (group, v, ch) in [("u0", &p.u0, &e.inputs), ("y0", &p.y0, &e.outputs)] {
+            for (x, c) in v.iter().zip(ch) {
+                row(group, format!("{group}[{}]", c.name), *x, c.unit.clone());
+            }
+        }
     }
     out
 }
@@ -45,6 +105,17 @@ pub struct FossenPoint {
     /// Linear damping D (the λ-identified D̄).
     #[serde(rename = "D")]
     pub d: Matrix,
+    /// Constant load b per DOF of M ν̇ + D ν + b + g(η) = τ (N, N·m; absent
+    /// when the model has none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub b: Option<Vec<f64>>,
+    /// Terms added by missing-physics discovery at this speed, each with
+    /// its coefficients, standard deviations, units and DOF; they enter the
+    /// left-hand side (damping, Coriolis, restoring, loads, current) or act
+    /// on τ before it is applied (lag, delay, saturation, dead zone). Empty
+    /// for a model without discovered physics.
+    #[serde(default)]
+    pub terms: Vec<ExportedTerm>,
 }
 
 /// A Fossen-form parameter set.
@@ -85,9 +156,22 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
     match doc.kind {
         ModelKind::Lpv => {
             let lpv = doc.lpv.as_ref().ok_or("the LPV model has no grid points")?;
+            let augmented = lpv.points.iter().any(|p| p.augmentation.is_some());
+            let mut notes = vec![
+                "Schedule on forward speed: nearest U, or interpolate M and D between neighbours."
+                    .into(),
+                "D is the λ-identified D̄ (linear damping about the grid speed).".into(),
+            ];
+            if augmented {
+                notes.push("Discovered physics: each point's `terms` add to the left-hand side (their coefficients times the regressor named in `label`), or shape τ before it acts (lag, delay, saturation, dead zone); M and D are then the refitted ones.".into());
+            }
             Ok(FossenParameterSet {
                 format: "seatrial-fossen/1".into(),
-                equation: "M·ν̇ + D·ν + g(η) = τ (per forward speed U; C(ν) from M)".into(),
+                equation: if augmented {
+                    "M·ν̇ + D·ν + b + Σ terms(ν, η) + g(η) = τ_applied (per forward speed U)".into()
+                } else {
+                    "M·ν̇ + D·ν + b + g(η) = τ (per forward speed U; C(ν) from M)".into()
+                },
                 dofs,
                 units: "SI (kg, kg·m, kg·m², kg/s, N, N·m)".into(),
                 points: lpv
@@ -97,16 +181,14 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                         u: p.speed_mps,
                         m: p.m.clone(),
                         d: p.d_bar.clone(),
+                        b: p.load.clone(),
+                        terms: point_terms(p),
                     })
                     .collect(),
                 restoring,
                 t: None,
                 k: None,
-                notes: vec![
-                    "Schedule on forward speed: nearest U, or interpolate M and D between neighbours."
-                        .into(),
-                    "D is the λ-identified D̄ (linear damping about the grid speed).".into(),
-                ],
+                notes,
             })
         }
         ModelKind::DpShip => {
@@ -123,6 +205,8 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                     u: 0.0,
                     m: s.m.clone(),
                     d: s.d.clone(),
+                    b: None,
+                    terms: vec![],
                 }],
                 restoring,
                 t: Some(s.t_config.clone()),
@@ -214,5 +298,56 @@ mod tests {
         let mut ss = doc();
         ss.kind = ModelKind::StateSpace;
         assert!(fossen_parameter_set(&ss).unwrap_err().contains("black box"));
+    }
+
+    #[test]
+    fn fossen_set_of_an_augmented_model_carries_every_discovered_term() {
+        use crate::discrepancy::{Effect, ModelTerm};
+        use crate::identification::document::PointAugmentation;
+        let mut d = doc();
+        let p = &mut d.lpv.as_mut().unwrap().points[0];
+        p.load = Some(vec![25.0]);
+        p.augmentation = Some(PointAugmentation {
+            m_ref: p.m.clone(),
+            d_ref: p.d_bar.clone(),
+            terms: vec![
+                ModelTerm {
+                    effect: Effect::QuadraticDamping { dof: Dof::Surge },
+                    coefficients: vec![310.0],
+                    covariance: vec![vec![100.0]],
+                    shape: None,
+                    shape_std: None,
+                },
+                ModelTerm {
+                    effect: Effect::Saturation { dof: Dof::Surge },
+                    coefficients: vec![],
+                    covariance: vec![],
+                    shape: Some(450.0),
+                    shape_std: Some(12.0),
+                },
+            ],
+        });
+        let set = fossen_parameter_set(&d).unwrap();
+        let terms = &set.points[0].terms;
+        assert_eq!(terms.len(), 2);
+        assert_eq!(set.points[0].b, Some(vec![25.0]));
+        let json = serde_json::to_value(&set).unwrap();
+        let q = &json["points"][0]["terms"][0];
+        assert_eq!(q["dof"], "surge");
+        assert_eq!(q["effect"]["effect"], "quadratic_damping");
+        assert_eq!(q["coefficients"][0]["value"], 310.0);
+        assert_eq!(q["coefficients"][0]["std"], 10.0);
+        assert_eq!(q["coefficients"][0]["unit"], "N·s²/m²");
+        let sat = &json["points"][0]["terms"][1]["shape"];
+        assert_eq!(
+            (
+                sat["name"].as_str(),
+                sat["value"].as_f64(),
+                sat["std"].as_f64(),
+                sat["unit"].as_str()
+            ),
+            (Some("tau_max"), Some(450.0), Some(12.0), Some("N"))
+        );
+        assert!(set.equation.contains("terms"));
     }
 }

@@ -152,13 +152,15 @@ pub fn identify_n4sid_campaign(
         },
         ..N4sidSettings::new(h)
     };
-    let model = {
+    let mut model = {
         let mut sub = SubProgress::new(progress, 0.0, 0.8);
         n4sid(&refs, &n4, &mut sub).map_err(|e| match e {
             N4sidError::Cancelled => IdentifyError::Cancelled,
             e => IdentifyError::invalid("settings", e.to_string()),
         })?
     };
+    // Validation reports name the channels as the logs do (u, v, …), not y0, y1, ….
+    model.output_names = outputs.clone();
     progress.update(0.8, "validating on held-out runs")?;
     let vsettings = ValidationSettings {
         k: settings.k,

@@ -1,0 +1,150 @@
+#!/usr/bin/env python3
+"""Loads seatrial's model exports with numpy/scipy and reproduces the
+service's own ZOH step response to 1e-9.
+
+Usage: check_exports.py DIR, where DIR holds per model TAG (written by
+tests/api_exports.rs):
+  TAG.npz        format=npz        (numpy.load)
+  TAG-ss.json    format=ss_json    (A, B, C, D per point, sample time)
+  TAG-view.json  GET /api/models/{id}?h=…  (the stored document and the
+                 service's ZOH Φ, Γ at h)
+  TAG-step.json  the service's step response: y(k) under a unit step on
+                 every input from x = 0, per point, computed from that Φ, Γ
+  TAG.m          format=matlab (run in Octave when it is installed)
+
+For each model: the npz matrices equal the stored ones exactly; A, B of the
+npz and of ss_json, discretized by scipy.signal.cont2discrete (or taken as
+they are for a discrete model), simulated by scipy.signal.dlsim, give the
+service's step response within 1e-9 (relative to its largest value).
+Prints one line per check and ends with 'N passed, M failed'; exits 1 on
+any failure.
+"""
+
+import json
+import pathlib
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+from scipy import signal
+
+TOL = 1e-9
+passed = 0
+failed = 0
+
+
+def check(ok, what):
+    global passed, failed
+    if ok:
+        passed += 1
+        print(f"ok   {what}")
+    else:
+        failed += 1
+        print(f"FAIL {what}")
+
+
+def close(a, b, what):
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    scale = max(np.max(np.abs(b)), 1e-300)
+    err = np.max(np.abs(a - b)) / scale if a.size else 0.0
+    check(a.shape == b.shape and err <= TOL, f"{what} (relative error {err:.2e})")
+
+
+def simulate(ad, bd, c, d, steps):
+    u = np.ones((steps, bd.shape[1]))
+    _, y, _ = signal.dlsim((ad, bd, c, d, 1.0), u, x0=np.zeros(ad.shape[0]))
+    return y
+
+
+def zoh(a, b, h):
+    n, m = a.shape[0], b.shape[1]
+    ad, bd, *_ = signal.cont2discrete((a, b, np.eye(n), np.zeros((n, m))), h, method="zoh")
+    return ad, bd
+
+
+def check_model(d, tag):
+    view = json.loads((d / f"{tag}-view.json").read_text())
+    ss = json.loads((d / f"{tag}-ss.json").read_text())
+    step = json.loads((d / f"{tag}-step.json").read_text())
+    doc = view["document"]
+    h = step["h"]
+    z = np.load(d / f"{tag}.npz")  # no pickles: allow_pickle stays False
+    meta = json.loads(str(z["metadata"]))
+    check(meta["format"] == "seatrial-npz/1" and meta["kind"] == doc["kind"], f"{tag}: metadata")
+    check(float(z["h"]) == h, f"{tag}: h = {h}")
+    check(list(z["output_names"]) == [c["name"] for c in ss["outputs"]], f"{tag}: output names")
+    check(list(z["input_units"]) == [c["unit"] for c in ss["inputs"]], f"{tag}: input units")
+    discrete = view["discrete"]["points"]
+    kind = doc["kind"]
+    if kind == "lpv":
+        pts = doc["lpv"]["points"]
+        check(np.array_equal(z["grid_speeds_mps"], [p["speed_mps"] for p in pts]), f"{tag}: grid speeds")
+        for key, field in [("M", "m"), ("M_std", "m_std"), ("Dbar", "d_bar"), ("A", "a"), ("B", "b")]:
+            check(np.array_equal(z[key], np.array([p[field] for p in pts])), f"{tag}: {key} exact")
+        models = [(z["A"][i], z["B"][i]) for i in range(len(pts))]
+    elif kind == "dp_ship":
+        dp = doc["dp_ship"]
+        check(np.array_equal(z["A"], np.array(dp["a_si"])), f"{tag}: A (SI) exact")
+        check(np.array_equal(z["M_bis"], np.array(dp["m"])), f"{tag}: M'' exact")
+        models = [(z["A"], z["B"])]
+    else:
+        s = doc["state_space"]
+        for key, field in [("A", "phi"), ("B", "gamma"), ("C", "c"), ("D", "d"), ("K", "k")]:
+            check(np.array_equal(z[key], np.array(s[field])), f"{tag}: {key} exact")
+        check(np.array_equal(z["u0"], s["u_offset"]), f"{tag}: u0 exact")
+        models = [(z["A"], z["B"])]
+    continuous = ss["sample_time_s"] == 0
+    for i, (a, b) in enumerate(models):
+        p = ss["points"][i]
+        c, dd = np.array(p["C"], float), np.array(p["D"], float)
+        service = np.array(step["points"][i])
+        close(z["Ad"][i], discrete[i]["phi"], f"{tag}[{i}]: npz A_d = the service's Φ")
+        close(z["Bd"][i], discrete[i]["gamma"], f"{tag}[{i}]: npz B_d = the service's Γ")
+        for src, (aa, bb) in [("npz", (a, b)), ("ss_json", (np.array(p["A"]), np.array(p["B"])))]:
+            ad, bd = zoh(aa, bb, h) if continuous else (aa, bb)
+            if continuous:
+                close(ad, discrete[i]["phi"], f"{tag}[{i}]: cont2discrete({src} A) = Φ")
+                close(bd, discrete[i]["gamma"], f"{tag}[{i}]: cont2discrete({src} A, B) = Γ")
+            y = simulate(ad, bd, c, dd, step["steps"])
+            close(y, service, f"{tag}[{i}]: dlsim({src}) step response = the service's")
+    octave(d, tag, doc)
+
+
+def octave(d, tag, doc):
+    exe = shutil.which("octave") or shutil.which("octave-cli")
+    if exe is None:
+        print(f"skip {tag}.m: octave is not installed")
+        return
+    field = {"lpv": "model.lpv.A(:,:,1)", "dp_ship": "model.dp.A_si", "state_space": "model.ss.Phi"}[doc["kind"]]
+    code = f"source('{d / (tag + '.m')}'); printf('%.17g ', ({field})');"
+    out = subprocess.run([exe, "--no-gui", "--quiet", "--eval", code], capture_output=True, text=True)
+    if out.returncode != 0:
+        check(False, f"{tag}.m runs in Octave: {out.stderr.strip()}")
+        return
+    got = np.array([float(x) for x in out.stdout.split()])
+    want = {
+        "lpv": lambda: doc["lpv"]["points"][0]["a"],
+        "dp_ship": lambda: doc["dp_ship"]["a_si"],
+        "state_space": lambda: doc["state_space"]["phi"],
+    }[doc["kind"]]()
+    check(np.array_equal(got, np.array(want, float).ravel()), f"{tag}.m: Octave reads the same matrix")
+
+
+def main():
+    d = pathlib.Path(sys.argv[1])
+    tags = sorted(p.name[: -len("-view.json")] for p in d.glob("*-view.json"))
+    if not tags:
+        print(f"no exports in {d}")
+        sys.exit(1)
+    for tag in tags:
+        try:
+            check_model(d, tag)
+        except Exception as e:  # a missing array or file is a failure, not a crash
+            check(False, f"{tag}: {type(e).__name__}: {e}")
+    print(f"{passed} passed, {failed} failed")
+    sys.exit(1 if failed else 0)
+
+
+if __name__ == "__main__":
+    main()
