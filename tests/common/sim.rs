@@ -48,6 +48,9 @@ pub fn simulate(
     let h = 1.0 / fs;
     let tc = [4.0, 3.0, 3.0, 1.5, 1.5, 2.0];
     let d = [2000.0, 4000.0, 4000.0, 3000.0, 3000.0, 3000.0];
+    // Righting moments of roll and pitch (N·m/rad): attitudes stay within a
+    // few degrees, as a real ROV's (a free pitch wandered past 90°).
+    let g = [0.0, 0.0, 0.0, 6000.0, 6000.0, 0.0];
     let mut rng = Rng(seed);
     let mut run = SimRun {
         t: (0..n).map(|k| k as f64 * h).collect(),
@@ -70,7 +73,7 @@ pub fn simulate(
             run.tau[i].push(tau);
             run.nu[i].push(v + noise * rng.normal());
             run.eta[i].push(pos + noise * rng.normal());
-            v = a * v + (1.0 - a) * tau / d[i];
+            v = a * v + (1.0 - a) * (tau - g[i] * pos) / d[i];
             pos += v * h;
         }
     }

@@ -21,6 +21,10 @@
 //!
 //! Small angles logged in degrees (e.g. a roll of ±3°) pass these rules
 //! unnoticed: ranges cannot tell them from radians.
+//!
+//! Every rule but the heading's and the constant column's is a doubt about
+//! units ([`LogWarning::units`]): the run's verdicts wait for the fix. A
+//! heading beyond a full turn may be an unwrapped heading in radians.
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -108,8 +112,12 @@ pub fn plausibility_warnings(table: &LogTable) -> Vec<LogWarning> {
             )),
             _ => None,
         };
-        if let Some(m) = msg {
-            out.push(LogWarning::units(name.as_str(), m));
+        // A heading beyond a full turn may be radians unwrapped over several
+        // turns: a doubt to read, not a reason to hold the run's verdicts.
+        match msg {
+            Some(m) if name == "psi" => out.push(LogWarning::column(name.as_str(), m)),
+            Some(m) => out.push(LogWarning::units(name.as_str(), m)),
+            None => {}
         }
         if min == max {
             out.push(LogWarning::column(
