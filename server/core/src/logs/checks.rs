@@ -86,39 +86,44 @@ pub fn plausibility_warnings(table: &LogTable) -> Vec<LogWarning> {
         let amax = min.abs().max(max.abs());
         let degrees = |limit: f64| {
             (amax > limit).then(|| {
-                format!(
-                    "{name} looks like degrees (max |{name}| = {}); the contract is radians: \
-                     convert before identification",
-                    short(amax)
+                LogWarning::units(
+                    name.as_str(),
+                    format!(
+                        "{name} looks like degrees (max |{name}| = {}); the contract is radians: \
+                         convert before identification",
+                        short(amax)
+                    ),
                 )
             })
         };
-        let msg = match name.as_str() {
+        let doubt = match name.as_str() {
             "phi" => degrees(PI + ANGLE_SLACK),
             "theta" => degrees(FRAC_PI_2 + ANGLE_SLACK),
+            // Beyond a full turn may also be radians unwrapped over several
+            // turns: a doubt to read, not a reason to hold the verdicts.
             "psi" if amax > TAU + HEADING_SLACK || max - min > TAU + HEADING_SLACK => {
-                Some(format!(
-                    "psi looks like degrees (max {}, range {}); the contract is radians: declare \
+                Some(LogWarning::column(
+                    name.as_str(),
+                    format!(
+                        "psi looks like degrees (max {}, range {}); the contract is radians: declare \
                  heading_unit deg (vessel profile or upload meta) or convert (if it is a \
                  heading in radians unwrapped over more than a full turn, ignore this)",
-                    short(max),
-                    short(max - min)
+                        short(max),
+                        short(max - min)
+                    ),
                 ))
             }
-            "p" | "q" | "r" if amax > TAU => Some(format!(
-                "{name} looks like deg/s (max |{name}| = {}, more than a full turn per second); \
-                 the contract is rad/s: convert before identification",
-                short(amax)
+            "p" | "q" | "r" if amax > TAU => Some(LogWarning::units(
+                name.as_str(),
+                format!(
+                    "{name} looks like deg/s (max |{name}| = {}, more than a full turn per \
+                     second); the contract is rad/s: convert before identification",
+                    short(amax)
+                ),
             )),
             _ => None,
         };
-        // A heading beyond a full turn may be radians unwrapped over several
-        // turns: a doubt to read, not a reason to hold the run's verdicts.
-        match msg {
-            Some(m) if name == "psi" => out.push(LogWarning::column(name.as_str(), m)),
-            Some(m) => out.push(LogWarning::units(name.as_str(), m)),
-            None => {}
-        }
+        out.extend(doubt);
         if min == max {
             out.push(LogWarning::column(
                 name.as_str(),
