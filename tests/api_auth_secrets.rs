@@ -222,3 +222,39 @@ async fn a_password_change_ends_the_sessions() {
     assert_eq!(r.status, 401);
     login(&app, "admin", "another-password").await;
 }
+
+#[tokio::test]
+async fn wrong_passwords_back_off_per_name_with_retry_after() {
+    let app = required_app().await;
+    let anyone = Caller::anonymous(&app);
+    let attempt = |name: &'static str, password: &'static str| {
+        let body = json!({ "name": name, "password": password });
+        anyone.send("POST", "/api/auth/login", &[], Some(body))
+    };
+    for i in 0..5 {
+        let r = attempt("admin", "guess-guess").await;
+        assert_eq!(r.status, 401, "attempt {i}: {}", r.text);
+    }
+    // The sixth attempt waits, even with the right password, and is not
+    // checked; the answer says how long.
+    let r = attempt("admin", ADMIN_PASSWORD).await;
+    assert_eq!(r.status, 429, "{}", r.text);
+    assert_eq!(r.headers["retry-after"], "1");
+    let message = r.json["message"].as_str().unwrap();
+    assert!(
+        message.contains("5 failed sign-ins for 'admin'"),
+        "{message}"
+    );
+    // Names that do not exist back off alike (answers do not reveal which
+    // exist); other names are not affected.
+    for _ in 0..5 {
+        assert_eq!(attempt("nobody", "x").await.status, 401);
+    }
+    assert_eq!(attempt("nobody", "x").await.status, 429);
+    tokio::time::sleep(std::time::Duration::from_millis(1100)).await;
+    let r = attempt("admin", ADMIN_PASSWORD).await;
+    assert_eq!(r.status, 200, "after the wait: {}", r.text);
+    // The success cleared the name: wrong passwords are free again.
+    assert_eq!(attempt("admin", "guess-guess").await.status, 401);
+    assert_eq!(attempt("admin", "guess-guess").await.status, 401);
+}

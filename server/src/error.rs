@@ -97,6 +97,15 @@ pub enum ApiError {
     /// A Host the service does not answer to: a DNS-rebinding guard (421).
     #[error("{0}")]
     Misdirected(String),
+    /// Too many attempts: try again after `retry_after_s` (429 with
+    /// `Retry-After`).
+    #[error("{message}")]
+    TooManyRequests {
+        /// Message.
+        message: String,
+        /// Seconds to wait.
+        retry_after_s: u64,
+    },
     /// Route exists, method does not (405).
     #[error("{0}")]
     MethodNotAllowed(String),
@@ -185,6 +194,7 @@ impl ApiError {
             ApiError::Unauthorized(_) => StatusCode::UNAUTHORIZED,
             ApiError::Forbidden { .. } => StatusCode::FORBIDDEN,
             ApiError::Misdirected(_) => StatusCode::MISDIRECTED_REQUEST,
+            ApiError::TooManyRequests { .. } => StatusCode::TOO_MANY_REQUESTS,
             ApiError::MethodNotAllowed(_) => StatusCode::METHOD_NOT_ALLOWED,
             ApiError::TooLarge { .. } => StatusCode::PAYLOAD_TOO_LARGE,
             ApiError::UnsupportedMediaType(_) => StatusCode::UNSUPPORTED_MEDIA_TYPE,
@@ -204,6 +214,10 @@ impl IntoResponse for ApiError {
             line: None,
             column: None,
             run_id: None,
+        };
+        let retry_after = match &self {
+            ApiError::TooManyRequests { retry_after_s, .. } => Some(*retry_after_s),
+            _ => None,
         };
         let (message, field, limit) = match self {
             ApiError::BadRequest { message, field } => (message, field, None),
@@ -247,7 +261,12 @@ impl IntoResponse for ApiError {
         body.message = seatrial_core::numbers::escape_controls(&message);
         body.field = field.map(|f| seatrial_core::numbers::escape_controls(&f));
         body.limit = limit;
-        (status, Json(body)).into_response()
+        let mut r = (status, Json(body)).into_response();
+        if let Some(secs) = retry_after {
+            r.headers_mut()
+                .insert(axum::http::header::RETRY_AFTER, secs.into());
+        }
+        r
     }
 }
 

@@ -17,6 +17,7 @@ pub async fn required_app() -> TestApp {
     app.state.auth = Arc::new(seatrial::http::auth::AuthConfig {
         required: true,
         secure_cookie: false,
+        ..Default::default()
     });
     let web = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("web");
     app.router = seatrial::http::app(app.state.clone(), web);

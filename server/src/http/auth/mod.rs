@@ -19,6 +19,7 @@
 pub mod middleware;
 pub mod secrets;
 pub mod session;
+pub mod throttle;
 pub mod tokens;
 pub mod users;
 
@@ -44,6 +45,8 @@ pub struct AuthConfig {
     pub required: bool,
     /// Mark the session cookie `Secure` (behind an https proxy).
     pub secure_cookie: bool,
+    /// Back-off of failed sign-ins and the bound on password checks.
+    pub throttle: std::sync::Arc<throttle::LoginThrottle>,
 }
 
 impl AuthConfig {
@@ -52,6 +55,7 @@ impl AuthConfig {
         AuthConfig {
             required: required || !listen.ip().is_loopback(),
             secure_cookie: false,
+            throttle: Default::default(),
         }
     }
 }

@@ -2,6 +2,8 @@
 //! `POST /api/auth/logout` ends it, `GET /api/auth/me` says who is signed
 //! in, `POST /api/auth/password` changes one's own password.
 
+use std::time::Instant;
+
 use axum::Json;
 use axum::extract::{Extension, State};
 use axum::http::StatusCode;
@@ -74,31 +76,50 @@ fn session_cookie(s: &AppState, value: &str, max_age: i64) -> Result<HeaderValue
         (status = 400, description = "Malformed JSON", body = ErrorBody),
         (status = 401, description = "Wrong name or password, or a disabled account", body = ErrorBody),
         (status = 403, description = "A write from another origin, or a signed-in cookie without `X-Seatrial-CSRF: 1`", body = ErrorBody),
-        (status = 415, description = "Not JSON", body = ErrorBody)))]
+        (status = 415, description = "Not JSON", body = ErrorBody),
+        (status = 429, description = "Too many wrong passwords for this name: wait the `Retry-After` seconds (after 5 failures, 1 s doubling to 15 min)", body = ErrorBody,
+            headers(("retry-after" = u64, description = "Seconds to wait")))))]
 pub async fn login(
     State(s): State<AppState>,
     ApiJson(body): ApiJson<Login>,
 ) -> ApiResult<Response> {
+    let throttle = &s.auth.throttle;
+    let actor = AuditActor {
+        user_id: None,
+        user_name: body.name.chars().take(200).collect(),
+    };
+    if let Err(e) = throttle.check(&body.name, Instant::now()) {
+        let mut r = e.into_response();
+        r.extensions_mut().insert(actor);
+        return Ok(r);
+    }
     let found = accounts::user_for_login(&s.db, &body.name).await?;
     let (user, phc) = match found {
         Some((u, phc)) => (Some(u), phc),
         None => (None, secrets::decoy_hash().to_string()),
     };
     let password = body.password;
-    let ok = blocking(move || secrets::verify_password(&password, &phc)).await?;
+    let ok = {
+        let _permit = throttle.hashing_permit().await?;
+        blocking(move || secrets::verify_password(&password, &phc)).await?
+    };
     let actor = AuditActor {
         user_id: user.as_ref().map(|u| u.id.clone()),
-        user_name: body.name.chars().take(200).collect(),
+        ..actor
     };
     let user = match user {
         Some(u) if ok && !u.disabled => u,
         _ => {
+            if !ok {
+                throttle.failed(&body.name, Instant::now());
+            }
             let mut r =
                 ApiError::Unauthorized("wrong name or password".to_string()).into_response();
             r.extensions_mut().insert(actor);
             return Ok(r);
         }
     };
+    throttle.succeeded(&body.name);
     let value = secrets::random_hex()?;
     accounts::insert_session(&s.db, &user.id, &secrets::token_hash(&value), SESSION_SECS).await?;
     let me = Me::of(
@@ -161,7 +182,9 @@ pub struct PasswordChange {
         (status = 400, description = "Malformed JSON", body = ErrorBody),
         (status = 409, description = "The local admin of local mode has no password", body = ErrorBody),
         (status = 415, description = "Not JSON", body = ErrorBody),
-        (status = 422, description = "`current_password` wrong, or `new_password` too short or long", body = ErrorBody)))]
+        (status = 422, description = "`current_password` wrong, or `new_password` too short or long", body = ErrorBody),
+        (status = 429, description = "Too many wrong passwords for this account: wait the `Retry-After` seconds", body = ErrorBody,
+            headers(("retry-after" = u64, description = "Seconds to wait")))))]
 pub async fn change_password(
     State(s): State<AppState>,
     Extension(p): Extension<Principal>,
@@ -176,12 +199,18 @@ pub async fn change_password(
     let (_, phc) = accounts::user_for_login(&s.db, &user.name)
         .await?
         .ok_or_else(|| ApiError::NotFound(format!("no user with id '{}'", user.id)))?;
+    let throttle = &s.auth.throttle;
+    throttle.check(&user.name, Instant::now())?;
     let (current, new) = (body.current_password, body.new_password);
-    let hashed = blocking(move || {
-        secrets::verify_password(&current, &phc).then(|| secrets::hash_password(&new))
-    })
-    .await?;
+    let hashed = {
+        let _permit = throttle.hashing_permit().await?;
+        blocking(move || {
+            secrets::verify_password(&current, &phc).then(|| secrets::hash_password(&new))
+        })
+        .await?
+    };
     let Some(hash) = hashed else {
+        throttle.failed(&user.name, Instant::now());
         return Err(ApiError::invalid(
             "current_password",
             "the current password is wrong",
