@@ -30,7 +30,7 @@ function show() {
   el.hidden = false;
   const local = me.via === 'local';
   fill(el,
-    h('span', { 'data-testid': 'account-name' }, local ? 'local' : me.name),
+    h('a', { href: '#/account', 'data-testid': 'account-name', title: 'your account: password, API tokens' + (me.role === 'admin' ? ', users' : '') }, local ? 'local' : me.name),
     ' · ',
     h('span', { class: 'badge neutral', 'data-testid': 'account-role', title: local ? 'local mode: no sign-in on this loopback address' : 'your role' }, me.role),
     local ? null : h('button', { type: 'button', class: 'btn small', 'data-testid': 'logout', onClick: logout }, 'Sign out'));

@@ -60,6 +60,15 @@ export const api = {
   me: () => request('GET', '/api/auth/me'),
   login: (name, password) => request('POST', '/api/auth/login', { name, password }),
   logout: () => request('POST', '/api/auth/logout'),
+  changePassword: (current, next) =>
+    request('POST', '/api/auth/password', { current_password: current, new_password: next }),
+  // Personal API tokens (own), and users (admins).
+  tokens: () => request('GET', '/api/auth/tokens'),
+  createToken: (body) => request('POST', '/api/auth/tokens', body),
+  revokeToken: (id) => request('DELETE', `/api/auth/tokens/${enc(id)}`),
+  users: () => request('GET', '/api/users?limit=1000'),
+  createUser: (body) => request('POST', '/api/users', body),
+  changeUser: (id, change) => request('PATCH', `/api/users/${enc(id)}`, change),
   vessels: () => request('GET', '/api/vessels').then(many(flatVessel)),
   vessel: (id) => request('GET', `/api/vessels/${enc(id)}`).then(flatVessel),
   createVessel: (profile) => request('POST', '/api/vessels', profile).then(flatVessel),

@@ -1,7 +1,7 @@
 // seatrial planner: hash router and page shell.
 //   #/vessels  #/vessels/new[?from=id]  #/vessels/{id}
 //   #/campaigns  #/campaigns/new[?vessel=id]  #/campaigns/{id}[/experiments/{eid}]
-//   #/runs/{id}  #/models/{id}  #/discrepancies/{id}
+//   #/runs/{id}  #/models/{id}  #/discrepancies/{id}  #/account
 
 import { api, ApiError } from './api.js';
 import { h, fill, banner, clearBanner, showFlash } from './forms.js';
@@ -13,6 +13,7 @@ import { modelPage } from './modelpage.js';
 import { discoveryPage } from './discoverypage.js';
 import { destroyPlots } from './plots.js';
 import { whoAmI, loginForm } from './account.js';
+import { accountPage } from './accountpage.js';
 
 const view = document.getElementById('view');
 let current = null; // controller of the page shown (campaign page), if any
@@ -59,6 +60,8 @@ async function route() {
       ctl = await modelPage(target, parts[1]);
     } else if (section === 'discrepancies' && parts[1]) {
       ctl = await discoveryPage(target, parts[1]);
+    } else if (section === 'account') {
+      await accountPage(target);
     } else {
       target.append(h('h1', null, 'Not found'), h('p', null, h('a', { href: '#/campaigns' }, 'Campaigns')));
     }
