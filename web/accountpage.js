@@ -36,6 +36,30 @@ export async function accountPage(host) {
   if (me.role === 'admin') host.append(await userSection(me));
 }
 
+/**
+ * A create form: on submit clears its errors, runs `act()` (errors shown on
+ * the fields they name), then resets and calls `refresh()`.
+ */
+function createForm(attrs, act, refresh, fields, submitLabel, submitId) {
+  const form = h('form', {
+    class: 'card form', ...attrs,
+    onSubmit: async (e) => {
+      e.preventDefault();
+      clearErrors(form);
+      try {
+        await act();
+        form.reset();
+        await refresh();
+      } catch (err) {
+        showError(form, err);
+      }
+    },
+  },
+  ...fields,
+  h('div', { class: 'actions' }, h('button', { type: 'submit', class: 'btn primary', 'data-testid': submitId }, submitLabel)));
+  return form;
+}
+
 function passwordSection() {
   const current = h('input', { type: 'password', name: 'current_password', autocomplete: 'current-password', required: true, 'data-testid': 'pw-current' });
   const next = h('input', { type: 'password', name: 'new_password', autocomplete: 'new-password', minlength: 8, required: true, 'data-testid': 'pw-new' });
@@ -95,33 +119,22 @@ async function tokenSection(me) {
   const name = h('input', { type: 'text', required: true, maxlength: 200, placeholder: 'e.g. MPC design laptop', 'data-testid': 'token-name' });
   const role = roleSelect(me.role, me.role, 'token-role');
   const days = h('input', { type: 'number', min: 1, max: 3650, step: 1, placeholder: 'never', 'data-testid': 'token-days' });
-  const form = h('form', {
-    class: 'card form', 'data-testid': 'token-form', 'aria-label': 'New API token',
-    onSubmit: async (e) => {
-      e.preventDefault();
-      clearErrors(form);
-      fill(shown);
-      try {
-        const body = { name: name.value, role: role.value };
-        if (days.value) body.expires_in_days = Number(days.value);
-        const made = await api.createToken(body);
-        const code = h('code', { 'data-testid': 'token-secret' }, made.token);
-        fill(shown, h('div', { class: 'card notice', role: 'status' },
-          h('p', null, h('strong', null, 'Copy this token now: it is not stored and will not be shown again.')),
-          h('p', { class: 'secret' }, code, ' ',
-            h('button', { type: 'button', class: 'btn small', onClick: () => navigator.clipboard?.writeText(made.token) }, 'Copy')),
-          h('p', { class: 'hint' }, 'Use it as ', h('code', null, 'Authorization: Bearer …'), ' in REST clients.')));
-        form.reset();
-        await refresh();
-      } catch (err) {
-        showError(form, err);
-      }
-    },
-  },
-  h('label', null, 'Name ', name),
-  h('label', null, 'Role (at most yours) ', role),
-  h('label', null, 'Expires after (days, empty: never) ', days),
-  h('div', { class: 'actions' }, h('button', { type: 'submit', class: 'btn primary', 'data-testid': 'token-create' }, 'Create token')));
+  const form = createForm({ 'data-testid': 'token-form', 'aria-label': 'New API token' }, async () => {
+    fill(shown);
+    const body = { name: name.value, role: role.value };
+    if (days.value) body.expires_in_days = Number(days.value);
+    const made = await api.createToken(body);
+    const code = h('code', { 'data-testid': 'token-secret' }, made.token);
+    fill(shown, h('div', { class: 'card notice', role: 'status' },
+      h('p', null, h('strong', null, 'Copy this token now: it is not stored and will not be shown again.')),
+      h('p', { class: 'secret' }, code, ' ',
+        h('button', { type: 'button', class: 'btn small', onClick: () => navigator.clipboard?.writeText(made.token) }, 'Copy')),
+      h('p', { class: 'hint' }, 'Use it as ', h('code', null, 'Authorization: Bearer …'), ' in REST clients.')));
+  }, refresh, [
+    h('label', null, 'Name ', name),
+    h('label', null, 'Role (at most yours) ', role),
+    h('label', null, 'Expires after (days, empty: never) ', days),
+  ], 'Create token', 'token-create');
   await refresh();
   section.append(h('h2', { id: 'tok-h' }, 'Personal API tokens'),
     h('p', { class: 'hint' }, 'For scripts and REST clients (MATLAB, Python). Stored only as a hash; revoke one you no longer use.'),
@@ -141,24 +154,13 @@ async function userSection(me) {
   const name = h('input', { type: 'text', required: true, maxlength: 200, autocomplete: 'off', 'data-testid': 'user-name' });
   const role = roleSelect('admin', 'viewer', 'user-role');
   const password = h('input', { type: 'password', required: true, minlength: 8, autocomplete: 'new-password', 'data-testid': 'user-password' });
-  const form = h('form', {
-    class: 'card form', 'data-testid': 'user-form', 'aria-label': 'New user',
-    onSubmit: async (e) => {
-      e.preventDefault();
-      clearErrors(form);
-      try {
-        await api.createUser({ name: name.value, role: role.value, password: password.value });
-        form.reset();
-        await refresh();
-      } catch (err) {
-        showError(form, err);
-      }
-    },
-  },
-  h('label', null, 'Login name ', name),
-  h('label', null, 'Role ', role),
-  h('label', null, 'First password (8 characters or more; tell them to change it) ', password),
-  h('div', { class: 'actions' }, h('button', { type: 'submit', class: 'btn primary', 'data-testid': 'user-create' }, 'Create user')));
+  const form = createForm({ 'data-testid': 'user-form', 'aria-label': 'New user' },
+    () => api.createUser({ name: name.value, role: role.value, password: password.value }),
+    refresh, [
+      h('label', null, 'Login name ', name),
+      h('label', null, 'Role ', role),
+      h('label', null, 'First password (8 characters or more; tell them to change it) ', password),
+    ], 'Create user', 'user-create');
   await refresh();
   section.append(h('h2', { id: 'users-h' }, 'Users'),
     h('p', { class: 'hint' }, 'viewer: reads · supervisor: plans, uploads, runs jobs · engineer: also edits models and settings · admin: also users and tokens. Every action is recorded with who did it.'),

@@ -11,7 +11,9 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, writeFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { harness, tid } from './harness.mjs';
+import { harness, tid, signIn as signInAs } from './harness.mjs';
+
+const signIn = (page, name, password) => signInAs(H, page, name, password);
 
 const ADMIN_PASSWORD = 'account-admin-pw';
 const secrets = mkdtempSync(path.join(tmpdir(), 'seatrial-accounts-'));
@@ -30,14 +32,6 @@ after(async () => {
   rmSync(secrets, { recursive: true, force: true });
 });
 
-async function signIn(page, name, password) {
-  await page.goto(`${H.base}/#/campaigns`);
-  await page.locator(tid('login-form')).waitFor();
-  await page.fill(tid('login-name'), name);
-  await page.fill(tid('login-password'), password);
-  await page.click(tid('login-submit'));
-  await page.locator(tid('account-role')).waitFor();
-}
 
 test('an admin manages users and tokens and changes the password on the account page', async () => {
   await H.withPage([ME_401, GET_401], async (page) => {

@@ -10,7 +10,9 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, writeFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { harness, tid } from './harness.mjs';
+import { harness, tid, signIn as signInAs } from './harness.mjs';
+
+const signIn = (page, name, password) => signInAs(H, page, name, password);
 import { SURVEYOR_ROV } from '../templates.js';
 
 const ADMIN_PASSWORD = 'browser-admin-pw';
@@ -60,14 +62,6 @@ async function hiddenControl(page, id) {
   assert.equal(await loc.first().isVisible(), false, `${id} hidden for a viewer`);
 }
 
-async function signIn(page, name, password) {
-  await page.goto(`${H.base}/#/campaigns`);
-  await page.locator(tid('login-form')).waitFor();
-  await page.fill(tid('login-name'), name);
-  await page.fill(tid('login-password'), password);
-  await page.click(tid('login-submit'));
-  await page.locator(tid('account-role')).waitFor();
-}
 
 test('the sign-in form refuses a wrong password, then signs the admin in with every control', async () => {
   await H.withPage([ME_401, LOGIN_401, GET_401], async (page) => {

@@ -25,6 +25,16 @@ const ARGS = [
 
 export const tid = (id) => `[data-testid="${id}"]`;
 
+/** Signs in through the page's sign-in form (a server requiring credentials). */
+export async function signIn(h, page, name, password) {
+  await page.goto(`${h.base}/#/campaigns`);
+  await page.locator(tid('login-form')).waitFor();
+  await page.fill(tid('login-name'), name);
+  await page.fill(tid('login-password'), password);
+  await page.click(tid('login-submit'));
+  await page.locator(tid('account-role')).waitFor();
+}
+
 /** `extraArgs`: more server flags, e.g. ['--demo']. */
 export function harness({ extraArgs = [] } = {}) {
   // `headers`: sent with every h.api call (credentials, when the server requires them).
