@@ -65,9 +65,9 @@ pub struct PointTimeResponse {
     pub channels: Vec<ChannelTimeResponse>,
 }
 
-/// Time shown by default: six time constants of the slowest stable pole
-/// (twenty of the fastest unstable one when none is stable), 60 s for a
-/// model of integrators only.
+/// Time shown by default: six time constants of the slowest stable pole,
+/// and at least twenty of the fastest unstable one (long enough for its
+/// divergence to show and be cut); 60 s for a model of integrators only.
 pub fn default_horizon_s(m: &LinearModel) -> f64 {
     let h = m.sample_time_s;
     let (mut slow, mut fast_unstable) = (0.0_f64, f64::INFINITY);
@@ -86,10 +86,11 @@ pub fn default_horizon_s(m: &LinearModel) -> f64 {
             fast_unstable = fast_unstable.min(1.0 / s.re);
         }
     }
-    let t = if slow > 0.0 {
-        SETTLING_TIME_CONSTANTS * slow
-    } else if fast_unstable.is_finite() {
-        20.0 * fast_unstable
+    let settle = SETTLING_TIME_CONSTANTS * slow;
+    let t = if fast_unstable.is_finite() {
+        settle.max(20.0 * fast_unstable)
+    } else if slow > 0.0 {
+        settle
     } else {
         60.0
     };
@@ -325,6 +326,14 @@ mod tests {
     #[test]
     fn an_unstable_response_is_cut_and_the_time_reported() {
         let m = scalar(1.0, 1.0, 0.0); // ẋ = x + u: e^t − 1
+        assert!((default_horizon_s(&m) - 20.0).abs() < 1e-9);
+        // By default too: a slow stable pole beside it does not hide the growth.
+        let mut mixed = m.clone();
+        mixed.a = DMatrix::from_diagonal(&nalgebra::dvector![1.0, -0.01]);
+        mixed.b = DMatrix::from_element(2, 1, 1.0);
+        mixed.c = DMatrix::from_element(1, 2, 1.0);
+        let r = time_responses(&models(mixed), ResponseKind::Step, None).unwrap();
+        assert!(r[0].channels[0].diverged_at_s.is_some());
         let r = time_responses(&models(m), ResponseKind::Step, Some(100.0)).unwrap();
         let ch = &r[0].channels[0];
         let at = ch.diverged_at_s.expect("diverges");
