@@ -32,10 +32,19 @@ async fn unstable_copy(app: &TestApp, mid: &str) -> String {
         .iter()
         .position(|d| d == "pitch")
         .expect("pitch is modelled");
+    let rows = |v: &serde_json::Value| {
+        seatrial_core::identification::document::from_rows(
+            &serde_json::from_value(v.clone()).unwrap(),
+        )
+        .unwrap()
+    };
     for p in doc["lpv"]["points"].as_array_mut().unwrap() {
         let d = p["d_bar"][pitch][pitch].as_f64().unwrap();
         assert!(d > 0.0, "the identified pitch damping is dissipative");
         p["d_bar"][pitch][pitch] = json!(-d);
+        // A = −M⁻¹D̄ follows, as identification stores it.
+        let a = -(rows(&p["m"]).try_inverse().unwrap() * rows(&p["d_bar"]));
+        p["a"] = json!(seatrial_core::identification::document::to_rows(&a));
     }
     let mut conn = app.state.db.acquire().await.unwrap();
     insert(
@@ -112,6 +121,16 @@ async fn walk_model(app: &TestApp, mid: &str) {
         assert_finite_csv(&r.text, "export ss_csv");
     }
     get(app, "/api/models/{id}/discrepancies", &[mid]).await;
+    // The plot data: Bode, poles and zeros, step and impulse, Hankel.
+    for route in [
+        "/api/models/{id}/frequency-response",
+        "/api/models/{id}/poles",
+        "/api/models/{id}/step-response?kind=step",
+        "/api/models/{id}/step-response?kind=impulse",
+        "/api/models/{id}/hankel",
+    ] {
+        get(app, route, &[mid]).await;
+    }
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -134,6 +153,23 @@ async fn every_number_served_about_a_campaign_and_its_models_is_finite() {
         .map(String::from);
     let unstable = unstable_copy(&app, &lambda).await;
 
+    // The unstable copy's pitch step is cut where it diverges, in words;
+    // its Hankel singular values are said not to exist.
+    let step = get(&app, "/api/models/{id}/step-response", &[&unstable]).await;
+    let cut: Vec<f64> = step["points"][0]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|c| c["diverged_at_s"].as_f64())
+        .collect();
+    assert!(!cut.is_empty(), "the unstable pitch diverges: {step}");
+    let hsv = get(&app, "/api/models/{id}/hankel", &[&unstable]).await;
+    assert!(
+        hsv["points"][0]["undefined"]
+            .as_str()
+            .unwrap()
+            .contains("not stable")
+    );
     let mut models = vec![lambda.clone(), n4sid.clone(), unstable.clone()];
     models.extend(augmented.clone());
     for mid in &models {

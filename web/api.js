@@ -87,6 +87,8 @@ export const api = {
   // Delete a run (409 names the models built from it).
   deleteRun: (rid) => request('DELETE', `/api/runs/${enc(rid)}`),
   quality: (rid) => request('GET', urls.quality(rid)),
+  // Every channel of a run over a window (`query`: from_s, to_s, points), with the window's statistics.
+  runTraces: (rid, query) => request('GET', `/api/runs/${enc(rid)}/traces${query ? `?${query}` : ''}`),
   coverage: (id) => request('GET', `/api/campaigns/${enc(id)}/coverage`),
   // Clock offsets of two-file runs (s; null clears the one set by hand).
   campaignClockOffset: (id) => request('GET', `/api/campaigns/${enc(id)}/clock-offset`),
@@ -104,6 +106,13 @@ export const api = {
   model: (mid, hSample) => request('GET', `/api/models/${enc(mid)}${hSample != null ? `?h=${enc(hSample)}` : ''}`),
   // Delete a model version; `cascade` also the versions derived from it (else 409 names them).
   deleteModel: (mid, cascade) => request('DELETE', `/api/models/${enc(mid)}${cascade ? '?cascade=true' : ''}`),
+  // Linear responses of a model for its plots.
+  frequencyResponse: (mid, runId) => request('GET', `/api/models/${enc(mid)}/frequency-response${runId ? `?run_id=${enc(runId)}` : ''}`),
+  poles: (mid) => request('GET', `/api/models/${enc(mid)}/poles`),
+  stepResponse: (mid, kind) => request('GET', `/api/models/${enc(mid)}/step-response?kind=${enc(kind || 'step')}`),
+  hankel: (mid) => request('GET', `/api/models/${enc(mid)}/hankel`),
+  // Several models validated on one run (`ids`: 1–6 model ids).
+  compare: (ids, runId) => request('GET', `/api/models/compare?a=${enc(ids[0])}&b=${enc(ids[1] || ids[0])}${ids.length > 2 ? `&more=${enc(ids.slice(2).join(','))}` : ''}&run_id=${enc(runId)}`),
   // Missing-physics discovery reports.
   discrepancies: (mid) => request('GET', `/api/models/${enc(mid)}/discrepancies`),
   discrepancy: (did) => request('GET', `/api/discrepancies/${enc(did)}`),

@@ -1,8 +1,10 @@
 // Model page (#/models/{id}): provenance (method, settings, runs, software,
 // version and lineage), structure findings and notes, the parameter table with
 // standard deviations, the validation on each held-out run (fits, predicted vs
-// measured, residual autocorrelation, verdict and findings), exports, and the
-// ZOH-discretized Φ, Γ at a chosen sample time.
+// measured, residual autocorrelation, verdict and findings), the responses
+// (Bode over a run's H1, pole-zero, step/impulse, Hankel singular values,
+// residual cross-correlation, overlay compare: modelviews.js), exports, and
+// the ZOH-discretized Φ, Γ at a chosen sample time.
 
 import { api, urls } from './api.js';
 import { fmt, fmtDate, fmtKn } from './format.js';
@@ -12,6 +14,11 @@ import { predictionPlot, autocorrelationPlot, zoomGroup } from './modelplots.js'
 import { exact } from './runplots.js';
 import { discoveryPanel } from './discoverpanel.js';
 import { modelDeleteControl } from './manage.js';
+import { modelViewsSection } from './modelviews.js';
+import { exportBar, uplotExportable } from './plotexport.js';
+
+/** Export buttons of the live chart `name`. */
+const exportOf = (name, title) => exportBar(() => (window.__plots[name] ? uplotExportable(window.__plots[name], title) : null), 'validation-export');
 
 /** Unit of an output channel (the log contract). */
 function outUnit(name) {
@@ -190,6 +197,7 @@ export async function modelPage(view, id) {
     : h('p', { class: 'empty', 'data-testid': 'no-params' }, 'This model has no parameter table.');
 
   // ---- validation -----------------------------------------------------------------
+  const views = modelViewsSection(model, doc, { runs, validation });
   const plotJobs = []; // drawn in mount(), when the hosts have a width
   const valSections = validation.map((rv, ri) => {
     const rep = rv.report || {};
@@ -225,8 +233,8 @@ export async function modelPage(view, id) {
           h('span', { class: 'verdict-line', 'data-testid': 'channel-verdict-line' }, c.verdict)),
         (c.findings || []).length ? h('ul', { class: 'findings', 'data-testid': 'channel-findings' }, c.findings.map((f) => h('li', null, f))) : null,
         h('div', { class: 'plot-grid pvm-grid' },
-          h('div', { class: 'plot-card' }, h('h3', null, 'Predicted vs measured ', h('span', { class: 'hint' }, `fit 1-step ${fitText(c.fit_one_step)} · ${rep.k}-step ${fitText(c.fit_k_step)} · restarted ${fitText(c.fit_restarted)} · simulation ${fitText(c.fit_simulation)}`)), pvm),
-          h('div', { class: 'plot-card' }, h('h3', null, 'Residual autocorrelation ', h('span', { class: 'hint' },
+          h('div', { class: 'plot-card' }, h('h3', null, 'Predicted vs measured ', exportOf(`pvm:${ri}:${ci}`, `${model.name} v${model.version} on ${rv.run_name || rv.run_id}: ${c.output} predicted vs measured`), h('span', { class: 'hint' }, `fit 1-step ${fitText(c.fit_one_step)} · ${rep.k}-step ${fitText(c.fit_k_step)} · restarted ${fitText(c.fit_restarted)} · simulation ${fitText(c.fit_simulation)}`)), pvm),
+          h('div', { class: 'plot-card' }, h('h3', null, 'Residual autocorrelation ', exportOf(`acf:${ri}:${ci}`, `${model.name} v${model.version} on ${rv.run_name || rv.run_id}: ${c.output} residual autocorrelation`), h('span', { class: 'hint' },
             ac ? `1-step errors; ${ac.lags_outside.length} lag${ac.lags_outside.length === 1 ? '' : 's'} outside the ${Math.round(ac.confidence * 100)} % band (${fmt(ac.fraction_outside * 100, 1)} %, expected ${fmt(ac.expected_fraction * 100, 1)} %)${zc ? ` · ${zc.count} zero crossings (expected ${fmt(zc.expected, 0)})` : ''}` : '')), acf)));
     });
     return h('section', { class: 'card validation', 'data-testid': 'validation-run', 'data-run-id': rv.run_id, 'aria-label': `Validation on ${rv.run_name || rv.run_id}` },
@@ -299,6 +307,8 @@ export async function modelPage(view, id) {
     h('h2', { class: 'section-title' }, 'Parameters ', h('span', { class: 'hint' }, `${params.length} estimates with their standard deviations`)),
     paramSection,
     doc.dp_ship ? [h('h2', { class: 'section-title' }, 'DP ship matrices'), dpShipSection(doc.dp_ship, doc.inputs || [])] : null,
+    h('h2', { class: 'section-title', id: 'responses' }, 'Responses ', h('span', { class: 'hint' }, 'Bode over the data, poles and zeros, step, Hankel singular values, residual cross-correlation, compare')),
+    views.el,
     h('h2', { class: 'section-title' }, 'Validation ', h('span', { class: 'hint' }, 'on runs the model was not fitted to')),
     valSections.length ? valSections : h('p', { class: 'empty', 'data-testid': 'no-validation' }, 'No validation report.'),
     h('h2', { class: 'section-title' }, 'Missing physics ', h('span', { class: 'hint' }, 'where simulation and recordings part, and why')),
@@ -310,7 +320,7 @@ export async function modelPage(view, id) {
 
   return {
     key: `model:${id}`,
-    mount() { for (const f of plotJobs) f(); },
-    destroy() { discovery.destroy(); },
+    mount() { for (const f of plotJobs) f(); views.draw(); },
+    destroy() { discovery.destroy(); views.destroy(); },
   };
 }

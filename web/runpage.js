@@ -2,7 +2,8 @@
 // the run is (role, grid speed, excited DOFs, signal: the supervisor's, the
 // plan's or inferred, editable), how it was read (rate, duration, gaps,
 // warnings, clock alignment of two-file runs), the verdict per DOF with its
-// reason, and the quality report's plots:
+// reason, the time plot of every recorded channel (runtraces.js), and the
+// quality report's plots (each exportable as PNG, SVG, CSV):
 // PSDs, coherence, H1 magnitude and phase, regressor singular values, plan
 // adherence.
 
@@ -15,6 +16,11 @@ import { verdictBadge, statusBadge, coverageBadge, errorWhere, errorText, rawLin
 import { runOffsetPanel } from './offsetpanel.js';
 import { descriptionSection } from './rundescribe.js';
 import { excludedBadge, runManageSection } from './manage.js';
+import { runTracesSection } from './runtraces.js';
+import { exportBar, uplotExportable } from './plotexport.js';
+
+/** Export buttons of the live chart `name`, titled for the run. */
+const exportOf = (name, title) => exportBar(() => (window.__plots[name] ? uplotExportable(window.__plots[name], title()) : null), `${name}-export`);
 
 const GOOD_COHERENCE = 0.8; // server: quality::verdict::GOOD_COHERENCE (the reasons quote it)
 
@@ -152,6 +158,7 @@ export async function runPage(view, rid) {
   const vessel = campaign ? await api.vessel(campaign.vessel_id).catch(() => null) : null;
   const s = run.summary || {};
   const qualityHost = h('section', { class: 'quality', 'data-testid': 'quality', 'aria-label': 'Quality report' });
+  const traces = run.status === 'accepted' ? runTracesSection(run) : null;
   let destroyed = false;
 
   fill(view,
@@ -194,9 +201,11 @@ export async function runPage(view, rid) {
         warningsList((s.warnings || []).filter((x) => !(s.alignment && x.file === 'alignment')))),
       run.layout === 'split' ? h('div', null, h('h2', null, 'Alignment'), runOffsetPanel(run), s.alignment ? alignmentBox(s.alignment) : null) : null),
 
+    traces ? traces.el : null,
     run.status === 'accepted' ? qualityHost : null);
 
   async function mount() {
+    if (traces) traces.draw();
     if (!qualityP) return;
     fill(qualityHost, h('p', { class: 'loading', 'data-testid': 'quality-loading' }, h('span', { class: 'spinner', 'aria-hidden': 'true' }), 'Loading the quality report…'));
     const { q, err } = await qualityP;
@@ -311,19 +320,19 @@ export async function runPage(view, rid) {
       h('p', { class: 'hint' }, 'Drag to zoom a frequency range · double-click to reset · click a legend entry to hide/show. ', decim),
       h('div', { class: 'plot-grid' },
         h('div', { class: 'plot-card' },
-          h('h3', null, 'Power spectral density ', psdSelect),
+          h('h3', null, 'Power spectral density ', psdSelect, exportOf('runPsd', () => `${run.name} PSD of ${psdSel}`)),
           h('p', { class: 'hint' }, q.inputs.map((x) => `${x.name}: PE ${x.pe_order >= x.pe_cap ? '≥ ' : ''}${x.pe_order}, band ${bandText(x.usable_band_hz)}${x.nyquist && x.nyquist.warning ? ' ⚠ Nyquist' : ''}`).join(' · ')),
           psdHost),
         h('div', { class: 'plot-card' },
-          h('h3', null, 'Coherence ', cohSelect),
+          h('h3', null, 'Coherence ', cohSelect, exportOf('runCoherence', () => `${run.name} coherence`)),
           h('p', { class: 'hint' }, `γ² of input and output: near 1 where the output is explained linearly by the input. Line: ${GOOD_COHERENCE}.`),
           cohHost),
         h('div', { class: 'plot-card' },
-          h('h3', null, 'Frequency response H1 ', h1Select),
+          h('h3', null, 'Frequency response H1 ', h1Select, exportOf('runH1mag', () => `${run.name} H1 magnitude ${h1Sel}`), exportOf('runH1phase', () => `${run.name} H1 phase ${h1Sel}`)),
           h('p', { class: 'hint' }, 'H1 = Pxy / Pxx; magnitude and unwrapped phase, zoom either — the other follows.'),
           magHost, phHost),
         h('div', { class: 'plot-card' },
-          h('h3', null, 'Regressor singular values'),
+          h('h3', null, 'Regressor singular values', exportOf('runSv', () => `${run.name} regressor singular values`)),
           h('p', { class: 'hint', 'data-testid': 'sv-summary' },
             `${reg.identifiable} of ${reg.n_columns} parameters identifiable (σᵢ/σ₁ above ${exact(reg.threshold)}) · ARX, ${reg.lags} lag${reg.lags === 1 ? '' : 's'}, ${reg.n_rows} rows`),
           svHost,
@@ -344,6 +353,6 @@ export async function runPage(view, rid) {
   return {
     key: `run:${rid}`,
     mount,
-    destroy() { destroyed = true; },
+    destroy() { destroyed = true; if (traces) traces.destroy(); },
   };
 }

@@ -13,19 +13,12 @@
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { harness, tid, inked } from './harness.mjs';
+import { harness, tid, inked, waitJob as waitFor } from './harness.mjs';
 
 const H = harness({ extraArgs: ['--demo'] });
 let mid;
 
-async function waitJob(id, seconds) {
-  for (let i = 0; i < seconds * 5; i += 1) {
-    const j = await H.api('GET', `/api/jobs/${id}`);
-    if (['succeeded', 'failed', 'cancelled', 'interrupted'].includes(j.json.state)) return j.json;
-    await new Promise((r) => setTimeout(r, 200));
-  }
-  throw new Error(`job ${id} did not finish in ${seconds} s`);
-}
+const waitJob = (id, seconds) => waitFor(H, id, seconds);
 
 before(async () => {
   await H.start();

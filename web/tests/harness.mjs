@@ -158,6 +158,16 @@ export async function dragZoom(page, hostSel, a, b) {
   return over;
 }
 
+/** Poll job `id` until it ends (at most `seconds`); its JSON. */
+export async function waitJob(h, id, seconds) {
+  for (let i = 0; i < seconds * 5; i += 1) {
+    const j = await h.api('GET', `/api/jobs/${id}`);
+    if (['succeeded', 'failed', 'cancelled', 'interrupted'].includes(j.json.state)) return j.json;
+    await new Promise((r) => setTimeout(r, 200));
+  }
+  throw new Error(`job ${id} did not finish in ${seconds} s`);
+}
+
 /** Upload a one-file run through the API (test set-up); asserts it was accepted. */
 export async function uploadRun(h, campaignId, log, meta) {
   const form = new FormData();

@@ -18,6 +18,9 @@
 //! - [`estimation`]: restoring forces, λ-filter Kalman identification,
 //!   parallel state-augmented EKF, N4SID.
 //! - [`validation`]: prediction and simulation NRMSE, divergence, residual tests.
+//! - [`responses`]: a model's Bode, poles and zeros, step and impulse
+//!   responses, Hankel singular values (for the plots).
+//! - [`traces`]: a record decimated for a time plot, statistics of a window.
 //! - [`numbers`]: numbers in sentences (three significant digits, units).
 //! - [`discrepancy`]: missing-physics discovery — locate where a model and
 //!   the recordings part, name the left-out physics, model it.
@@ -31,9 +34,11 @@ pub mod models;
 pub mod numbers;
 pub mod planning;
 pub mod quality;
+pub mod responses;
 pub mod rng;
 pub mod signals;
 pub mod simulation;
 pub mod spectra;
 pub mod timeseries;
+pub mod traces;
 pub mod validation;

@@ -15,11 +15,13 @@ pub mod json;
 pub mod manage;
 pub mod model_cache;
 pub mod model_export;
+pub mod model_views;
 pub mod models;
 pub mod offload;
 pub mod plans;
 pub mod query;
 pub mod run_description;
+pub mod run_traces;
 pub mod runs;
 pub mod vessels;
 
@@ -157,6 +159,7 @@ pub fn api() -> OpenApiRouter<AppState> {
         ))
         .routes(routes!(runs::raw_run))
         .routes(routes!(runs::run_quality))
+        .routes(routes!(run_traces::run_traces))
         .routes(routes!(runs::coverage))
         .routes(routes!(
             clock_offsets::get_campaign_clock_offset,
@@ -179,6 +182,10 @@ pub fn api() -> OpenApiRouter<AppState> {
             manage::delete_model
         ))
         .routes(routes!(model_export::export_model))
+        .routes(routes!(model_views::frequency_response))
+        .routes(routes!(model_views::poles))
+        .routes(routes!(model_views::step_response))
+        .routes(routes!(model_views::hankel))
         .routes(routes!(discrepancies::list_model_discrepancies))
         .routes(routes!(discrepancies::get_discrepancy))
         // Uploads stream to disk under their own limit (counted in the handler).

@@ -146,6 +146,8 @@ pub struct CompareQuery {
     pub a: String,
     /// Second model.
     pub b: String,
+    /// Further models to overlay, comma-separated ids (at most 6 models in all).
+    pub more: Option<String>,
     /// The run both are validated on (best one neither was estimated from).
     pub run_id: String,
     /// Horizon of the k-step predictions (default 10).
@@ -167,30 +169,57 @@ pub struct ComparedModel {
     pub report: serde_json::Value,
 }
 
-/// Two models side by side on the same run.
+/// Models side by side on the same run.
 #[derive(Debug, Serialize, utoipa::ToSchema)]
 pub struct Comparison {
     /// The run.
     pub run_id: String,
     /// Its name.
     pub run_name: String,
-    /// The two models, in the order asked.
+    /// The models, in the order asked (a, b, then `more`).
     pub models: Vec<ComparedModel>,
 }
 
-/// Validate two models on the same run, side by side (1-step, k-step,
-/// restarted free-run and simulation fits, divergences; residual tests).
+/// Most models in one comparison.
+const MAX_COMPARED: usize = 6;
+
+/// Validate two models (or up to six with `more`) on the same run, side by
+/// side (1-step, k-step, restarted free-run and simulation fits,
+/// divergences; residual tests).
 #[utoipa::path(get, path = "/api/models/compare", tag = "models", params(CompareQuery),
     responses((status = 200, description = "Both validations", body = Comparison),
               (status = 400, description = "Missing or malformed query parameter", body = ErrorBody),
               (status = 404, description = "No such model or run", body = ErrorBody),
-              (status = 422, description = "The run cannot validate a model (vessel, columns, kind), or `restart_s` is not a positive number of seconds", body = ErrorBody)))]
+              (status = 422, description = "The run cannot validate a model (vessel, columns, kind), `restart_s` is not a positive number of seconds, or more than 6 models", body = ErrorBody)))]
 pub async fn compare_models(
     State(s): State<AppState>,
     ApiQuery(q): ApiQuery<CompareQuery>,
 ) -> ApiResult<Json<Comparison>> {
+    let more: Vec<String> = q
+        .more
+        .as_deref()
+        .unwrap_or("")
+        .split(',')
+        .map(str::trim)
+        .filter(|x| !x.is_empty())
+        .map(String::from)
+        .collect();
+    if more.len() + 2 > MAX_COMPARED {
+        return Err(ApiError::invalid(
+            "more",
+            format!(
+                "at most {MAX_COMPARED} models in one comparison, got {}",
+                more.len() + 2
+            ),
+        ));
+    }
+    let asked: Vec<(&'static str, &String)> = [("a", &q.a), ("b", &q.b)]
+        .into_iter()
+        .chain(more.iter().map(|id| ("more", id)))
+        .collect();
+    let fields: Vec<&'static str> = asked.iter().map(|(f, _)| *f).collect();
     let mut stored = Vec::new();
-    for (field, id) in [("a", &q.a), ("b", &q.b)] {
+    for (field, id) in asked.iter().copied() {
         let m = models::get(&s.db, id)
             .await?
             .ok_or_else(|| ApiError::missing(field, format!("no model with id '{id}'")))?;
@@ -206,7 +235,7 @@ pub async fn compare_models(
         ));
     }
     let (campaign, vessel) = campaign_and_vessel(&s.db, &run).await?;
-    for (field, m) in [("a", &stored[0]), ("b", &stored[1])] {
+    for (field, m) in fields.iter().copied().zip(&stored) {
         if m.summary.vessel_id != campaign.vessel_id {
             return Err(ApiError::invalid(
                 field,
@@ -242,7 +271,7 @@ pub async fn compare_models(
         let input = stored_run.input(record);
         let forces = processing::generalized_force_columns(&profile);
         docs.iter()
-            .zip(["a", "b"])
+            .zip(fields)
             .map(|(doc, field)| {
                 let settings = ValidationSettings {
                     k,

@@ -171,4 +171,34 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn cross_correlation_is_numpys_correlate_over_n_sigma_sigma() {
+        // de = [−1, 0, 1], du = [1, 0, −1]; numpy.correlate(de, du, "full")
+        // = [1, 0, −2, 0, 1] for τ = −2..2, and N σ_e σ_u = √2·√2 = 2.
+        let r = cross_correlation(&[1.0, 2.0, 3.0], &[1.0, 0.0, -1.0], 2).unwrap();
+        for (a, b) in r.iter().zip([0.5, 0.0, -1.0, 0.0, 0.5]) {
+            assert!((a - b).abs() < 1e-15, "{r:?}");
+        }
+    }
+
+    #[test]
+    fn independent_white_sequences_stay_inside_the_99_percent_band() {
+        // z₀.₉₉₅/√N bounds r_eu(τ) of independent white e and u at 99 %.
+        use crate::validation::residuals::input_residual_correlation;
+        let n = 4000;
+        let mut rng = SplitMix64::new(29);
+        let e: Vec<f64> = (0..n).map(|_| rng.normal()).collect();
+        let u: Vec<f64> = (0..n).map(|_| rng.normal()).collect();
+        let c = input_residual_correlation(&e, &u, "tau_X", 100, 0.99).unwrap();
+        let z = 2.5758293035489;
+        assert!(
+            (c.bound - z / (n as f64).sqrt()).abs() < 0.05 * c.bound,
+            "{}",
+            c.bound
+        );
+        // About 1 % of the 201 lags fall outside; far fewer than 5 %.
+        assert!(c.lags_outside.len() <= 10, "{:?}", c.lags_outside);
+        assert!(!c.leak);
+    }
 }
