@@ -76,7 +76,12 @@ export const api = {
   // What a run is: fields absent are kept, null clears a user value.
   describeRun: (rid, body) => request('PATCH', `/api/runs/${enc(rid)}`, body),
   // Delete a run (409 names the models built from it).
-  deleteRun: (rid) => request('DELETE', `/api/runs/${enc(rid)}`),
+  deleteRun: (rid, reason) => request('DELETE', `/api/runs/${enc(rid)}${reason ? `?reason=${enc(reason)}` : ''}`),
+  restoreRun: (rid) => request('POST', `/api/runs/${enc(rid)}/restore`),
+  deletedRuns: (id) => request('GET', `/api/campaigns/${enc(id)}/runs?deleted=true`),
+  renameRun: (rid, name) => request('PATCH', `/api/runs/${enc(rid)}`, { name }),
+  renameVessel: (id, name) => request('PATCH', `/api/vessels/${enc(id)}`, { name }).then(flatVessel),
+  renameCampaign: (id, name) => request('PATCH', `/api/campaigns/${enc(id)}`, { name }).then(flatCampaign),
   quality: (rid) => request('GET', urls.quality(rid)),
   coverage: (id) => request('GET', `/api/campaigns/${enc(id)}/coverage`),
   // Clock offsets of two-file runs (s; null clears the one set by hand).
@@ -94,7 +99,10 @@ export const api = {
   // `hSample`: add the ZOH-discretized Φ, Γ at this sample time.
   model: (mid, hSample) => request('GET', `/api/models/${enc(mid)}${hSample != null ? `?h=${enc(hSample)}` : ''}`),
   // Delete a model version; `cascade` also the versions derived from it (else 409 names them).
-  deleteModel: (mid, cascade) => request('DELETE', `/api/models/${enc(mid)}${cascade ? '?cascade=true' : ''}`),
+  deleteModel: (mid, cascade, reason) => request('DELETE', `/api/models/${enc(mid)}?cascade=${cascade ? 'true' : 'false'}${reason ? `&reason=${enc(reason)}` : ''}`),
+  restoreModel: (mid) => request('POST', `/api/models/${enc(mid)}/restore`),
+  deletedModels: (campaignId) => request('GET', `/api/models?deleted=true&campaign_id=${enc(campaignId)}`),
+  renameModel: (mid, name) => request('PATCH', `/api/models/${enc(mid)}`, { name }),
   // Missing-physics discovery reports.
   discrepancies: (mid) => request('GET', `/api/models/${enc(mid)}/discrepancies`),
   discrepancy: (did) => request('GET', `/api/discrepancies/${enc(did)}`),

@@ -48,3 +48,33 @@ pub async fn get_vessel(
 ) -> ApiResult<Json<Vessel>> {
     Ok(Json(found(vessels::get(&s.db, &id).await?, "vessel", &id)?))
 }
+
+/// A change to a vessel. Its physics (DOFs, limits, thrusters) stay as the
+/// plans were made with them: a changed vessel is a new profile.
+#[derive(Debug, serde::Deserialize, utoipa::ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct VesselChange {
+    /// New name, 1–200 characters (trimmed).
+    #[schema(min_length = 1, max_length = 200, pattern = r"\S")]
+    pub name: String,
+}
+
+/// Rename a vessel (its campaigns, runs and models are unchanged).
+#[utoipa::path(patch, path = "/api/vessels/{id}", tag = "planning",
+    params(("id" = String, Path, description = "Vessel id")),
+    request_body = VesselChange,
+    responses(
+        (status = 200, description = "The renamed vessel", body = Vessel),
+        (status = 400, description = "Malformed JSON; `field` names the JSON path", body = ErrorBody),
+        (status = 404, description = "No such vessel", body = ErrorBody),
+        (status = 415, description = "Not JSON", body = ErrorBody),
+        (status = 422, description = "An empty or too long `name`", body = ErrorBody)))]
+pub async fn patch_vessel(
+    State(s): State<AppState>,
+    Path(id): Path<String>,
+    ApiJson(change): ApiJson<VesselChange>,
+) -> ApiResult<Json<Vessel>> {
+    let name = super::run_description::check_name("name", &change.name)?;
+    let v = vessels::rename(&s.db, &id, &name).await?;
+    Ok(Json(found(v, "vessel", &id)?))
+}
