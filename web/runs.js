@@ -458,7 +458,7 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
       good.length ? h('div', { class: 'table-x' },
         h('table', { class: 'grid-table runs-table', 'data-testid': 'runs-table' },
           h('thead', null, h('tr', null, h('th', null, 'Uploaded'), h('th', null, 'Name'), h('th', null, 'Experiment'),
-            h('th', null, 'What it is'), h('th', null, 'Layout'),
+            h('th', { title: 'role · grid speed · excited DOFs; “?”: inferred from the data, confirm on the run page' }, 'What it is'), h('th', null, 'Layout'),
             h('th', null, 'Status'), h('th', null, 'Verdict per DOF'), h('th', { class: 'num' }, 'Size'))),
           h('tbody', null, shown.map((r) => runRow(r, codes))))) : null,
       pager,
