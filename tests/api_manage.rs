@@ -654,3 +654,28 @@ async fn model_versions_are_deleted_unless_derived_from_and_campaigns_renamed() 
         assert_eq!(r.status, 404, "{}", r.text);
     }
 }
+
+#[tokio::test]
+async fn vessels_campaigns_and_jobs_are_paged_with_their_total() {
+    let app = TestApp::new().await;
+    vessel_and_campaign(&app, json!({})).await;
+    vessel_and_campaign(&app, json!({})).await;
+    for (path, len, all) in [
+        ("/api/vessels?limit=1", 1, 2),
+        ("/api/campaigns?limit=1&offset=1", 1, 2),
+        ("/api/campaigns?offset=2", 0, 2),
+        ("/api/jobs?limit=5", 0, 0),
+    ] {
+        let r = app.call("GET", path, &[], None).await;
+        assert_eq!(
+            (r.json.as_array().map(Vec::len), total(&r)),
+            (Some(len), all),
+            "{path}: {}",
+            r.text
+        );
+    }
+    for path in ["/api/vessels?limit=0", "/api/jobs?limit=1001"] {
+        let r = app.call("GET", path, &[], None).await;
+        refused(&r, 422, "limit");
+    }
+}

@@ -6,9 +6,11 @@ use axum::http::StatusCode;
 use seatrial_core::planning::VesselProfile;
 
 use super::json::ApiJson;
+use super::query::{ApiQuery, Paging, paged};
 use super::{AppState, found};
 use crate::error::{ApiResult, ErrorBody};
 use crate::storage::vessels::{self, Vessel};
+use axum::response::Response;
 
 /// Create a vessel profile.
 #[utoipa::path(post, path = "/api/vessels", tag = "planning",
@@ -30,11 +32,19 @@ pub async fn create_vessel(
     ))
 }
 
-/// List vessels.
-#[utoipa::path(get, path = "/api/vessels", tag = "planning",
-    responses((status = 200, description = "All vessels", body = [Vessel])))]
-pub async fn list_vessels(State(s): State<AppState>) -> ApiResult<Json<Vec<Vessel>>> {
-    Ok(Json(vessels::list(&s.db).await?))
+/// List vessels, oldest first; `limit`/`offset` page the list and the
+/// `X-Total-Count` header gives how many there are.
+#[utoipa::path(get, path = "/api/vessels", tag = "planning", params(Paging),
+    responses((status = 200, description = "Vessels, oldest first", body = [Vessel],
+                headers(("x-total-count" = i64, description = "Vessels (all pages)"))),
+              (status = 400, description = "Malformed query parameter", body = ErrorBody),
+              (status = 422, description = "`limit` outside 1–1000", body = ErrorBody)))]
+pub async fn list_vessels(
+    State(s): State<AppState>,
+    ApiQuery(p): ApiQuery<Paging>,
+) -> ApiResult<Response> {
+    let page = p.page()?;
+    Ok(paged(vessels::list(&s.db).await?, page))
 }
 
 /// One vessel.
