@@ -172,6 +172,27 @@ async fn a_supervisor_plans_and_uploads_an_engineer_deletes_models_all_audited()
     assert_eq!(r.status, 403, "{}", r.text);
     let r = eng.send("DELETE", "/api/models/{id}", &[&mid], None).await;
     assert_eq!(r.status, 200, "{}", r.text);
+    // Soft deletes name who deleted; restoring needs the same role.
+    let r = eng.send("GET", "/api/models/{id}", &[&mid], None).await;
+    assert_eq!(r.json["model"]["deleted_by"], "engineer", "{}", r.text);
+    let r = sup
+        .send("POST", "/api/models/{id}/restore", &[&mid], None)
+        .await;
+    assert_eq!(r.status, 403, "{}", r.text);
+    let r = sup
+        .send(
+            "DELETE",
+            "/api/runs/{id}?reason=wrong%20vessel",
+            &[&rid],
+            None,
+        )
+        .await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["run"]["deleted_by"].as_str()),
+        (200, Some("supervisor")),
+        "{}",
+        r.text
+    );
 
     // The audit trail names who did each write, and what it touched.
     let (_, cookie) = login(&app, "admin", ADMIN_PASSWORD).await;

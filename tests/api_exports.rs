@@ -255,6 +255,10 @@ async fn exported(app: &TestApp, mid: &str, tag: &str, h: f64, dir: &Path) -> Va
     .unwrap();
     let m = export(app, mid, "format=matlab").await;
     std::fs::write(dir.join(format!("{tag}.m")), m.text).unwrap();
+    let mat = export(app, mid, &format!("format=mat&h={h}")).await;
+    assert_eq!(mat.content_type, "application/octet-stream");
+    assert!(mat.bytes.starts_with(b"MATLAB 5.0 MAT-file"), "{tag}.mat");
+    std::fs::write(dir.join(format!("{tag}.mat")), &mat.bytes).unwrap();
     view
 }
 

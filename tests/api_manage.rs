@@ -139,7 +139,7 @@ async fn runs_are_renamed_excluded_paged_and_deleted_with_their_files() {
         common::jobs::config(0),
     )
     .await;
-    let (vid, cid) = vessel_and_campaign(&app, json!({})).await;
+    let (_, cid) = vessel_and_campaign(&app, json!({})).await;
     let (one, two) = (log(1), log(2));
     let a = id(&upload(&app, &cid, "a", &one).await);
     let b = id(&upload(&app, &cid, "b (same bytes as a)", &one).await);
@@ -314,46 +314,101 @@ async fn runs_are_renamed_excluded_paged_and_deleted_with_their_files() {
         .await;
     assert_eq!(r.status, 404);
 
-    // A run a model was built from is kept, naming the model.
-    let mid = common::stored_model(&app, &cid, &vid, None, &[&c]).await;
-    let r = app.call("DELETE", "/api/runs/{id}", &[&c], None).await;
-    assert_eq!(r.status, 409, "{}", r.text);
-    assert!(
-        r.json["message"].as_str().unwrap().contains(&mid),
-        "{}",
-        r.text
-    );
-
-    // Deleting a run keeps a file another run shares, and removes it with the last.
+    // Deleting is soft: the files stay, the run leaves the list, it is
+    // listed with ?deleted=true, and restore undoes it.
     let sha = {
         let r = app.call("GET", "/api/runs/{id}", &[&a], None).await;
         r.json["files"][0]["sha256"].as_str().unwrap().to_string()
     };
-    let path = app.state.blobs.path(&sha);
-    let r = app.call("DELETE", "/api/runs/{id}", &[&a], None).await;
-    assert_eq!(
-        (
-            r.status.as_u16(),
-            r.json["files_removed"].as_array().unwrap().len()
-        ),
-        (200, 0),
-        "{}",
-        r.text
-    );
-    assert!(path.exists());
-    let r = app.call("DELETE", "/api/runs/{id}", &[&b], None).await;
-    assert_eq!(r.json["files_removed"][0], sha.as_str(), "{}", r.text);
-    assert!(!path.exists());
-    assert_eq!(
-        app.call("GET", "/api/runs/{id}", &[&a], None).await.status,
-        404
-    );
+    let r = app
+        .call(
+            "DELETE",
+            "/api/runs/{id}?reason=logged%20twice",
+            &[&a],
+            None,
+        )
+        .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["run"]["delete_reason"], "logged twice", "{}", r.text);
+    assert_eq!(r.json["run"]["deleted_by"], "local", "{}", r.text);
+    assert!(r.json["run"]["deleted_at"].is_string(), "{}", r.text);
+    assert!(app.state.blobs.path(&sha).exists());
+    let r = app.call("GET", "/api/runs/{id}", &[&a], None).await;
+    assert_eq!(r.status, 200, "a deleted run stays readable: {}", r.text);
     assert_eq!(
         app.call("DELETE", "/api/runs/{id}", &[&a], None)
             .await
             .status,
-        404
+        404,
+        "deleted already"
     );
+    let r = app
+        .call(
+            "GET",
+            "/api/campaigns/{id}/runs?deleted=true",
+            &[&cid],
+            None,
+        )
+        .await;
+    assert_eq!(
+        (total(&r), r.json[0]["id"].as_str()),
+        (1, Some(a.as_str())),
+        "{}",
+        r.text
+    );
+    // Named in run_ids, a deleted run is refused by name and id.
+    let r = app
+        .call(
+            "POST",
+            "/api/jobs",
+            &[],
+            Some(json!({ "kind": "identify", "campaign_id": cid, "run_ids": [c, a] })),
+        )
+        .await;
+    refused(&r, 422, "run_ids[1]");
+    let msg = r.json["message"].as_str().unwrap();
+    assert!(msg.contains("dive 3") && msg.contains(&a), "{msg}");
+    // The audit trail says who, when and why.
+    let r = app.call("GET", "/api/audit", &[], None).await;
+    let entry = r
+        .json
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["method"] == "DELETE" && e["target_id"] == a.as_str() && e["status"] == 200)
+        .unwrap_or_else(|| panic!("no audit row: {}", r.text));
+    assert_eq!(
+        (entry["note"].as_str(), entry["user_name"].as_str()),
+        (Some("logged twice"), Some("local"))
+    );
+    let r = app
+        .call("POST", "/api/runs/{id}/restore", &[&a], None)
+        .await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["deleted_at"].is_null()),
+        (200, true),
+        "{}",
+        r.text
+    );
+    let r = app
+        .call("POST", "/api/runs/{id}/restore", &[&a], None)
+        .await;
+    assert_eq!(r.status, 409, "not deleted: {}", r.text);
+    let r = app
+        .call("POST", "/api/runs/{id}/restore", &["nope"], None)
+        .await;
+    assert_eq!(r.status, 404, "{}", r.text);
+    let r = app.call("DELETE", "/api/runs/{id}", &[&b], None).await;
+    assert_eq!(r.json["run"]["delete_reason"], json!(null), "{}", r.text);
+    let r = app
+        .call(
+            "DELETE",
+            &format!("/api/runs/{{id}}?reason={}", "x".repeat(2001)),
+            &[&c],
+            None,
+        )
+        .await;
+    refused(&r, 422, "reason");
     // A rejected upload is removable too.
     assert_eq!(
         app.call("DELETE", "/api/runs/{id}", &[&bad], None)
@@ -364,7 +419,54 @@ async fn runs_are_renamed_excluded_paged_and_deleted_with_their_files() {
     let r = app
         .call("GET", "/api/campaigns/{id}/runs", &[&cid], None)
         .await;
-    assert_eq!(total(&r), 1, "{}", r.text);
+    assert_eq!(total(&r), 2, "{}", r.text);
+}
+
+#[tokio::test]
+async fn deleting_a_run_keeps_the_provenance_of_its_models() {
+    let app = TestApp::new().await;
+    let (vid, cid) = vessel_and_campaign(&app, json!({})).await;
+    let run = id(&upload(&app, &cid, "dive 7", &log(7)).await);
+    let mid = common::stored_model(&app, &cid, &vid, None, &[&run]).await;
+    let r = app
+        .call(
+            "DELETE",
+            "/api/runs/{id}?reason=bad%20depth%20sensor",
+            &[&run],
+            None,
+        )
+        .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    let used_by = r.json["used_by"].to_string();
+    assert!(
+        used_by.contains(&mid),
+        "the answer names the model: {used_by}"
+    );
+    // The model still names the run, and the run still reads, marked deleted.
+    let m = app.call("GET", "/api/models/{id}", &[&mid], None).await;
+    assert_eq!(m.status, 200, "{}", m.text);
+    assert!(
+        m.text.contains(&run),
+        "provenance keeps the run: {}",
+        m.text
+    );
+    let r = app.call("GET", "/api/runs/{id}", &[&run], None).await;
+    assert_eq!(
+        (r.json["name"].as_str(), r.json["delete_reason"].as_str()),
+        (Some("dive 7"), Some("bad depth sensor")),
+        "{}",
+        r.text
+    );
+    assert_eq!(
+        app.call("GET", "/api/runs/{id}/quality", &[&run], None)
+            .await
+            .status,
+        200
+    );
+    let r = app
+        .call("GET", "/api/campaigns/{id}/runs", &[&cid], None)
+        .await;
+    assert_eq!(total(&r), 0, "{}", r.text);
 }
 
 #[tokio::test]
@@ -388,18 +490,55 @@ async fn model_versions_are_deleted_unless_derived_from_and_campaigns_renamed() 
     assert_eq!(r.status, 409, "{}", r.text);
     let msg = r.json["message"].as_str().unwrap();
     assert!(msg.contains(&v2) && msg.contains("cascade"), "{msg}");
-    let r = app.call("DELETE", "/api/models/{id}", &[&v2], None).await;
+    let r = app
+        .call("DELETE", "/api/models/{id}?reason=duplicate", &[&v2], None)
+        .await;
     assert_eq!(
         (r.status.as_u16(), r.json["deleted"].clone()),
         (200, json!([v2])),
         "{}",
         r.text
     );
+    // Soft: readable by id, marked; out of the list, in ?deleted=true.
+    let r = app.call("GET", "/api/models/{id}", &[&v2], None).await;
     assert_eq!(
-        app.call("GET", "/api/models/{id}", &[&v2], None)
+        (r.status.as_u16(), r.json["model"]["delete_reason"].as_str()),
+        (200, Some("duplicate")),
+        "{}",
+        r.text
+    );
+    let r = app.call("GET", "/api/models", &[], None).await;
+    assert_eq!(total(&r), 1, "{}", r.text);
+    let r = app.call("GET", "/api/models?deleted=true", &[], None).await;
+    assert_eq!(
+        (total(&r), r.json[0]["id"].as_str()),
+        (1, Some(v2.as_str())),
+        "{}",
+        r.text
+    );
+    // Undo, then delete again.
+    let r = app
+        .call("POST", "/api/models/{id}/restore", &[&v2], None)
+        .await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["deleted_at"].is_null()),
+        (200, true),
+        "{}",
+        r.text
+    );
+    let r = app.call("GET", "/api/models/{id}", &[&v2], None).await;
+    assert!(r.json["model"]["deleted_at"].is_null(), "{}", r.text);
+    assert_eq!(
+        app.call("POST", "/api/models/{id}/restore", &[&v2], None)
             .await
             .status,
-        404
+        409
+    );
+    assert_eq!(
+        app.call("DELETE", "/api/models/{id}", &[&v2], None)
+            .await
+            .status,
+        200
     );
     let v3 = common::stored_model(&app, &cid, &vid, Some(&v1), &[]).await;
     let r = app
@@ -415,7 +554,8 @@ async fn model_versions_are_deleted_unless_derived_from_and_campaigns_renamed() 
         app.call("DELETE", "/api/models/{id}", &[&v1], None)
             .await
             .status,
-        404
+        404,
+        "deleted already"
     );
     let r = app
         .call("DELETE", "/api/models/{id}?cascade=maybe", &[&v1], None)
@@ -471,34 +611,71 @@ async fn model_versions_are_deleted_unless_derived_from_and_campaigns_renamed() 
         .await;
     assert_eq!(r.status, 404, "{}", r.text);
 
-    // Rename a campaign.
-    let r = app
-        .call(
-            "PATCH",
-            "/api/campaigns/{id}",
-            &[&cid],
-            Some(json!({ "name": "March trials" })),
-        )
-        .await;
-    assert_eq!(r.json["spec"]["name"], "March trials", "{}", r.text);
-    let r = app.call("GET", "/api/campaigns/{id}", &[&cid], None).await;
-    assert_eq!(r.json["spec"]["name"], "March trials");
-    let r = app
-        .call(
-            "PATCH",
-            "/api/campaigns/{id}",
-            &[&cid],
-            Some(json!({ "name": "" })),
-        )
-        .await;
-    refused(&r, 422, "name");
-    let r = app
-        .call(
-            "PATCH",
-            "/api/campaigns/{id}",
-            &["nope"],
-            Some(json!({ "name": "x" })),
-        )
-        .await;
-    assert_eq!(r.status, 404, "{}", r.text);
+    // Rename a campaign and a vessel (names trimmed); an unknown field is refused.
+    for (route, id, name) in [
+        ("/api/campaigns/{id}", &cid, "/spec/name"),
+        ("/api/vessels/{id}", &vid, "/profile/name"),
+    ] {
+        let r = app
+            .call(
+                "PATCH",
+                route,
+                &[id],
+                Some(json!({ "name": " March trials " })),
+            )
+            .await;
+        assert_eq!(
+            r.json.pointer(name),
+            Some(&json!("March trials")),
+            "{}",
+            r.text
+        );
+        let r = app.call("GET", route, &[id], None).await;
+        assert_eq!(
+            r.json.pointer(name),
+            Some(&json!("March trials")),
+            "{}",
+            r.text
+        );
+        for (body, field) in [
+            (json!({ "name": "" }), "name"),
+            (json!({ "name": "x", "dofs": [] }), "dofs"),
+        ] {
+            let r = app.call("PATCH", route, &[id], Some(body)).await;
+            assert!(
+                r.status.is_client_error() && r.json["field"] == field,
+                "{route} {field}: {}",
+                r.text
+            );
+        }
+        let r = app
+            .call("PATCH", route, &["nope"], Some(json!({ "name": "x" })))
+            .await;
+        assert_eq!(r.status, 404, "{}", r.text);
+    }
+}
+
+#[tokio::test]
+async fn vessels_campaigns_and_jobs_are_paged_with_their_total() {
+    let app = TestApp::new().await;
+    vessel_and_campaign(&app, json!({})).await;
+    vessel_and_campaign(&app, json!({})).await;
+    for (path, len, all) in [
+        ("/api/vessels?limit=1", 1, 2),
+        ("/api/campaigns?limit=1&offset=1", 1, 2),
+        ("/api/campaigns?offset=2", 0, 2),
+        ("/api/jobs?limit=5", 0, 0),
+    ] {
+        let r = app.call("GET", path, &[], None).await;
+        assert_eq!(
+            (r.json.as_array().map(Vec::len), total(&r)),
+            (Some(len), all),
+            "{path}: {}",
+            r.text
+        );
+    }
+    for path in ["/api/vessels?limit=0", "/api/jobs?limit=1001"] {
+        let r = app.call("GET", path, &[], None).await;
+        refused(&r, 422, "limit");
+    }
 }

@@ -258,8 +258,8 @@ async fn every_documented_operation_is_exercised_and_answers() {
                     )
                     .await
                 }
-                // Deleting needs something of its own to delete.
-                ("delete", "/api/runs/{id}") => {
+                // Deleting and restoring need a run of their own (restoring, deleted first).
+                ("delete", "/api/runs/{id}") | ("post", "/api/runs/{id}/restore") => {
                     let r = app
                         .raw(
                             "POST",
@@ -268,15 +268,24 @@ async fn every_documented_operation_is_exercised_and_answers() {
                         )
                         .await;
                     let id = r.json["id"].as_str().unwrap().to_string();
-                    app.call("DELETE", template, &[&id], None).await
+                    if method == "post" {
+                        app.call("DELETE", "/api/runs/{id}", &[&id], None).await;
+                    }
+                    app.call(&method.to_uppercase(), template, &[&id], None)
+                        .await
                 }
                 ("delete", "/api/models/{id}") => {
                     let id = stored_model(&app, &cid, &vid).await;
                     app.call("DELETE", template, &[&id], None).await
                 }
-                ("patch", "/api/campaigns/{id}") => {
+                ("patch", "/api/campaigns/{id}" | "/api/vessels/{id}") => {
                     app.call("PATCH", template, &args, Some(json!({ "name": "walked" })))
                         .await
+                }
+                ("post", "/api/models/{id}/restore") => {
+                    let id = stored_model(&app, &cid, &vid).await;
+                    app.call("DELETE", "/api/models/{id}", &[&id], None).await;
+                    app.call("POST", template, &[&id], None).await
                 }
                 ("patch", "/api/models/{id}") => {
                     app.call(

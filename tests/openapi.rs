@@ -54,6 +54,9 @@ fn every_fixed_route_of_the_contract_is_documented() {
         ("patch", "/api/campaigns/{id}"),
         ("patch", "/api/models/{id}"),
         ("delete", "/api/models/{id}"),
+        ("patch", "/api/vessels/{id}"),
+        ("post", "/api/runs/{id}/restore"),
+        ("post", "/api/models/{id}/restore"),
     ] {
         assert!(
             spec["paths"][path][method].is_object(),
@@ -133,6 +136,13 @@ fn query_parameters_the_handlers_read_are_in_query() {
         ("/api/campaigns/{id}/runs", "get", "offset", false),
         ("/api/campaigns/{id}/runs", "get", "status", false),
         ("/api/models/{id}", "delete", "cascade", false),
+        ("/api/models/{id}", "delete", "reason", false),
+        ("/api/runs/{id}", "delete", "reason", false),
+        ("/api/models", "get", "deleted", false),
+        ("/api/vessels", "get", "limit", false),
+        ("/api/campaigns", "get", "offset", false),
+        ("/api/jobs", "get", "limit", false),
+        ("/api/campaigns/{id}/runs", "get", "deleted", false),
         ("/api/models/{id}", "get", "h", false),
         ("/api/models/{id}/export", "get", "format", false),
         ("/api/models/compare", "get", "a", true),

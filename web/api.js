@@ -85,7 +85,12 @@ export const api = {
   // What a run is: fields absent are kept, null clears a user value.
   describeRun: (rid, body) => request('PATCH', `/api/runs/${enc(rid)}`, body),
   // Delete a run (409 names the models built from it).
-  deleteRun: (rid) => request('DELETE', `/api/runs/${enc(rid)}`),
+  deleteRun: (rid, reason) => request('DELETE', `/api/runs/${enc(rid)}${reason ? `?reason=${enc(reason)}` : ''}`),
+  restoreRun: (rid) => request('POST', `/api/runs/${enc(rid)}/restore`),
+  deletedRuns: (id) => request('GET', `/api/campaigns/${enc(id)}/runs?deleted=true`),
+  renameRun: (rid, name) => request('PATCH', `/api/runs/${enc(rid)}`, { name }),
+  renameVessel: (id, name) => request('PATCH', `/api/vessels/${enc(id)}`, { name }).then(flatVessel),
+  renameCampaign: (id, name) => request('PATCH', `/api/campaigns/${enc(id)}`, { name }).then(flatCampaign),
   quality: (rid) => request('GET', urls.quality(rid)),
   // Every channel of a run over a window (`query`: from_s, to_s, points), with the window's statistics.
   runTraces: (rid, query) => request('GET', `/api/runs/${enc(rid)}/traces${query ? `?${query}` : ''}`),
@@ -105,7 +110,6 @@ export const api = {
   // `hSample`: add the ZOH-discretized Φ, Γ at this sample time.
   model: (mid, hSample) => request('GET', `/api/models/${enc(mid)}${hSample != null ? `?h=${enc(hSample)}` : ''}`),
   // Delete a model version; `cascade` also the versions derived from it (else 409 names them).
-  deleteModel: (mid, cascade) => request('DELETE', `/api/models/${enc(mid)}${cascade ? '?cascade=true' : ''}`),
   // Linear responses of a model for its plots.
   frequencyResponse: (mid, runId) => request('GET', `/api/models/${enc(mid)}/frequency-response${runId ? `?run_id=${enc(runId)}` : ''}`),
   poles: (mid) => request('GET', `/api/models/${enc(mid)}/poles`),
@@ -113,6 +117,10 @@ export const api = {
   hankel: (mid) => request('GET', `/api/models/${enc(mid)}/hankel`),
   // Several models validated on one run (`ids`: 1–6 model ids).
   compare: (ids, runId) => request('GET', `/api/models/compare?a=${enc(ids[0])}&b=${enc(ids[1] || ids[0])}${ids.length > 2 ? `&more=${enc(ids.slice(2).join(','))}` : ''}&run_id=${enc(runId)}`),
+  deleteModel: (mid, cascade, reason) => request('DELETE', `/api/models/${enc(mid)}?cascade=${cascade ? 'true' : 'false'}${reason ? `&reason=${enc(reason)}` : ''}`),
+  restoreModel: (mid) => request('POST', `/api/models/${enc(mid)}/restore`),
+  deletedModels: (campaignId) => request('GET', `/api/models?deleted=true&campaign_id=${enc(campaignId)}`),
+  renameModel: (mid, name) => request('PATCH', `/api/models/${enc(mid)}`, { name }),
   // Missing-physics discovery reports.
   discrepancies: (mid) => request('GET', `/api/models/${enc(mid)}/discrepancies`),
   discrepancy: (did) => request('GET', `/api/discrepancies/${enc(did)}`),

@@ -14,6 +14,7 @@ import { discoveryPage } from './discoverypage.js';
 import { destroyPlots } from './plots.js';
 import { whoAmI, loginForm } from './account.js';
 import { accountPage } from './accountpage.js';
+import { installTouchHelp } from './help.js';
 
 const view = document.getElementById('view');
 let current = null; // controller of the page shown (campaign page), if any
@@ -100,6 +101,13 @@ async function health() {
 }
 
 window.addEventListener('hashchange', route);
+// A page asks to be drawn again (forms.js reloadPage), even the campaign shown.
+window.addEventListener('seatrial:reload', () => {
+  if (current && current.destroy) current.destroy();
+  current = null;
+  route();
+});
+installTouchHelp();
 if (!location.hash) history.replaceState(null, '', '#/campaigns');
 // Who is signed in decides what is shown: the sign-in form, or the page
 // with the controls of the role.

@@ -1,7 +1,7 @@
 // The "Missing physics" panel of a model page: start a discovery job on the
-// model (its own runs, held-out runs kept held out), follow its progress,
-// open the report when it is done; earlier reports on the model; for an
-// augmented model, the report that produced it.
+// model (its own runs, held-out runs kept held out), follow its progress
+// (never backwards), cancel it, open the report when it is done; earlier
+// reports on the model; for an augmented model, the report that produced it.
 
 import { api, urls } from './api.js';
 import { fmtDate } from './format.js';
@@ -41,7 +41,18 @@ export async function discoveryPanel(model) {
     const bar = h('progress', { max: '1', value: 0, 'data-testid': 'discover-progress' });
     const text = h('span', { class: 'progress-text', 'data-testid': 'discover-stage' }, 'queued');
     const state = h('span');
-    fill(status, h('div', { class: 'progress-box' }, bar, text), state);
+    const cancel = h('button', {
+      type: 'button', class: 'btn small danger', 'data-testid': 'discover-cancel', 'data-needs': 'supervisor',
+      onClick: () => {
+        cancel.disabled = true;
+        api.cancelJob(job.id).catch((err) => {
+          cancel.disabled = false;
+          state.append(h('span', { class: 'error-text', role: 'alert' }, ` ${errLine(err)}`));
+        });
+      },
+    }, 'Cancel');
+    let lastState = null;
+    fill(status, h('div', { class: 'progress-box' }, bar, text), state, ' ', cancel);
     const poll = async () => {
       if (destroyed) return;
       try {
@@ -50,10 +61,14 @@ export async function discoveryPanel(model) {
         fill(status, h('span', { class: 'error-text', role: 'alert' }, errLine(err)));
         return;
       }
-      bar.value = job.state === 'succeeded' ? 1 : job.progress || 0;
+      // Never backwards within one attempt (a retry starts over).
+      const p = job.state === 'succeeded' ? 1 : job.progress || 0;
+      bar.value = job.state === lastState ? Math.max(bar.value, p) : p;
+      lastState = job.state;
       text.textContent = `${Math.round(bar.value * 100)} %${job.stage ? ` · ${job.stage}` : ''}`;
       fill(state, jobStateBadge(job.state));
       if (!TERMINAL.has(job.state)) { timer = setTimeout(poll, 400); return; }
+      cancel.remove();
       start.disabled = false;
       if (job.state === 'succeeded' && job.result && job.result.discrepancy_id) {
         location.hash = urls.discrepancy(job.result.discrepancy_id);

@@ -143,3 +143,8 @@ export function showError(root, err) {
   banner(`${status}${err.message}${where}`);
   if (err.field) showFieldError(root, err.field, err.message, err.limit);
 }
+
+/** Draws the page shown again from the server (after a rename, a restore). */
+export function reloadPage() {
+  window.dispatchEvent(new Event('seatrial:reload'));
+}

@@ -213,7 +213,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
   }
 
   // ---- jobs ---------------------------------------------------------------------
-  const jobsBox = h('div', { class: 'card jobs', 'data-testid': 'jobs', 'aria-label': 'Identification jobs' });
+  const jobsBox = h('div', { 'data-section': 'jobs', class: 'card jobs', 'data-testid': 'jobs', 'aria-label': 'Identification jobs' });
 
   function progressText(j) {
     const pct = `${Math.round((j.progress || 0) * 100)} %`;
@@ -247,9 +247,12 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
     const j = j0.state === 'succeeded' ? { ...j0, progress: 1 } : j0;
     r.job = j;
     r.tr.dataset.state = j.state;
-    r.bar.value = j.progress || 0;
-    r.bar.setAttribute('value', String(j.progress || 0));
-    r.text.textContent = progressText(j);
+    // Never backwards within one attempt (a retry, queued again, starts over).
+    const p = r.lastState === j.state ? Math.max(r.bar.value, j.progress || 0) : j.progress || 0;
+    r.lastState = j.state;
+    r.bar.value = p;
+    r.bar.setAttribute('value', String(p));
+    r.text.textContent = progressText({ ...j, progress: p });
     fill(r.state, jobStateBadge(j.state), j.cancel_requested && !TERMINAL.has(j.state) ? h('span', { class: 'hint' }, ' cancelling…') : null);
     const acts = [];
     if (!TERMINAL.has(j.state)) {
@@ -361,7 +364,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
   }
 
   // ---- models -------------------------------------------------------------------
-  const modelsBox = h('div', { class: 'card models', 'data-testid': 'models', 'aria-label': 'Models' });
+  const modelsBox = h('div', { 'data-section': 'models', class: 'card models', 'data-testid': 'models', 'aria-label': 'Models' });
 
   function renderModels() {
     if (!models.length) {

@@ -13,7 +13,7 @@ import { METHOD_LABEL, KIND_LABEL_MODEL, errLine } from './identify.js';
 import { predictionPlot, autocorrelationPlot, zoomGroup } from './modelplots.js';
 import { exact } from './runplots.js';
 import { discoveryPanel } from './discoverpanel.js';
-import { modelDeleteControl } from './manage.js';
+import { deletedBadge, modelManageControls } from './manage.js';
 import { modelViewsSection } from './modelviews.js';
 import { exportBar, uplotExportable } from './plotexport.js';
 
@@ -297,9 +297,9 @@ export async function modelPage(view, id) {
     h('nav', { class: 'crumbs muted', 'aria-label': 'Breadcrumb' }, h('a', { href: `#/campaigns/${model.campaign_id}`, 'data-testid': 'model-campaign-link' }, '← campaign')),
     h('div', { class: 'page-head' },
       h('div', null,
-        h('h1', { 'data-testid': 'model-title' }, model.name, h('span', { class: 'badge neutral' }, `v${model.version}`)),
+        h('h1', { 'data-testid': 'model-title' }, model.name, h('span', { class: 'badge neutral' }, `v${model.version}`), deletedBadge(model)),
         h('div', { class: 'muted' }, `${METHOD_LABEL[model.method] || model.method} · ${(doc.dofs || []).join(', ')} · inputs ${(doc.inputs || []).join(', ')} → outputs ${(doc.outputs || []).join(', ')}`)),
-      h('div', null, exportsBox, modelDeleteControl(model))),
+      h('div', null, exportsBox, modelManageControls(model))),
     provenance,
     h('h2', { class: 'section-title' }, 'Findings'),
     findings,

@@ -2,11 +2,14 @@
 // table, and one experiment (channels, schedule plot, PSD, exports).
 
 import { api, urls } from './api.js';
+import { renameControl } from './rename.js';
+import { deletedSection } from './trash.js';
+import { sectionNav } from './sectionnav.js';
 import {
   FAMILY_LABEL, KIND_LABEL, SIGNAL_LABEL, bandText, describeWaveform, fmt, fmtDate, fmtKn, hms,
   peText, secs, unitLabel,
 } from './format.js';
-import { h, fill, banner, clearBanner } from './forms.js';
+import { h, fill, banner, clearBanner, reloadPage } from './forms.js';
 import { DURATIONS, gridText } from './campaigns.js';
 import { schedulePlot, psdPlot, destroyPlots } from './plots.js';
 import { runsSection } from './runs.js';
@@ -105,6 +108,8 @@ export async function campaignPage(view, id) {
   const loading = h('span', { class: 'loading', hidden: true, role: 'status', 'aria-live': 'polite', 'data-testid': 'plan-loading' }, h('span', { class: 'spinner', 'aria-hidden': 'true' }), 'Generating plan…');
   const exportLinks = h('span', { class: 'actions' });
   const planHost = h('section', { class: 'plan', 'aria-label': 'Plan' });
+  const planTitle = h('h2', { class: 'section-title', 'data-section': 'plan' }, 'Plan');
+  const trash = deletedSection(id, () => reloadPage());
   const runsHost = h('section', { class: 'runs', 'aria-label': 'Runs', 'data-testid': 'runs-section' });
   const identifyHost = h('section', { class: 'identification', 'aria-label': 'Identification', 'data-testid': 'identify-section' });
   let runs = null; // the Runs section's controller
@@ -118,7 +123,7 @@ export async function campaignPage(view, id) {
         h('h1', { 'data-testid': 'campaign-title' }, c.name),
         h('div', { class: 'muted' }, 'Campaign for ', vessel ? h('a', { href: `#/vessels/${vessel.id}` }, vessel.name) : c.vessel_id,
           vessel ? ` · ${KIND_LABEL[vessel.kind] || vessel.kind}` : '', ` · created ${fmtDate(c.created_at)}`)),
-      h('div', { class: 'actions' }, loading, exportLinks, genBtn)),
+      h('div', { class: 'actions' }, renameControl({ what: 'campaign', name: c.name, needs: 'supervisor', save: (n) => api.renameCampaign(c.id, n) }), loading, exportLinks, genBtn)),
     h('dl', { class: 'summary', 'data-testid': 'campaign-summary' },
       h('dt', null, 'Grid'), h('dd', null, gridText(c), h('span', { class: 'muted' }, ` = ${c.grid_speeds_mps.map((x) => fmt(x)).join(', ')} m/s`)),
       h('dt', null, 'Families'), h('dd', null, c.families.map((f) => FAMILY_LABEL[f] || f).join(', ')),
@@ -126,11 +131,13 @@ export async function campaignPage(view, id) {
       h('dt', null, 'Excitation'), h('dd', null, excitationText(c)),
       h('dt', null, 'Durations'), h('dd', null, DURATIONS.filter((d) => durs[d.key] != null).map((d) => `${d.label.toLowerCase()} ${fmt(durs[d.key])} s`).join(' · ') || 'defaults'),
       h('dt', null, 'Seed'), h('dd', { class: 'mono' }, c.seed ?? 'default')),
+    sectionNav([['runs', 'Runs'], ['coverage', 'Coverage'], ['jobs', 'Jobs'], ['models', 'Models'], ['plan', 'Plan'], ['deleted', 'Deleted']]),
     runsHost,
     campaignOffsetPanel(c.id),
     identifyHost,
-    h('h2', { class: 'section-title' }, 'Plan'),
-    planHost);
+    planTitle,
+    planHost,
+    trash.host);
 
   async function generate() {
     genBtn.disabled = true;

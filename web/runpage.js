@@ -15,7 +15,8 @@ import { spectrumPlot, singularValuePlot, syncX, exact } from './runplots.js';
 import { verdictBadge, statusBadge, coverageBadge, errorWhere, errorText, rawLinks, unitWarnings } from './runs.js';
 import { runOffsetPanel } from './offsetpanel.js';
 import { descriptionSection } from './rundescribe.js';
-import { excludedBadge, runManageSection } from './manage.js';
+import { deletedBadge, excludedBadge, runManageSection } from './manage.js';
+import { renameControl } from './rename.js';
 import { runTracesSection } from './runtraces.js';
 import { exportBar, uplotExportable } from './plotexport.js';
 
@@ -164,14 +165,14 @@ export async function runPage(view, rid) {
   fill(view,
     h('div', { class: 'page-head' },
       h('div', null,
-        h('h1', { 'data-testid': 'run-title' }, run.name, statusBadge(run.status, run), excludedBadge(run)),
+        h('h1', { 'data-testid': 'run-title' }, run.name, statusBadge(run.status, run), excludedBadge(run), deletedBadge(run)),
         h('div', { class: 'muted' },
           'Run of ', campaign ? h('a', { href: `#/campaigns/${campaign.id}`, 'data-testid': 'run-campaign-link' }, campaign.name) : run.campaign_id,
           run.experiment_id ? [' · experiment ',
             exp ? h('a', { class: 'mono', href: `#/campaigns/${run.campaign_id}/experiments/${run.experiment_id}`, 'data-testid': 'run-experiment' }, exp.code) : h('span', { title: run.experiment_id }, 'of an older plan'),
             exp ? [' ', coverageBadge(exp.status)] : null] : ' · not assigned to an experiment',
           ` · ${run.layout === 'split' ? 'control + nav logs' : 'one log'} · uploaded ${fmtDate(run.created_at)}`)),
-      h('div', { class: 'actions' }, rawLinks(run),
+      h('div', { class: 'actions' }, renameControl({ what: 'run', name: run.name, needs: 'supervisor', save: (n) => api.renameRun(run.id, n) }), rawLinks(run),
         run.status === 'accepted' ? h('a', { class: 'btn small', href: urls.quality(run.id), target: '_blank', rel: 'noopener', 'data-testid': 'quality-json-link' }, 'Quality JSON') : null)),
 
     run.status === 'rejected' ? h('div', { class: 'upload-error big', role: 'alert', 'data-testid': 'run-error' },

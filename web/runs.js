@@ -330,7 +330,7 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
   }
 
   // -- coverage
-  const covBox = h('div', { class: 'card coverage', 'data-testid': 'coverage', 'aria-label': 'Coverage' });
+  const covBox = h('div', { 'data-section': 'coverage', class: 'card coverage', 'data-testid': 'coverage', 'aria-label': 'Coverage' });
 
   function renderCoverage() {
     if (!plan) {
@@ -402,36 +402,67 @@ export async function runsSection(host, { campaign, plan: plan0, onRuns = null }
   }
 
   // -- run list
-  const listBox = h('div', { class: 'run-list', 'data-testid': 'run-list' });
+  const listBox = h('div', { class: 'run-list', 'data-testid': 'run-list', 'data-section': 'runs' });
+
+  // Runs shown per page of the list (a campaign may hold hundreds).
+  const PAGE = 20;
+  let pageNo = 0;
+
+  function runRow(r, codes) {
+    const v = (r.summary && r.summary.verdicts) || [];
+    const size = r.files.reduce((a, f) => a + f.size_bytes, 0);
+    return h('tr', { 'data-testid': 'run-row', 'data-run-id': r.id, 'data-status': r.status },
+      h('td', { class: 'nowrap' }, fmtDate(r.created_at)),
+      h('td', null, h('a', { href: urls.run(r.id), 'data-testid': 'run-link' }, r.name)),
+      h('td', { class: 'mono nowrap' }, r.experiment_id ? codes.get(r.experiment_id) || h('span', { class: 'muted', title: r.experiment_id }, 'older plan') : h('span', { class: 'muted' }, '–')),
+      h('td', { class: 'nowrap' }, describeCell(r)),
+      h('td', null, r.layout === 'split' ? 'control + nav' : 'one log'),
+      h('td', null, statusBadge(r.status, r), r.excluded ? [' ', excludedBadge(r)] : null),
+      h('td', { class: 'badges' }, v.map((x) => verdictBadge(x))),
+      h('td', { class: 'num', title: r.files.map((f) => `${f.role}: ${f.filename}, ${f.size_bytes} bytes`).join('\n') }, bytes(size)));
+  }
+
+  /** Rejected uploads, apart from the runs, each removable (a soft delete: undo under "Deleted"). */
+  function rejectedBox(rejected) {
+    if (!rejected.length) return null;
+    const msg = h('div', { 'aria-live': 'polite' });
+    return h('div', { class: 'rejected-list', 'data-testid': 'rejected-list' },
+      h('h3', null, `Rejected uploads (${rejected.length}) `, h('span', { class: 'hint' }, 'invalid files, kept as received; fix and upload again, then remove them')),
+      h('ul', { class: 'plain' }, rejected.slice().reverse().map((r) => h('li', { 'data-testid': 'run-row', 'data-run-id': r.id, 'data-status': r.status },
+        h('a', { href: urls.run(r.id) }, r.name), ' ',
+        h('span', { class: 'error-text', 'data-testid': 'run-error' }, errorWhere(r.error, r.files), r.error && r.error.message ? h('span', { class: 'muted' }, ` — ${errorText(r.error.message)}`) : null), ' ',
+        h('button', {
+          type: 'button', class: 'btn small danger', 'data-needs': 'supervisor', 'data-testid': 'remove-rejected',
+          onclick: () => api.deleteRun(r.id, 'rejected upload removed').then(refresh, (e) => fill(msg, h('p', { class: 'error-text', role: 'alert' }, e.message))),
+        }, 'Remove')))),
+      msg);
+  }
 
   function renderRuns() {
     const codes = new Map(plan ? plan.experiments.map((e) => [e.id, e.code]) : []);
+    const good = runs.filter((r) => r.status !== 'rejected');
+    const rejected = runs.filter((r) => r.status === 'rejected');
     if (!runs.length) {
       fill(listBox, h('h3', null, 'Runs'), h('p', { class: 'empty', 'data-testid': 'no-runs' }, 'No runs uploaded yet.'));
       return;
     }
-    const rows = runs.slice().reverse().map((r) => {
-      const v = (r.summary && r.summary.verdicts) || [];
-      const size = r.files.reduce((a, f) => a + f.size_bytes, 0);
-      return h('tr', { 'data-testid': 'run-row', 'data-run-id': r.id, 'data-status': r.status },
-        h('td', { class: 'nowrap' }, fmtDate(r.created_at)),
-        h('td', null, h('a', { href: urls.run(r.id), 'data-testid': 'run-link' }, r.name)),
-        h('td', { class: 'mono nowrap' }, r.experiment_id ? codes.get(r.experiment_id) || h('span', { class: 'muted', title: r.experiment_id }, 'older plan') : h('span', { class: 'muted' }, '–')),
-        h('td', { class: 'nowrap' }, describeCell(r)),
-        h('td', null, r.layout === 'split' ? 'control + nav' : 'one log'),
-        h('td', null, statusBadge(r.status, r), r.excluded ? [' ', excludedBadge(r)] : null),
-        h('td', { class: 'badges' }, r.status === 'rejected'
-          ? h('span', { class: 'error-text', 'data-testid': 'run-error' }, errorWhere(r.error, r.files), r.error && r.error.message ? h('span', { class: 'muted' }, ` — ${errorText(r.error.message)}`) : null)
-          : v.map((x) => verdictBadge(x))),
-        h('td', { class: 'num', title: r.files.map((f) => `${f.role}: ${f.filename}, ${f.size_bytes} bytes`).join('\n') }, bytes(size)));
-    });
-    fill(listBox, h('h3', null, `Runs (${runs.length}) `, h('span', { class: 'hint' }, 'newest first · badge colours: green good, amber weak, red insufficient; hover for the reason')),
-      h('div', { class: 'table-x' },
+    const pages = Math.max(1, Math.ceil(good.length / PAGE));
+    pageNo = Math.min(pageNo, pages - 1);
+    const shown = good.slice().reverse().slice(pageNo * PAGE, (pageNo + 1) * PAGE);
+    const go = (p) => { pageNo = p; renderRuns(); };
+    const pager = pages > 1 ? h('nav', { class: 'pager actions', 'aria-label': 'Pages of runs', 'data-testid': 'runs-pager' },
+      h('button', { type: 'button', class: 'btn small', disabled: pageNo === 0, 'data-testid': 'runs-prev', onclick: () => go(pageNo - 1) }, '‹ newer'),
+      h('span', { class: 'muted', 'data-testid': 'runs-page' }, `${pageNo * PAGE + 1}–${pageNo * PAGE + shown.length} of ${good.length}`),
+      h('button', { type: 'button', class: 'btn small', disabled: pageNo >= pages - 1, 'data-testid': 'runs-next', onclick: () => go(pageNo + 1) }, 'older ›')) : null;
+    fill(listBox, h('h3', null, `Runs (${good.length}) `, h('span', { class: 'hint' }, 'newest first · badge colours: green good, amber weak, red insufficient; tap a badge for the reason')),
+      good.length ? h('div', { class: 'table-x' },
         h('table', { class: 'grid-table runs-table', 'data-testid': 'runs-table' },
           h('thead', null, h('tr', null, h('th', null, 'Uploaded'), h('th', null, 'Name'), h('th', null, 'Experiment'),
             h('th', { title: 'role · grid speed · excited DOFs; “?”: inferred from the data, confirm on the run page' }, 'What it is'), h('th', null, 'Layout'),
             h('th', null, 'Status'), h('th', null, 'Verdict per DOF'), h('th', { class: 'num' }, 'Size'))),
-          h('tbody', null, rows))));
+          h('tbody', null, shown.map((r) => runRow(r, codes))))) : null,
+      pager,
+      rejectedBox(rejected));
   }
 
   async function refresh() {

@@ -1,6 +1,7 @@
 // Vessels: list, one vessel, and the create form (from a template).
 
 import { api } from './api.js';
+import { renameControl } from './rename.js';
 import {
   DOFS, KIND_LABEL, dofUnits, fmt, fmtDate, fmtU, knots, FAMILY_LABEL,
 } from './format.js';
@@ -89,6 +90,7 @@ export async function vesselPage(view, id) {
     h('div', { class: 'page-head' },
       h('h1', null, v.name, h('span', { class: 'tag' }, KIND_LABEL[v.kind] || v.kind)),
       h('div', { class: 'actions' },
+        renameControl({ what: 'vessel', name: v.name, needs: 'engineer', save: (n) => api.renameVessel(v.id, n) }),
         h('a', { class: 'btn', href: `#/vessels/new?from=${encodeURIComponent(v.id)}`, 'data-needs': 'engineer' }, 'Copy as new vessel'),
         h('a', { class: 'btn primary', href: `#/campaigns/new?vessel=${encodeURIComponent(v.id)}`, 'data-testid': 'new-campaign-for-vessel', 'data-needs': 'supervisor' }, '+ New campaign'))),
     h('dl', { class: 'summary' },

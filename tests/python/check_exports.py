@@ -11,11 +11,14 @@ tests/api_exports.rs):
   TAG-step.json  the service's step response: y(k) under a unit step on
                  every input from x = 0, per point, computed from that Φ, Γ
   TAG.m          format=matlab (run in Octave when it is installed)
+  TAG.mat        format=mat        (scipy.io.loadmat)
 
 For each model: the npz matrices equal the stored ones exactly; A, B of the
 npz and of ss_json, discretized by scipy.signal.cont2discrete (or taken as
 they are for a discrete model), simulated by scipy.signal.dlsim, give the
-service's step response within 1e-9 (relative to its largest value).
+service's step response within 1e-9 (relative to its largest value). The
+.mat holds the same arrays (a stack over grid speeds as MATLAB's r×c×p),
+names and units as cell rows; its A, B simulate to the same response.
 Prints one line per check and ends with 'N passed, M failed'; exits 1 on
 any failure.
 """
@@ -27,7 +30,7 @@ import subprocess
 import sys
 
 import numpy as np
-from scipy import signal
+from scipy import io, signal
 
 TOL = 1e-9
 passed = 0
@@ -108,7 +111,41 @@ def check_model(d, tag):
                 close(bd, discrete[i]["gamma"], f"{tag}[{i}]: cont2discrete({src} A, B) = Γ")
             y = simulate(ad, bd, c, dd, step["steps"])
             close(y, service, f"{tag}[{i}]: dlsim({src}) step response = the service's")
+    check_mat(d, tag, z, ss, step, models, continuous)
     octave(d, tag, doc)
+
+
+def page(m, i, stacked):
+    """Matrix i of a .mat array: page i of an r×c×p stack, or the matrix itself."""
+    return m[:, :, i] if stacked and m.ndim == 3 else (m if m.ndim == 2 else m[:, :, 0])
+
+
+def check_mat(d, tag, z, ss, step, models, continuous):
+    """The .mat export: same arrays as the npz, names and units, a true simulation."""
+    m = io.loadmat(d / f"{tag}.mat")
+    meta = json.loads(str(m["metadata"][0]))
+    check(meta["format"] == "seatrial-mat/1", f"{tag}.mat: metadata")
+    names = [str(x[0]) for x in m["output_names"][0]]
+    check(names == [c["name"] for c in ss["outputs"]], f"{tag}.mat: output names")
+    units = [str(x[0]) for x in m["input_units"][0]]
+    check(units == [c["unit"] for c in ss["inputs"]], f"{tag}.mat: input units")
+    check(float(m["h"][0, 0]) == step["h"], f"{tag}.mat: h")
+    stacked = "grid_speeds_mps" in z
+    if stacked:
+        check(np.array_equal(m["grid_speeds_mps"][0], z["grid_speeds_mps"]), f"{tag}.mat: grid speeds")
+    for key in z.files:
+        if z[key].dtype.kind == "f" and z[key].ndim == 3:
+            check(np.array_equal(np.moveaxis(m[key], 2, 0), z[key]), f"{tag}.mat: {key} = npz {key} (r×c×p)")
+        elif z[key].dtype.kind == "f" and z[key].ndim == 2:
+            check(np.array_equal(m[key], z[key]), f"{tag}.mat: {key} = npz {key}")
+    h = step["h"]
+    for i in range(len(models)):
+        p = ss["points"][i]
+        c, dd = np.array(p["C"], float), np.array(p["D"], float)
+        a, b = page(m["A"], i, stacked), page(m["B"], i, stacked)
+        ad, bd = zoh(a, b, h) if continuous else (a, b)
+        y = simulate(ad, bd, c, dd, step["steps"])
+        close(y, np.array(step["points"][i]), f"{tag}[{i}].mat: dlsim step response = the service's")
 
 
 def octave(d, tag, doc):

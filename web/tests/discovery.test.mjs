@@ -95,3 +95,28 @@ test('discover the demo ROV\'s missing restoring from the model page and read th
     await page.locator(tid('discover-report-link')).first().waitFor();
   });
 });
+
+test('a discovery is cancelled from its panel, its progress never going backwards', async () => {
+  await H.withPage([], async (page) => {
+    await page.goto(`${H.base}/#/models/${mid}`);
+    await page.locator(tid('discovery-panel')).waitFor();
+    // Record every value the bar shows.
+    await page.evaluate(() => {
+      window.shown = [];
+      new MutationObserver(() => {
+        const bar = document.querySelector('[data-testid="discover-progress"]');
+        if (bar) window.shown.push(bar.value);
+      }).observe(document.body, { subtree: true, childList: true, characterData: true });
+    });
+    await page.getByRole('button', { name: 'Discover missing physics' }).click();
+    await page.locator(tid('discover-cancel')).click();
+    const jobs = await H.api('GET', '/api/jobs');
+    const job = jobs.json.filter((j) => j.kind === 'discover').sort((a, b) => (a.id < b.id ? 1 : -1))[0];
+    const done = await waitJob(job.id, 120);
+    assert.equal(done.state, 'cancelled', JSON.stringify(done));
+    await page.locator(`${tid('discover-status')} >> text=cancelled`).first().waitFor();
+    assert.equal(await page.locator(tid('discover-cancel')).count(), 0, 'no cancel once the job ended');
+    const shown = await page.evaluate(() => window.shown);
+    assert.ok(shown.every((v, i) => i === 0 || v >= shown[i - 1]), `progress went backwards: ${shown}`);
+  });
+});

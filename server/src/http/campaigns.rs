@@ -8,11 +8,12 @@ use seatrial_core::planning::{CampaignSpec, ExperimentFamily, SpeedGrid, generat
 use serde::Deserialize;
 
 use super::json::ApiJson;
-use super::query::ApiQuery;
+use super::query::{ApiQuery, Paging, paged};
 use super::{AppState, blocking, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::storage::campaigns::{self, Campaign};
 use crate::storage::vessels;
+use axum::response::Response;
 
 /// A new campaign: the vessel it is for, and the campaign itself.
 #[derive(Debug, Deserialize, utoipa::ToSchema)]
@@ -92,15 +93,24 @@ pub async fn create_campaign(
     ))
 }
 
-/// List campaigns.
+/// List campaigns, oldest first; `limit`/`offset` page the list and the
+/// `X-Total-Count` header gives how many match.
 #[utoipa::path(get, path = "/api/campaigns", tag = "planning",
-    params(CampaignFilter),
-    responses((status = 200, description = "Campaigns, oldest first", body = [Campaign])))]
+    params(CampaignFilter, Paging),
+    responses((status = 200, description = "Campaigns, oldest first", body = [Campaign],
+                headers(("x-total-count" = i64, description = "Campaigns that match the filter (all pages)"))),
+              (status = 400, description = "Malformed query parameter", body = ErrorBody),
+              (status = 422, description = "`limit` outside 1–1000", body = ErrorBody)))]
 pub async fn list_campaigns(
     State(s): State<AppState>,
     ApiQuery(f): ApiQuery<CampaignFilter>,
-) -> ApiResult<Json<Vec<Campaign>>> {
-    Ok(Json(campaigns::list(&s.db, f.vessel_id.as_deref()).await?))
+    ApiQuery(p): ApiQuery<Paging>,
+) -> ApiResult<Response> {
+    let page = p.page()?;
+    Ok(paged(
+        campaigns::list(&s.db, f.vessel_id.as_deref()).await?,
+        page,
+    ))
 }
 
 /// One campaign.

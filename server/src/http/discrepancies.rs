@@ -74,12 +74,13 @@ pub async fn get_discrepancy(
         Some(mid) => models::get(&s.db, mid).await?.map(|m| m.summary),
         None => None,
     };
-    let run_names = runs::list(&s.db, &d.summary.campaign_id)
-        .await?
-        .into_iter()
-        .filter(|r| d.run_ids.contains(&r.id) || d.validation_run_ids.contains(&r.id))
-        .map(|r| (r.id, r.name))
-        .collect();
+    // By id: a deleted run keeps its name in the report.
+    let mut run_names = std::collections::BTreeMap::new();
+    for rid in d.run_ids.iter().chain(&d.validation_run_ids) {
+        if let Some(r) = runs::get(&s.db, rid).await? {
+            run_names.insert(r.id, r.name);
+        }
+    }
     Ok(Json(DiscrepancyView {
         discrepancy: d.summary,
         model,

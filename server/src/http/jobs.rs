@@ -11,7 +11,7 @@ use futures_util::StreamExt;
 use serde::Deserialize;
 
 use super::json::ApiJson;
-use super::query::ApiQuery;
+use super::query::{ApiQuery, Paging, paged};
 use super::{AppState, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
 use crate::jobs::{self, JobEvent};
@@ -69,17 +69,22 @@ pub struct JobFilter {
     pub state: Option<String>,
 }
 
-/// Jobs, newest first.
+/// Jobs, newest first; `limit`/`offset` page the list and the
+/// `X-Total-Count` header gives how many match.
 #[utoipa::path(get, path = "/api/jobs", tag = "jobs",
-    params(JobFilter),
+    params(JobFilter, Paging),
     responses(
-        (status = 200, description = "Jobs, newest first", body = [Job]),
+        (status = 200, description = "Jobs, newest first", body = [Job],
+            headers(("x-total-count" = i64, description = "Jobs that match the filters (all pages)"))),
         (status = 400, description = "Unknown `state`", body = ErrorBody),
-        (status = 404, description = "No such campaign", body = ErrorBody)))]
+        (status = 404, description = "No such campaign", body = ErrorBody),
+        (status = 422, description = "`limit` outside 1–1000", body = ErrorBody)))]
 pub async fn list_jobs(
     State(s): State<AppState>,
     ApiQuery(q): ApiQuery<JobFilter>,
-) -> ApiResult<Json<Vec<Job>>> {
+    ApiQuery(p): ApiQuery<Paging>,
+) -> ApiResult<Response> {
+    let page = p.page()?;
     let state = match q.state.as_deref() {
         None => None,
         Some(v) => Some(JobState::parse(v).ok_or_else(|| {
@@ -99,7 +104,10 @@ pub async fn list_jobs(
         ));
     }
     let list = stored::list(&s.db, q.campaign_id.as_deref(), state).await?;
-    Ok(Json(list.into_iter().map(|j| fresh(&s, j)).collect()))
+    Ok(paged(
+        list.into_iter().map(|j| fresh(&s, j)).collect(),
+        page,
+    ))
 }
 
 /// One job: state, progress 0–1, stage, result or error, attempts, times.

@@ -1,14 +1,12 @@
-//! Managing what is stored: rename a campaign, rename or annotate a model,
-//! delete a model version (runs: `PATCH`/`DELETE /api/runs/{id}` in
-//! `run_description` and `runs`). Every write is one transaction.
+//! Managing what is stored: rename a campaign, rename or annotate a model
+//! (vessels: `vessels`; runs: `PATCH /api/runs/{id}` in `run_description`;
+//! deletes and their undo: `lifecycle`). Every write is one transaction.
 
 use axum::Json;
 use axum::extract::{Path, State};
-use axum::http::StatusCode;
 use serde::Deserialize;
 
 use super::json::ApiJson;
-use super::query::ApiQuery;
 use super::run_description::{MAX_NOTES_CHARS, check_name};
 use super::{AppState, found};
 use crate::error::{ApiError, ApiResult, ErrorBody};
@@ -108,55 +106,4 @@ pub async fn patch_model(
     }
     let m = found(models::get(&s.db, &id).await?, "model", &id)?;
     Ok(Json(m.summary))
-}
-
-/// Options of a model deletion.
-#[derive(Debug, Deserialize, utoipa::IntoParams)]
-#[into_params(parameter_in = Query)]
-pub struct DeleteModelQuery {
-    /// Also delete every version derived from this one (default false: 409 when there is one).
-    pub cascade: Option<bool>,
-}
-
-/// What a model deletion removed.
-#[derive(Debug, serde::Serialize, utoipa::ToSchema)]
-pub struct DeletedModels {
-    /// The model and, with `cascade`, the versions derived from it.
-    pub deleted: Vec<String>,
-}
-
-/// Delete a model version with its discovery reports. A version another
-/// was derived from (an augmented model, a re-identification) is kept with a
-/// 409 naming them, unless `?cascade=true` deletes those too; so is a model a
-/// queued or running job works on. The runs it was built from stay.
-#[utoipa::path(delete, path = "/api/models/{id}", tag = "models",
-    params(("id" = String, Path, description = "Model id"), DeleteModelQuery),
-    responses(
-        (status = 200, description = "Deleted: the ids removed", body = DeletedModels),
-        (status = 400, description = "Malformed `cascade`", body = ErrorBody),
-        (status = 404, description = "No such model", body = ErrorBody),
-        (status = 409, description = "Versions were derived from it (without `cascade`), or a job works on it; the message names them", body = ErrorBody)))]
-pub async fn delete_model(
-    State(s): State<AppState>,
-    Path(id): Path<String>,
-    ApiQuery(q): ApiQuery<DeleteModelQuery>,
-) -> ApiResult<(StatusCode, Json<DeletedModels>)> {
-    match models::delete(&s.db, &id, q.cascade.unwrap_or(false)).await? {
-        models::Deleted::NotFound => Err(ApiError::NotFound(format!("no model with id '{id}'"))),
-        models::Deleted::InUse(why) => Err(ApiError::Conflict(format!(
-            "model '{id}' is kept: {}{}",
-            why.join("; "),
-            if why.iter().any(|w| w.contains("derived")) {
-                " (delete with ?cascade=true to remove those versions too)"
-            } else {
-                ""
-            }
-        ))),
-        models::Deleted::Gone(deleted) => {
-            for gone in &deleted {
-                s.model_cache.forget(gone);
-            }
-            Ok((StatusCode::OK, Json(DeletedModels { deleted })))
-        }
-    }
 }

@@ -12,6 +12,7 @@ pub mod exposure;
 pub mod health;
 pub mod jobs;
 pub mod json;
+pub mod lifecycle;
 pub mod manage;
 pub mod model_cache;
 pub mod model_export;
@@ -141,7 +142,7 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(auth::users::patch_user))
         .routes(routes!(auth::users::list_audit))
         .routes(routes!(vessels::create_vessel, vessels::list_vessels))
-        .routes(routes!(vessels::get_vessel))
+        .routes(routes!(vessels::get_vessel, vessels::patch_vessel))
         .routes(routes!(
             campaigns::create_campaign,
             campaigns::list_campaigns
@@ -155,8 +156,9 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(
             runs::get_run,
             run_description::describe_run,
-            runs::delete_run
+            lifecycle::delete_run
         ))
+        .routes(routes!(lifecycle::restore_run))
         .routes(routes!(runs::raw_run))
         .routes(routes!(runs::run_quality))
         .routes(routes!(run_traces::run_traces))
@@ -179,8 +181,9 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(
             models::get_model,
             manage::patch_model,
-            manage::delete_model
+            lifecycle::delete_model
         ))
+        .routes(routes!(lifecycle::restore_model))
         .routes(routes!(model_export::export_model))
         .routes(routes!(model_views::frequency_response))
         .routes(routes!(model_views::poles))

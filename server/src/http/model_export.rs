@@ -1,6 +1,6 @@
 //! Downloading a model: the whole document (JSON), the parameter table
-//! (CSV), the Fossen-form set, a MATLAB/Octave script, NumPy arrays (`.npz`)
-//! and plain state space (JSON or CSV). Files are named `<name>-v<version>`
+//! (CSV), the Fossen-form set, a MATLAB/Octave script, NumPy arrays (`.npz`),
+//! a MAT-file (`.mat`) and plain state space (JSON or CSV). Files are named `<name>-v<version>`
 //! with `filename*=` for names beyond ASCII.
 
 use axum::extract::{Path, State};
@@ -8,6 +8,7 @@ use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use seatrial_core::identification::document::ModelKind;
 use seatrial_core::identification::export::{fossen_parameter_set, parameter_csv};
+use seatrial_core::identification::export_mat::mat_export;
 use seatrial_core::identification::export_matlab::matlab_script;
 use seatrial_core::identification::export_npz::npz_export;
 use seatrial_core::identification::export_state_space::{state_space_csv, state_space_export};
@@ -29,12 +30,14 @@ pub struct ExportQuery {
     /// PythonVehicleSimulator), `matlab` (a `.m` script defining the struct
     /// `model`), `npz` (NumPy arrays: every matrix per grid speed with its
     /// std, loads, g(η), names and units, and the ZOH A_d, B_d at `h`),
+    /// `mat` (the same arrays as a MAT-file for MATLAB `load` and
+    /// `scipy.io.loadmat`; a stack over the grid speeds is `r×c×p`),
     /// `ss_json` or `ss_csv` (A, B, C, D with named states, inputs and
     /// outputs, units, offsets u0/y0 and sample time; continuous unless `h`
     /// is given).
     #[param(value_type = Option<ExportFormat>)]
     pub format: Option<String>,
-    /// Sample time h (s). `npz`: the h of A_d, B_d (default: the vessel's
+    /// Sample time h (s). `npz`, `mat`: the h of A_d, B_d (default: the vessel's
     /// log interval; an N4SID model's own h). `ss_json`/`ss_csv`: the
     /// ZOH-discretized model at h instead of the continuous one (an N4SID
     /// model is discrete at its own h and refuses another). Others ignore it.
@@ -56,6 +59,8 @@ pub enum ExportFormat {
     Matlab,
     /// NumPy `.npz` (uncompressed zip of `.npy` arrays).
     Npz,
+    /// MAT-file (Level 5): the `.npz` arrays for MATLAB/Octave `load` and `scipy.io.loadmat`.
+    Mat,
     /// State space A, B, C, D with names, units, offsets, sample time (JSON).
     SsJson,
     /// The same as a long CSV, one matrix entry per row.
@@ -103,7 +108,7 @@ fn pretty<T: Serialize>(v: &T) -> ApiResult<String> {
 #[utoipa::path(get, path = "/api/models/{id}/export", tag = "models",
     params(("id" = String, Path, description = "Model id"), ExportQuery),
     responses(
-        (status = 200, description = "The export, a file to save: NumPy arrays (`npz`), JSON (`json`, `fossen`, `ss_json`), CSV (`csv`, `ss_csv`) or a MATLAB script (`matlab`). The binary content comes first so that generated clients hand every format over as a file", content(
+        (status = 200, description = "The export, a file to save: NumPy arrays (`npz`), a MAT-file (`mat`), JSON (`json`, `fossen`, `ss_json`), CSV (`csv`, `ss_csv`) or a MATLAB script (`matlab`). The binary content comes first so that generated clients hand every format over as a file", content(
             (BinaryFile = "application/octet-stream"),
             (JsonExport = "application/json"),
             (String = "text/csv"),
@@ -152,7 +157,7 @@ pub async fn export_model(
                 stem.replace(|c: char| !c.is_ascii_alphanumeric(), "_")
             ),
         )),
-        "npz" => {
+        fmt @ ("npz" | "mat") => {
             let h = match (q.h, doc.state_space.as_ref()) {
                 (Some(h), _) => h,
                 (None, Some(ss)) if doc.kind == ModelKind::StateSpace => ss.h,
@@ -169,11 +174,16 @@ pub async fn export_model(
                     1.0 / vessel.profile.logger_rate_hz
                 }
             };
-            let bytes = npz_export(doc, name, version, h).map_err(h_error)?;
+            let bytes = if fmt == "mat" {
+                mat_export(doc, name, version, h)
+            } else {
+                npz_export(doc, name, version, h)
+            }
+            .map_err(h_error)?;
             Ok(attachment(
                 bytes,
                 "application/octet-stream",
-                format!("{stem}.npz"),
+                format!("{stem}.{fmt}"),
             ))
         }
         "ss_json" => {
@@ -195,7 +205,7 @@ pub async fn export_model(
         other => Err(ApiError::bad_field(
             "format",
             format!(
-                "unknown export format '{other}'; use json, csv, fossen, matlab, npz, ss_json or ss_csv"
+                "unknown export format '{other}'; use json, csv, fossen, matlab, mat, npz, ss_json or ss_csv"
             ),
         )),
     }

@@ -29,10 +29,13 @@ pub struct ModelFilter {
     pub campaign_id: Option<String>,
     /// Only the versions of this lineage.
     pub lineage_id: Option<String>,
+    /// `true`: the deleted versions instead of the live ones (default false).
+    pub deleted: Option<bool>,
 }
 
-/// Models, newest first (metadata only); `limit`/`offset` page the list and
-/// the `X-Total-Count` header gives how many match.
+/// Models, newest first (metadata only), without the deleted versions
+/// (`?deleted=true` lists those); `limit`/`offset` page the list and the
+/// `X-Total-Count` header gives how many match.
 #[utoipa::path(get, path = "/api/models", tag = "models", params(ModelFilter, Paging),
     responses((status = 200, description = "Models, newest first", body = [ModelSummary],
                 headers(("x-total-count" = i64, description = "Models that match the filters (all pages)"))),
@@ -48,6 +51,7 @@ pub async fn list_models(
         &s.db,
         f.campaign_id.as_deref(),
         f.lineage_id.as_deref(),
+        f.deleted.unwrap_or(false),
         page,
     )
     .await?;

@@ -81,6 +81,17 @@ impl Paging {
     }
 }
 
+/// One page of a list read whole (a short one: vessels, campaigns, jobs),
+/// with the number of items in the `X-Total-Count` header.
+pub fn paged<T: serde::Serialize>(items: Vec<T>, page: Page) -> Response {
+    let total = items.len() as i64;
+    let offset = usize::try_from(page.offset).unwrap_or(usize::MAX);
+    let limit = page
+        .limit
+        .map_or(usize::MAX, |l| usize::try_from(l).unwrap_or(usize::MAX));
+    with_total(items.into_iter().skip(offset).take(limit).collect(), total)
+}
+
 /// A list with its total in the `X-Total-Count` header.
 pub fn with_total<T: serde::Serialize>(items: Vec<T>, total: i64) -> Response {
     ([(TOTAL_HEADER, total.to_string())], Json(items)).into_response()

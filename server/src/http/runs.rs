@@ -295,11 +295,14 @@ pub struct RunFilter {
     /// Only runs with this status: `accepted`, `rejected` (uploads that failed
     /// validation, listed apart) or `stored`.
     pub status: Option<String>,
+    /// `true`: the deleted runs instead of the live ones (default false).
+    pub deleted: Option<bool>,
 }
 
 const RUN_STATUSES: [&str; 3] = ["stored", "accepted", "rejected"];
 
-/// Runs of a campaign, oldest first, each with `excluded` (left out of
+/// Runs of a campaign, oldest first, without the deleted ones
+/// (`?deleted=true` lists those), each with `excluded` (left out of
 /// identification) and its reason; `limit`/`offset` page the list and the
 /// `X-Total-Count` header gives how many match.
 #[utoipa::path(get, path = "/api/campaigns/{id}/runs", tag = "runs",
@@ -325,51 +328,15 @@ pub async fn list_runs(
         ));
     }
     found(campaigns::get(&s.db, &id).await?, "campaign", &id)?;
-    let (items, total) = runs::page(&s.db, &id, f.status.as_deref(), page).await?;
+    let (items, total) = runs::page(
+        &s.db,
+        &id,
+        f.status.as_deref(),
+        f.deleted.unwrap_or(false),
+        page,
+    )
+    .await?;
     Ok(with_total(items, total))
-}
-
-/// What deleting a run removed.
-#[derive(Debug, serde::Serialize, utoipa::ToSchema)]
-pub struct DeletedRun {
-    /// The run's id.
-    pub deleted: String,
-    /// SHA-256 of the stored files removed with it (a file another run shares stays).
-    pub files_removed: Vec<String>,
-}
-
-/// Delete a run with its files (a file another run shares stays), quality
-/// report and clock offset. A run a model or discovery report was built from
-/// is kept (409 naming them): delete those models first, or exclude the run.
-#[utoipa::path(delete, path = "/api/runs/{id}", tag = "runs",
-    params(("id" = String, Path, description = "Run id")),
-    responses((status = 200, description = "Deleted: the run and the stored files that went with it", body = DeletedRun),
-              (status = 404, description = "No such run", body = ErrorBody),
-              (status = 409, description = "Models or discovery reports were built from it; the message names them", body = ErrorBody)))]
-pub async fn delete_run(
-    State(s): State<AppState>,
-    Path(id): Path<String>,
-) -> ApiResult<Json<DeletedRun>> {
-    match runs::delete(&s.db, &id).await? {
-        runs::Deleted::NotFound => Err(ApiError::NotFound(format!("no run with id '{id}'"))),
-        runs::Deleted::InUse(users) => Err(ApiError::Conflict(format!(
-            "run '{id}' is kept: {} {} built from it; delete {} first, or exclude the run from identification",
-            users.join(", "),
-            if users.len() == 1 { "was" } else { "were" },
-            if users.len() == 1 { "it" } else { "them" },
-        ))),
-        runs::Deleted::Gone(orphans) => {
-            for sha in &orphans {
-                if let Err(e) = s.blobs.remove(sha).await {
-                    tracing::warn!(sha256 = %sha, error = %e, "removing the file of a deleted run");
-                }
-            }
-            Ok(Json(DeletedRun {
-                deleted: id,
-                files_removed: orphans,
-            }))
-        }
-    }
 }
 
 /// One run: files, status, summary (rates, gaps, warnings, alignment,

@@ -29,9 +29,19 @@ async fn the_model(cx: &JobContext, req: &JobRequest) -> Result<StoredModel, Api
             "discover needs the model to examine (model_id)",
         ));
     };
-    models::get(&cx.db, id)
+    let m = models::get(&cx.db, id)
         .await?
-        .ok_or_else(|| ApiError::missing("model_id", format!("no model with id '{id}'")))
+        .ok_or_else(|| ApiError::missing("model_id", format!("no model with id '{id}'")))?;
+    if let Some(at) = &m.summary.deleted_at {
+        return Err(ApiError::invalid(
+            "model_id",
+            format!(
+                "model '{}' v{} ({id}) was deleted at {at}; restore it (POST /api/models/{id}/restore) first",
+                m.summary.name, m.summary.version
+            ),
+        ));
+    }
+    Ok(m)
 }
 
 impl JobHandler for Discover {
@@ -107,9 +117,16 @@ impl JobHandler for Discover {
             let all = runs::list(&cx.db, &cid).await?;
             let mut chosen = Vec::new();
             for id in est_ids.iter().chain(&val_ids) {
-                let run = all.iter().find(|r| &r.id == id).cloned().ok_or_else(|| {
-                    JobFailure::field("run_ids", format!("run '{id}' of the model is gone"))
-                })?;
+                let Some(run) = all.iter().find(|r| &r.id == id).cloned() else {
+                    let name = runs::get(&cx.db, id).await?.map(|r| r.name);
+                    return Err(JobFailure::field(
+                        "run_ids",
+                        format!(
+                            "run '{}' ({id}) of the model is deleted; restore it (POST /api/runs/{id}/restore) to use it",
+                            name.as_deref().unwrap_or("?")
+                        ),
+                    ));
+                };
                 chosen.push(run);
             }
             let stored = run_inputs::describe(cx, &cid, chosen).await?;

@@ -9,6 +9,7 @@ use tokio::sync::watch;
 
 use super::progress::JobEvent;
 use super::service::Jobs;
+use crate::storage::jobs::JobState;
 use crate::storage::{Db, jobs};
 
 /// Fastest event rate per subscriber (progress coalesces in between).
@@ -73,6 +74,7 @@ async fn next(mut f: Follow) -> Option<(JobEvent, Follow)> {
                 }
             }
         };
+        let event = monotone(f.last.as_ref(), event);
         if f.last.as_ref() == Some(&event) {
             if f.live.is_none() {
                 tokio::time::sleep(POLL).await;
@@ -82,5 +84,53 @@ async fn next(mut f: Follow) -> Option<(JobEvent, Follow)> {
         f.done = event.state.is_terminal();
         f.last = Some(event.clone());
         return Some((event, f));
+    }
+}
+
+/// Progress never goes backwards within one running attempt: a reading of
+/// the database (its heartbeat lags the live channel) or a stage that
+/// reports from zero again keeps the highest fraction already sent. A new
+/// attempt (queued again, then running) starts over.
+fn monotone(last: Option<&JobEvent>, mut e: JobEvent) -> JobEvent {
+    if let Some(l) = last
+        && l.state == e.state
+        && e.state == JobState::Running
+        && e.progress < l.progress
+    {
+        e.progress = l.progress;
+    }
+    e
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(state: JobState, progress: f64, stage: &str) -> JobEvent {
+        JobEvent {
+            state,
+            progress,
+            stage: stage.into(),
+        }
+    }
+
+    #[test]
+    fn progress_never_goes_backwards_while_running() {
+        let mut last: Option<JobEvent> = None;
+        let mut sent = Vec::new();
+        for e in [
+            ev(JobState::Queued, 0.0, "queued"),
+            ev(JobState::Running, 0.39, "fit"),
+            ev(JobState::Running, 0.36, "fit"),
+            ev(JobState::Running, 1.0, "fit"),
+            ev(JobState::Running, 0.79, "store"),
+            ev(JobState::Queued, 0.0, "retry"),
+            ev(JobState::Running, 0.1, "fit"),
+        ] {
+            let e = monotone(last.as_ref(), e);
+            sent.push(e.progress);
+            last = Some(e);
+        }
+        assert_eq!(sent, [0.0, 0.39, 0.39, 1.0, 1.0, 0.0, 0.1]);
     }
 }

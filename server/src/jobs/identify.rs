@@ -161,7 +161,10 @@ impl JobHandler for Identify {
                 let mut v = Vec::new();
                 for id in &req.run_ids {
                     v.push(all.iter().find(|r| &r.id == id).cloned().ok_or_else(|| {
-                        JobFailure::field("run_ids", format!("run '{id}' is gone"))
+                        JobFailure::field(
+                            "run_ids",
+                            format!("run '{id}' was deleted after the job was queued"),
+                        )
                     })?);
                 }
                 v

@@ -93,8 +93,10 @@ impl Progress for JobProgress {
     fn update(&mut self, fraction: f64, stage: &str) -> Result<(), Cancelled> {
         let mut new_stage = false;
         self.events.send_if_modified(|e| {
+            // Monotone: a stage that counts from zero again never shows
+            // the engineer a bar going backwards.
             let f = if fraction.is_finite() {
-                fraction.clamp(0.0, 1.0)
+                fraction.clamp(0.0, 1.0).max(e.progress)
             } else {
                 e.progress
             };
@@ -123,7 +125,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn publishes_clamped_progress_and_stops_on_any_flag() {
+    fn publishes_clamped_monotone_progress_and_stops_on_any_flag() {
         let (tx, rx) = watch::channel(JobEvent {
             state: JobState::Running,
             progress: 0.0,
@@ -140,6 +142,9 @@ mod tests {
         assert_eq!(rx.borrow().progress, 1.0);
         assert!(p.update(f64::NAN, "fit").is_ok());
         assert_eq!(rx.borrow().progress, 1.0);
+        assert!(p.update(0.3, "store").is_ok());
+        assert_eq!(rx.borrow().progress, 1.0, "never backwards");
+        assert_eq!(rx.borrow().stage, "store");
         flags.cancel.store(true, Ordering::Relaxed);
         assert_eq!(p.update(1.0, "fit"), Err(Cancelled));
         flags.cancel.store(false, Ordering::Relaxed);

@@ -64,12 +64,21 @@ async fn check_campaign_and_runs(cx: &JobContext, request: &JobRequest) -> Resul
         let run = runs::get(&cx.db, rid)
             .await?
             .ok_or_else(|| ApiError::missing(field.clone(), format!("no run with id '{rid}'")))?;
+        let named = format!("run '{}' ({rid})", run.name);
         if run.campaign_id != campaign.id {
             return Err(ApiError::invalid(
                 field,
                 format!(
-                    "run '{rid}' belongs to campaign '{}', not to '{}'",
+                    "{named} belongs to campaign '{}', not to '{}'",
                     run.campaign_id, campaign.id
+                ),
+            ));
+        }
+        if let Some(at) = &run.deleted_at {
+            return Err(ApiError::invalid(
+                field,
+                format!(
+                    "{named} was deleted at {at}; restore it (POST /api/runs/{rid}/restore) or leave it out"
                 ),
             ));
         }
@@ -77,7 +86,7 @@ async fn check_campaign_and_runs(cx: &JobContext, request: &JobRequest) -> Resul
             return Err(ApiError::invalid(
                 field,
                 format!(
-                    "run '{rid}' is {} (not accepted at upload): it has no usable data",
+                    "{named} is {} (not accepted at upload): it has no usable data",
                     run.status
                 ),
             ));

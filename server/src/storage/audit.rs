@@ -27,6 +27,8 @@ pub struct AuditEntry {
     pub target_id: Option<String>,
     /// The response's status code.
     pub status: i64,
+    /// The reason given with the write (e.g. why something was deleted), if any.
+    pub note: Option<String>,
 }
 
 /// What a new entry says (its id and time are set on insert).
@@ -48,13 +50,15 @@ pub struct NewAudit {
     pub target_id: Option<String>,
     /// Status code.
     pub status: u16,
+    /// The reason given with the write.
+    pub note: Option<String>,
 }
 
 /// Appends an entry.
 pub async fn insert(db: &Db, e: NewAudit) -> anyhow::Result<()> {
     sqlx::query(
-        "INSERT INTO audit (id, at, user_id, user_name, via, method, route, path, target_id, status) \
-         VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10)",
+        "INSERT INTO audit (id, at, user_id, user_name, via, method, route, path, target_id, status, note) \
+         VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)",
     )
     .bind(new_id())
     .bind(now())
@@ -66,6 +70,7 @@ pub async fn insert(db: &Db, e: NewAudit) -> anyhow::Result<()> {
     .bind(&e.path)
     .bind(&e.target_id)
     .bind(i64::from(e.status))
+    .bind(&e.note)
     .execute(db)
     .await?;
     Ok(())
@@ -78,7 +83,7 @@ pub async fn page(
     page: Page,
 ) -> anyhow::Result<(Vec<AuditEntry>, i64)> {
     let items = sqlx::query_as(
-        "SELECT id, at, user_id, user_name, via, method, route, path, target_id, status \
+        "SELECT id, at, user_id, user_name, via, method, route, path, target_id, status, note \
          FROM audit WHERE ($1 IS NULL OR user_id = $1) ORDER BY id DESC LIMIT $2 OFFSET $3",
     )
     .bind(user_id)

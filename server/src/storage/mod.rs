@@ -79,6 +79,17 @@ pub(crate) async fn lock_row(
         > 0)
 }
 
+/// What restoring a deleted item did.
+#[derive(Debug, PartialEq, Eq)]
+pub enum Restored {
+    /// No such item.
+    NotFound,
+    /// It was not deleted; nothing changed.
+    NotDeleted,
+    /// Restored.
+    Done,
+}
+
 /// A new time-ordered id.
 pub fn new_id() -> String {
     uuid::Uuid::now_v7().to_string()

@@ -6,7 +6,7 @@
 use serde::Serialize;
 use sqlx::SqliteConnection;
 
-use super::{Db, Page, lock_row, new_id, now};
+use super::{Db, Page, Restored, lock_row, new_id, now};
 
 /// A stored model without its (large) document and validation.
 #[derive(Debug, Clone, Serialize, sqlx::FromRow, utoipa::ToSchema)]
@@ -37,6 +37,14 @@ pub struct ModelSummary {
     pub created_at: String,
     /// The engineer's notes.
     pub notes: Option<String>,
+    /// When it was deleted (RFC 3339; `null`: not deleted). A deleted version
+    /// stays readable by id (provenance) but leaves the lists; `POST
+    /// /api/models/{id}/restore` undoes the delete.
+    pub deleted_at: Option<String>,
+    /// Who deleted it (user name).
+    pub deleted_by: Option<String>,
+    /// Why it was deleted.
+    pub delete_reason: Option<String>,
 }
 
 /// A stored model with provenance, document and validation (JSON).
@@ -95,7 +103,7 @@ pub struct NewModel {
 }
 
 const SUMMARY: &str = "id, lineage_id, version, parent_id, campaign_id, vessel_id, kind, method, \
-                       name, software_version, job_id, created_at, notes";
+                       name, software_version, job_id, created_at, notes, deleted_at, deleted_by, delete_reason";
 
 /// Stores a model inside the caller's transaction (so a job's success and its
 /// model commit together); versions are assigned here.
@@ -164,7 +172,7 @@ pub async fn latest_of_method(
     Ok(
         sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
             "SELECT {SUMMARY} FROM model WHERE campaign_id = $1 AND method = $2 \
-         ORDER BY created_at DESC, version DESC LIMIT 1"
+         AND deleted_at IS NULL ORDER BY created_at DESC, version DESC LIMIT 1"
         )))
         .bind(campaign_id)
         .bind(method)
@@ -216,24 +224,27 @@ pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<StoredModel>> {
 }
 
 /// A page of models, newest first, optionally of one campaign or lineage,
-/// and the number that match.
+/// the live ones or (`deleted`) the deleted ones, and the number that match.
 pub async fn page(
     db: &Db,
     campaign_id: Option<&str>,
     lineage_id: Option<&str>,
+    deleted: bool,
     page: Page,
 ) -> anyhow::Result<(Vec<ModelSummary>, i64)> {
-    const WHERE: &str =
-        "WHERE ($1 IS NULL OR campaign_id = $1) AND ($2 IS NULL OR lineage_id = $2)";
+    let filter = format!(
+        "WHERE ($1 IS NULL OR campaign_id = $1) AND ($2 IS NULL OR lineage_id = $2) AND deleted_at IS {}",
+        if deleted { "NOT NULL" } else { "NULL" }
+    );
     let (total,): (i64,) = sqlx::query_as(sqlx::AssertSqlSafe(format!(
-        "SELECT COUNT(*) FROM model {WHERE}"
+        "SELECT COUNT(*) FROM model {filter}"
     )))
     .bind(campaign_id)
     .bind(lineage_id)
     .fetch_one(db)
     .await?;
     let items = sqlx::query_as::<_, ModelSummary>(sqlx::AssertSqlSafe(format!(
-        "SELECT {SUMMARY} FROM model {WHERE} ORDER BY created_at DESC, version DESC LIMIT $3 OFFSET $4"
+        "SELECT {SUMMARY} FROM model {filter} ORDER BY created_at DESC, version DESC LIMIT $3 OFFSET $4"
     )))
     .bind(campaign_id)
     .bind(lineage_id)
@@ -272,31 +283,39 @@ pub async fn update(
 /// What deleting a model did.
 #[derive(Debug)]
 pub enum Deleted {
-    /// No such model.
+    /// No such model (or it is deleted already).
     NotFound,
-    /// Versions derived from it (without `cascade`), or jobs waiting on it,
-    /// as phrases naming them; nothing changed.
+    /// Live versions derived from it (without `cascade`), or jobs waiting on
+    /// it, as phrases naming them; nothing changed.
     InUse(Vec<String>),
     /// The ids deleted: the model, then (with `cascade`) what was derived from it.
     Gone(Vec<String>),
 }
 
-/// Deletes a model version with its discovery reports, in one transaction.
-/// A version another was derived from (`parent_id`) is refused unless
-/// `cascade`, which deletes the derived versions too; so is a model a queued
-/// or running job works on. Discovery reports of a deleted model go with it;
-/// a report whose augmented model is deleted keeps its text without the link.
-pub async fn delete(db: &Db, id: &str, cascade: bool) -> anyhow::Result<Deleted> {
+/// Soft-deletes a model version, in one transaction: it keeps its row (so
+/// the provenance of what was derived from it stays readable) and its
+/// discovery reports, with who deleted it, when and why. A version a live
+/// one was derived from (`parent_id`) is refused unless `cascade`, which
+/// deletes the derived versions too; so is a model a queued or running job
+/// works on.
+pub async fn delete(
+    db: &Db,
+    id: &str,
+    cascade: bool,
+    by: &str,
+    reason: Option<&str>,
+) -> anyhow::Result<Deleted> {
     let mut tx = db.begin().await?;
-    if !lock_row(&mut tx, "model", id).await? {
+    if !lock_row(&mut tx, "model", id).await? || is_deleted(&mut tx, id).await? {
         return Ok(Deleted::NotFound);
     }
-    // The model and everything derived from it, parents before children.
+    // The model and everything live derived from it, parents before children.
     let mut ids = vec![id.to_string()];
     let mut i = 0;
     while i < ids.len() {
         let children: Vec<(String, String, i64)> = sqlx::query_as(
-            "SELECT id, name, version FROM model WHERE parent_id = $1 ORDER BY version",
+            "SELECT id, name, version FROM model WHERE parent_id = $1 AND deleted_at IS NULL \
+             ORDER BY version",
         )
         .bind(&ids[i])
         .fetch_all(&mut *tx)
@@ -328,22 +347,46 @@ pub async fn delete(db: &Db, id: &str, cascade: bool) -> anyhow::Result<Deleted>
     if !busy.is_empty() {
         return Ok(Deleted::InUse(busy));
     }
-    for m in ids.iter().rev() {
+    let at = now();
+    for m in &ids {
         sqlx::query(
-            "UPDATE discrepancy SET augmented_model_id = NULL WHERE augmented_model_id = $1",
+            "UPDATE model SET deleted_at = $1, deleted_by = $2, delete_reason = $3 WHERE id = $4",
         )
+        .bind(&at)
+        .bind(by)
+        .bind(reason)
         .bind(m)
         .execute(&mut *tx)
         .await?;
-        sqlx::query("DELETE FROM discrepancy WHERE model_id = $1")
-            .bind(m)
-            .execute(&mut *tx)
-            .await?;
-        sqlx::query("DELETE FROM model WHERE id = $1")
-            .bind(m)
-            .execute(&mut *tx)
-            .await?;
     }
     tx.commit().await?;
     Ok(Deleted::Gone(ids))
+}
+
+async fn is_deleted(conn: &mut SqliteConnection, id: &str) -> anyhow::Result<bool> {
+    let at: Option<Option<String>> =
+        sqlx::query_scalar("SELECT deleted_at FROM model WHERE id = $1")
+            .bind(id)
+            .fetch_optional(conn)
+            .await?;
+    Ok(at.flatten().is_some())
+}
+
+/// Undoes the soft delete of one model version, in one transaction.
+pub async fn restore(db: &Db, id: &str) -> anyhow::Result<Restored> {
+    let mut tx = db.begin().await?;
+    if !lock_row(&mut tx, "model", id).await? {
+        return Ok(Restored::NotFound);
+    }
+    if !is_deleted(&mut tx, id).await? {
+        return Ok(Restored::NotDeleted);
+    }
+    sqlx::query(
+        "UPDATE model SET deleted_at = NULL, deleted_by = NULL, delete_reason = NULL WHERE id = $1",
+    )
+    .bind(id)
+    .execute(&mut *tx)
+    .await?;
+    tx.commit().await?;
+    Ok(Restored::Done)
 }

@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::blobs::StoredBlob;
 use sqlx::SqliteConnection;
 
-use super::{Db, Page, lock_row, new_id, now};
+use super::{Db, Page, Restored, lock_row, new_id, now};
 
 /// One uploaded file of a run.
 #[derive(Debug, Clone, Serialize, sqlx::FromRow, utoipa::ToSchema)]
@@ -62,6 +62,15 @@ pub struct Run {
     pub excluded_reason: Option<String>,
     /// When it was excluded (RFC 3339).
     pub excluded_at: Option<String>,
+    /// When it was deleted (RFC 3339; `null`: not deleted). A deleted run
+    /// stays readable by id (the provenance of models built from it) but
+    /// leaves the lists and identification; `POST /api/runs/{id}/restore`
+    /// undoes the delete.
+    pub deleted_at: Option<String>,
+    /// Who deleted it (user name).
+    pub deleted_by: Option<String>,
+    /// Why it was deleted.
+    pub delete_reason: Option<String>,
 }
 
 #[derive(sqlx::FromRow)]
@@ -85,13 +94,16 @@ struct Row {
     excluded: bool,
     excluded_reason: Option<String>,
     excluded_at: Option<String>,
+    deleted_at: Option<String>,
+    deleted_by: Option<String>,
+    delete_reason: Option<String>,
 }
 
 /// The run's columns, and its planned experiment's description (if any).
 const FROM: &str = "SELECT r.id, r.campaign_id, r.experiment_id, r.name, r.layout, r.status, r.error, \
      r.summary, r.created_at, r.role, r.grid_speed_mps, r.excited_dofs, r.signal, r.notes, \
-     r.inferred, e.detail AS plan_detail, r.excluded, r.excluded_reason, r.excluded_at \
-     FROM run r LEFT JOIN experiment e ON e.id = r.experiment_id";
+     r.inferred, e.detail AS plan_detail, r.excluded, r.excluded_reason, r.excluded_at, \
+     r.deleted_at, r.deleted_by, r.delete_reason FROM run r LEFT JOIN experiment e ON e.id = r.experiment_id";
 
 impl Row {
     fn user(&self) -> anyhow::Result<UserDescription> {
@@ -151,6 +163,9 @@ async fn with_files(db: &Db, r: Row) -> anyhow::Result<Run> {
         excluded: r.excluded,
         excluded_reason: r.excluded_reason,
         excluded_at: r.excluded_at,
+        deleted_at: r.deleted_at,
+        deleted_by: r.deleted_by,
+        delete_reason: r.delete_reason,
     })
 }
 
@@ -358,10 +373,10 @@ pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Run>> {
     }
 }
 
-/// The runs of a campaign, oldest first.
+/// The runs of a campaign that are not deleted, oldest first.
 pub async fn list(db: &Db, campaign_id: &str) -> anyhow::Result<Vec<Run>> {
     let rows = sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!(
-        "{FROM} WHERE r.campaign_id = $1 ORDER BY r.id"
+        "{FROM} WHERE r.campaign_id = $1 AND r.deleted_at IS NULL ORDER BY r.id"
     )))
     .bind(campaign_id)
     .fetch_all(db)
@@ -401,23 +416,27 @@ pub async fn quality(db: &Db, id: &str) -> anyhow::Result<Option<String>> {
     )
 }
 
-/// A page of a campaign's runs, oldest first, optionally of one status, and
-/// the number of runs that match.
+/// A page of a campaign's runs, oldest first, optionally of one status, the
+/// live ones or (`deleted`) the deleted ones, and the number of runs that match.
 pub async fn page(
     db: &Db,
     campaign_id: &str,
     status: Option<&str>,
+    deleted: bool,
     page: Page,
 ) -> anyhow::Result<(Vec<Run>, i64)> {
-    let (total,): (i64,) = sqlx::query_as(
-        "SELECT COUNT(*) FROM run WHERE campaign_id = $1 AND ($2 IS NULL OR status = $2)",
-    )
+    let gone = if deleted { "NOT NULL" } else { "NULL" };
+    let (total,): (i64,) = sqlx::query_as(sqlx::AssertSqlSafe(format!(
+        "SELECT COUNT(*) FROM run WHERE campaign_id = $1 AND ($2 IS NULL OR status = $2) \
+         AND deleted_at IS {gone}"
+    )))
     .bind(campaign_id)
     .bind(status)
     .fetch_one(db)
     .await?;
     let rows = sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!(
-        "{FROM} WHERE r.campaign_id = $1 AND ($2 IS NULL OR r.status = $2) ORDER BY r.id LIMIT $3 OFFSET $4"
+        "{FROM} WHERE r.campaign_id = $1 AND ($2 IS NULL OR r.status = $2) \
+         AND r.deleted_at IS {gone} ORDER BY r.id LIMIT $3 OFFSET $4"
     )))
     .bind(campaign_id)
     .bind(status)
@@ -481,14 +500,15 @@ pub async fn update(
     Ok(true)
 }
 
-/// What is built from a run: the models (estimation or validation) and the
-/// discovery reports that used it, as `kind 'name' v<version> (id)` phrases.
+/// What is built from a run: the live models (estimation or validation)
+/// and the discovery reports that used it, as `kind 'name' v<version> (id)`
+/// phrases.
 pub async fn users(conn: &mut SqliteConnection, id: &str) -> anyhow::Result<Vec<String>> {
     // Ids are UUIDs: a quoted id matches exactly one element of a JSON list.
     let quoted = format!("%\"{id}\"%");
     let models: Vec<(String, String, i64)> = sqlx::query_as(
-        "SELECT id, name, version FROM model WHERE run_ids LIKE $1 OR validation_run_ids LIKE $1 \
-         ORDER BY created_at",
+        "SELECT id, name, version FROM model WHERE (run_ids LIKE $1 OR validation_run_ids LIKE $1) \
+         AND deleted_at IS NULL ORDER BY created_at",
     )
     .bind(&quoted)
     .fetch_all(&mut *conn)
@@ -514,53 +534,58 @@ pub async fn users(conn: &mut SqliteConnection, id: &str) -> anyhow::Result<Vec<
 /// What deleting a run did.
 #[derive(Debug)]
 pub enum Deleted {
-    /// No such run.
+    /// No such run (or it is deleted already).
     NotFound,
-    /// Models or reports were built from it (phrases naming them); nothing changed.
-    InUse(Vec<String>),
-    /// Deleted; these blobs are no longer referenced by any run (their files may go).
+    /// Deleted; the models and reports built from it (phrases naming them)
+    /// keep their provenance.
     Gone(Vec<String>),
 }
 
-/// Deletes a run with its files' rows, quality report and clock offset, in
-/// one transaction, unless a model or discovery report was built from it.
-pub async fn delete(db: &Db, id: &str) -> anyhow::Result<Deleted> {
+/// Soft-deletes a run, in one transaction: it keeps its row, files and
+/// quality report (so every model built from it keeps a readable
+/// provenance), with who deleted it, when and why.
+pub async fn delete(db: &Db, id: &str, by: &str, reason: Option<&str>) -> anyhow::Result<Deleted> {
     let mut tx = db.begin().await?;
-    // The write lock first: no model can be stored from the run between the
-    // check and the delete.
-    if !lock_row(&mut tx, "run", id).await? {
+    if !lock_row(&mut tx, "run", id).await? || deleted_at(&mut tx, id).await?.is_some() {
         return Ok(Deleted::NotFound);
     }
     let users = users(&mut tx, id).await?;
-    if !users.is_empty() {
-        return Ok(Deleted::InUse(users));
-    }
-    let blobs: Vec<(String,)> = sqlx::query_as("SELECT sha256 FROM run_file WHERE run_id = $1")
-        .bind(id)
-        .fetch_all(&mut *tx)
-        .await?;
-    for sql in [
-        "DELETE FROM run_quality WHERE run_id = $1",
-        "DELETE FROM run_clock_offset WHERE run_id = $1",
-        "DELETE FROM run_file WHERE run_id = $1",
-        "DELETE FROM run WHERE id = $1",
-    ] {
-        sqlx::query(sql).bind(id).execute(&mut *tx).await?;
-    }
-    let mut orphans = Vec::new();
-    for (sha,) in blobs {
-        let deleted = sqlx::query(
-            "DELETE FROM blob WHERE sha256 = $1 \
-             AND NOT EXISTS (SELECT 1 FROM run_file WHERE sha256 = $1)",
-        )
-        .bind(&sha)
-        .execute(&mut *tx)
-        .await?
-        .rows_affected();
-        if deleted > 0 {
-            orphans.push(sha);
-        }
-    }
+    sqlx::query(
+        "UPDATE run SET deleted_at = $1, deleted_by = $2, delete_reason = $3 WHERE id = $4",
+    )
+    .bind(now())
+    .bind(by)
+    .bind(reason)
+    .bind(id)
+    .execute(&mut *tx)
+    .await?;
     tx.commit().await?;
-    Ok(Deleted::Gone(orphans))
+    Ok(Deleted::Gone(users))
+}
+
+async fn deleted_at(conn: &mut SqliteConnection, id: &str) -> anyhow::Result<Option<String>> {
+    let at: Option<Option<String>> = sqlx::query_scalar("SELECT deleted_at FROM run WHERE id = $1")
+        .bind(id)
+        .fetch_optional(conn)
+        .await?;
+    Ok(at.flatten())
+}
+
+/// Undoes the soft delete of a run, in one transaction.
+pub async fn restore(db: &Db, id: &str) -> anyhow::Result<Restored> {
+    let mut tx = db.begin().await?;
+    if !lock_row(&mut tx, "run", id).await? {
+        return Ok(Restored::NotFound);
+    }
+    if deleted_at(&mut tx, id).await?.is_none() {
+        return Ok(Restored::NotDeleted);
+    }
+    sqlx::query(
+        "UPDATE run SET deleted_at = NULL, deleted_by = NULL, delete_reason = NULL WHERE id = $1",
+    )
+    .bind(id)
+    .execute(&mut *tx)
+    .await?;
+    tx.commit().await?;
+    Ok(Restored::Done)
 }

@@ -3,7 +3,7 @@
 use seatrial_core::planning::VesselProfile;
 use serde::Serialize;
 
-use super::{Db, new_id, now};
+use super::{Db, lock_row, new_id, now};
 
 /// A stored vessel.
 #[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
@@ -77,4 +77,27 @@ pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Vessel>> {
         .await?
         .map(Vessel::try_from)
         .transpose()
+}
+
+/// Renames a vessel (its profile's name and the name column), in one
+/// transaction; `None` when there is no such vessel.
+pub async fn rename(db: &Db, id: &str, name: &str) -> anyhow::Result<Option<Vessel>> {
+    let mut tx = db.begin().await?;
+    if !lock_row(&mut tx, "vessel", id).await? {
+        return Ok(None);
+    }
+    let row = sqlx::query_as::<_, Row>("SELECT id, profile, created_at FROM vessel WHERE id = $1")
+        .bind(id)
+        .fetch_one(&mut *tx)
+        .await?;
+    let mut v = Vessel::try_from(row)?;
+    v.profile.name = name.to_string();
+    sqlx::query("UPDATE vessel SET name = $1, profile = $2 WHERE id = $3")
+        .bind(name)
+        .bind(serde_json::to_string(&v.profile)?)
+        .bind(id)
+        .execute(&mut *tx)
+        .await?;
+    tx.commit().await?;
+    Ok(Some(v))
 }

@@ -27,6 +27,11 @@ pub struct AuditActor {
     pub user_name: String,
 }
 
+/// The reason a handler was given for a write (a delete's `reason`), for
+/// the audit row (set on its response).
+#[derive(Debug, Clone)]
+pub struct AuditNote(pub String);
+
 /// Largest response body read back for the id of what a write created.
 const MAX_AUDIT_BODY: usize = 4 << 20;
 
@@ -167,6 +172,7 @@ pub async fn guard(State(s): State<AppState>, mut req: Request, next: Next) -> R
         (None, None) => return resp,
     };
     let status = resp.status();
+    let note = resp.extensions().get::<AuditNote>().map(|n| n.0.clone());
     let (target_id, resp) = match path_id(&route, &path) {
         Some(id) => (Some(id), resp),
         None => created_id(resp).await,
@@ -180,6 +186,7 @@ pub async fn guard(State(s): State<AppState>, mut req: Request, next: Next) -> R
         path,
         target_id,
         status: status.as_u16(),
+        note,
     };
     if let Err(e) = audit::insert(&s.db, entry).await {
         tracing::error!(error = %e, "could not write the audit row of a write");
