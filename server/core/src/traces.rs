@@ -216,7 +216,7 @@ mod tests {
                     .map(|k| if k == 537 { 9.0 } else { k as f64 })
                     .collect(),
             ],
-            valid: vec![0..n],
+            valid: std::iter::once(0..n).collect(),
         }
     }
 
