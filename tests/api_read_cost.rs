@@ -87,11 +87,25 @@ async fn a_model_is_served_from_one_serialisation_true_to_its_metadata() {
         assert_eq!(v["document"], plain["document"]);
     }
 
-    // A deleted model is gone, whatever was cached.
-    let r = app.call("DELETE", "/api/models/{id}", &[&mid], None).await;
+    // A deleted model (soft delete: still readable by id) is served as
+    // deleted in both encodings, whatever was cached; restored, as live.
+    let r = app
+        .call("DELETE", "/api/models/{id}?reason=duplicate", &[&mid], None)
+        .await;
     assert_eq!(r.status, 200, "{}", r.text);
-    let r = app.call("GET", "/api/models/{id}", &[&mid], None).await;
-    assert_eq!(r.status, 404);
+    for gzip in [false, true] {
+        let (_, v) = get(&app, &path, gzip).await;
+        assert!(v["model"]["deleted_at"].is_string(), "{}", v["model"]);
+        assert_eq!(v["model"]["delete_reason"], "duplicate");
+    }
+    let r = app
+        .call("POST", "/api/models/{id}/restore", &[&mid], None)
+        .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    for gzip in [false, true] {
+        let (_, v) = get(&app, &path, gzip).await;
+        assert!(v["model"]["deleted_at"].is_null(), "{}", v["model"]);
+    }
 }
 
 #[tokio::test]
