@@ -106,7 +106,7 @@ async function tokenSection(me) {
         h('tbody', null, ...tokens.map((t) => h('tr', { 'data-testid': `token-${t.name}` },
           h('td', null, t.name), h('td', null, t.role), h('td', null, h('code', null, `${t.prefix}…`)),
           h('td', null, when(t.created_at)), h('td', null, when(t.last_used_at)), h('td', null, t.expires_at ? when(t.expires_at) : 'until revoked'),
-          h('td', null, t.revoked_at ? `revoked ${when(t.revoked_at)}` : 'valid'),
+          h('td', { 'data-testid': 'token-state' }, t.revoked_at ? `revoked ${when(t.revoked_at)}` : 'valid'),
           h('td', null, t.revoked_at ? null : h('button', {
             type: 'button', class: 'btn small danger', 'data-testid': 'token-revoke',
             onClick: async () => {
@@ -179,7 +179,7 @@ function userRow(u, me, refresh) {
   return h('tr', { 'data-testid': `user-${u.name}` },
     h('td', null, u.name, u.id === me.user_id ? ' (you)' : ''),
     h('td', null, role),
-    h('td', null, u.disabled ? `disabled ${when(u.disabled_at)}` : 'active'),
+    h('td', { 'data-testid': 'user-state' }, u.disabled ? `disabled ${when(u.disabled_at)}` : 'active'),
     h('td', null, when(u.created_at)),
     h('td', { class: 'actions' },
       h('button', {

@@ -57,16 +57,17 @@ test('an admin manages users and tokens and changes the password on the account 
     assert.equal(withToken.json.role, 'viewer');
     page.once('dialog', (d) => d.accept());
     await page.click(`${tid('token-laptop')} ${tid('token-revoke')}`);
-    await page.locator(`${tid('token-laptop')}:has-text("revoked")`).waitFor();
+    // (The row says "until revoked" from the start: wait for its state cell.)
+    await page.locator(`${tid('token-laptop')} ${tid('token-state')}:text-matches("^revoked")`).waitFor();
     const revoked = await H.api('GET', '/api/auth/me');
     H.headers = {};
     assert.equal(revoked.status, 401);
     if (process.env.ACCOUNT_SCREENSHOT) await page.screenshot({ path: process.env.ACCOUNT_SCREENSHOT, fullPage: true });
     // Disable, then enable, the new user.
     await page.click(`${tid('user-pia')} ${tid('user-toggle')}`);
-    await page.locator(`${tid('user-pia')}:has-text("disabled")`).waitFor();
+    await page.locator(`${tid('user-pia')} ${tid('user-state')}:text-matches("^disabled")`).waitFor();
     await page.click(`${tid('user-pia')} ${tid('user-toggle')}`);
-    await page.locator(`${tid('user-pia')}:has-text("active")`).waitFor();
+    await page.locator(`${tid('user-pia')} ${tid('user-state')}:text-is("active")`).waitFor();
     // No sideways scroll on a phone.
     await page.setViewportSize({ width: 390, height: 800 });
     const wide = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
