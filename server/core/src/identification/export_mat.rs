@@ -61,26 +61,11 @@ pub fn mat_export(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identification::tests::lpv_doc;
-    use crate::planning::dof::Dof;
+    use crate::identification::tests::surge_pitch_doc;
 
     #[test]
     fn lpv_variables_keep_names_units_and_grid_speeds() {
-        let doc = lpv_doc(
-            vec![Dof::Surge, Dof::Pitch],
-            vec![
-                (
-                    0.5,
-                    vec![vec![2000.0, 10.0], vec![10.0, 300.0]],
-                    vec![vec![500.0, 1.0], vec![2.0, 90.0]],
-                ),
-                (
-                    1.0,
-                    vec![vec![2100.0, 11.0], vec![11.0, 310.0]],
-                    vec![vec![700.0, 1.5], vec![2.5, 95.0]],
-                ),
-            ],
-        );
+        let doc = surge_pitch_doc();
         let vars = mat_variables(&doc, "surveyor", 2, 0.1).unwrap();
         let get = |n: &str| &vars.iter().find(|(k, _)| k == n).unwrap().1;
         let pts = &doc.lpv.as_ref().unwrap().points;

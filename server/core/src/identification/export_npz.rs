@@ -205,26 +205,11 @@ pub fn npz_export(
 mod tests {
     use super::*;
     use crate::identification::npz::{NpyData, read_npz};
-    use crate::identification::tests::lpv_doc;
-    use crate::planning::dof::Dof;
+    use crate::identification::tests::surge_pitch_doc;
 
     #[test]
     fn lpv_arrays_read_back_equal_to_the_document() {
-        let mut doc = lpv_doc(
-            vec![Dof::Surge, Dof::Pitch],
-            vec![
-                (
-                    0.5,
-                    vec![vec![2000.0, 10.0], vec![10.0, 300.0]],
-                    vec![vec![500.0, 1.0], vec![2.0, 90.0]],
-                ),
-                (
-                    1.0,
-                    vec![vec![2100.0, 11.0], vec![11.0, 310.0]],
-                    vec![vec![700.0, 1.5], vec![2.5, 95.0]],
-                ),
-            ],
-        );
+        let mut doc = surge_pitch_doc();
         doc.lpv.as_mut().unwrap().points[1].load = Some(vec![3.0, -0.25]);
         let back = read_npz(&npz_export(&doc, "Ærø", 3, 0.1).unwrap()).unwrap();
         let get = |k: &str| {

@@ -299,6 +299,27 @@ fn a_stored_model_validates_on_a_run_as_it_did_at_identification() {
     }
 }
 
+/// A surge–pitch [`lpv_doc`] at 0.5 and 1.0 m/s with coupled M and D̄ (the
+/// export tests' fixture).
+pub(crate) fn surge_pitch_doc() -> super::document::ModelDocument {
+    use crate::planning::dof::Dof;
+    lpv_doc(
+        vec![Dof::Surge, Dof::Pitch],
+        vec![
+            (
+                0.5,
+                vec![vec![2000.0, 10.0], vec![10.0, 300.0]],
+                vec![vec![500.0, 1.0], vec![2.0, 90.0]],
+            ),
+            (
+                1.0,
+                vec![vec![2100.0, 11.0], vec![11.0, 310.0]],
+                vec![vec![700.0, 1.5], vec![2.5, 95.0]],
+            ),
+        ],
+    )
+}
+
 /// A λ LPV document over `dofs` with one sub-model per (speed, M, D̄):
 /// A = −M⁻¹D̄, B = M⁻¹ (zero when M is singular), zero stds, no loads, no
 /// restoring — the fixture tests adjust what they need.
