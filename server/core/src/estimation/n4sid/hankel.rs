@@ -5,19 +5,22 @@
 //! H = [U_f; U_p; Y_p; Y_f] (U_f = U_{i|2i−1} first: projecting out the
 //! future inputs is then a truncation). H = L Qᵀ with L lower triangular.
 //!
-//! Why QR and not the Gram/Cholesky shortcut: L is the R factor (transposed)
-//! of Hᵀ, updated by QR of [R; next rows of Hᵀ] so only r × r plus one
-//! chunk is ever held (r = 2i(m + l)), never Q, never H itself. The Gram
-//! matrix H Hᵀ would be 3–4× cheaper (syrk vs Householder) but squares the
-//! condition number: on noise-free or high-SNR data Y_p is (nearly) a linear
+//! Two routes to L (see [`super::gram`]): the Gram matrix H Hᵀ from lagged
+//! cross-products (O((m + l)² 4i j), exploiting the Hankel structure) and
+//! its Cholesky factor, taken when that factor's diagonal spread is small;
+//! otherwise the QR below. Why not the Gram always: it squares the
+//! condition number. On noise-free or high-SNR data Y_p is (nearly) a linear
 //! combination of U_p and n states, H is rank-deficient, Cholesky breaks
 //! down or leaves √ε-size garbage in the null directions, and the oblique
 //! projection inherits it. The QR keeps those directions at ε·‖H‖. Test
 //! `gram_cholesky_loses_the_noise_free_null_space`, noise-free poles: QR
 //! 1.5e-14 vs Gram 6.6e-14 (white input), 1.9e-14 vs 1.3e-12 (input
 //! low-passed at 0.9, as oversampled trial data): the Gram loss grows with
-//! cond(H)², the QR's does not. Measured (faer, one core): QR of the 360,000 × 240
-//! data in chunks of 1,920 rows ≈ 3 s at ≈ 16 GF/s, syrk ≈ 0.8 s.
+//! cond(H)², the QR's does not; the spread test sends such data to the QR.
+//!
+//! The QR: L is the R factor (transposed) of Hᵀ, updated by QR of
+//! [R; next rows of Hᵀ] so only r × r plus one chunk is ever held
+//! (r = 2i(m + l)), never Q, never H itself.
 //!
 //! Cost O(j r²), memory (c + r)·r + r² doubles with c the chunk rows: both
 //! independent of the number of samples beyond the linear pass.
@@ -30,7 +33,8 @@ use faer::{Mat, MatMut};
 use nalgebra::DMatrix;
 
 use super::error::N4sidError;
-use crate::estimation::{Cancelled, Progress};
+use super::gram;
+use crate::estimation::{Cancelled, Progress, SubProgress};
 
 /// Row layout of H = [U_f; U_p; Y_p; Y_f] for m inputs, l outputs, horizon i.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -81,10 +85,59 @@ pub(crate) struct HankelLq {
     pub columns: usize,
 }
 
-/// Accumulates L for the experiments (already validated), each channel
-/// divided by its scale. Every experiment contributes its own columns; no
-/// window straddles two experiments.
+/// How [`hankel_lq`] obtained L.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum LqRoute {
+    /// Cholesky factor of the structured Gram matrix (well conditioned H).
+    Gram,
+    /// Chunked Householder QR.
+    Qr,
+}
+
+/// L for the experiments (already validated), each channel divided by its
+/// scale: from the Gram matrix when H is well conditioned, else by QR.
+/// Every experiment contributes its own columns; no window straddles two
+/// experiments.
 pub(crate) fn hankel_lq(
+    experiments: &[(&DMatrix<f64>, &DMatrix<f64>)],
+    u_scale: &[f64],
+    y_scale: &[f64],
+    layout: Layout,
+    chunk_rows: usize,
+    progress: &mut dyn Progress,
+) -> Result<(HankelLq, LqRoute), N4sidError> {
+    let inv_u: Vec<f64> = u_scale.iter().map(|s| 1.0 / s).collect();
+    let inv_y: Vec<f64> = y_scale.iter().map(|s| 1.0 / s).collect();
+    let g = gram::hankel_gram(
+        experiments,
+        &inv_u,
+        &inv_y,
+        layout,
+        &mut SubProgress::new(progress, 0.0, 0.2),
+    )?;
+    if let Some(l) = gram::well_conditioned_cholesky(g) {
+        let columns = experiments
+            .iter()
+            .map(|(u, _)| u.nrows() + 1 - 2 * layout.i)
+            .sum();
+        progress
+            .update(1.0, "Cholesky of the Gram matrix")
+            .map_err(|Cancelled| N4sidError::Cancelled)?;
+        return Ok((HankelLq { layout, l, columns }, LqRoute::Gram));
+    }
+    let lq = hankel_lq_qr(
+        experiments,
+        u_scale,
+        y_scale,
+        layout,
+        chunk_rows,
+        &mut SubProgress::new(progress, 0.2, 1.0),
+    )?;
+    Ok((lq, LqRoute::Qr))
+}
+
+/// L by chunked Householder QR of Hᵀ, whatever the conditioning.
+pub(crate) fn hankel_lq_qr(
     experiments: &[(&DMatrix<f64>, &DMatrix<f64>)],
     u_scale: &[f64],
     y_scale: &[f64],
@@ -230,7 +283,7 @@ mod tests {
         }
         for chunk in [1usize, 7, 1000] {
             let lq =
-                hankel_lq(&refs, &[1.0; 2], &[1.0; 3], layout, chunk, &mut NoProgress).unwrap();
+                hankel_lq_qr(&refs, &[1.0; 2], &[1.0; 3], layout, chunk, &mut NoProgress).unwrap();
             assert_eq!(lq.columns, 52 + 75);
             let err = (&lq.l * lq.l.transpose() - &gram).amax() / gram.amax();
             assert!(err < 1e-13, "chunk {chunk}: relative error {err}");

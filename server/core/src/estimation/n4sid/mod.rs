@@ -7,9 +7,11 @@
 //! O_i (oblique projection Y_f /_{U_f} W_p), Γ_i (extended observability
 //! matrix), W₁ O_i W₂ (weighted projection):
 //!
-//! 1. [`hankel`]: L of H = [U_f; U_p; Y_p; Y_f] = L Qᵀ by chunked QR (never
-//!    N × N, never H in full); several runs stack their Hankel columns, each
-//!    run with its own initial state (never concatenated signals).
+//! 1. [`hankel`]: L of H = [U_f; U_p; Y_p; Y_f] = L Qᵀ (never N × N, never
+//!    H in full): the Cholesky factor of H Hᵀ built from lagged
+//!    cross-products ([`gram`]) when H is well conditioned, else chunked QR;
+//!    several runs stack their Hankel columns, each run with its own
+//!    initial state (never concatenated signals).
 //! 2. [`projection`]: O_i, weighting (N4SID, MOESP, CVA), thin SVD, order
 //!    from the singular-value gap or fixed, Γ_i and the state map.
 //! 3. [`system`]: A, B, C, D by least squares on the estimated states
@@ -24,12 +26,13 @@
 //! and a scale-free order choice); the model is returned in physical units.
 //! Offsets are not removed: pass deviations from the trim point.
 //!
-//! Memory: beyond the caller's signals, the largest allocation is the QR
-//! work matrix (c + r) × r doubles, r = 2i(m + l), c = chunk rows (default
+//! Memory: beyond the caller's signals, the largest allocation is r × r
+//! on the Gram route and at most the QR work matrix (c + r) × r doubles, r = 2i(m + l), c = chunk rows (default
 //! 8r): independent of N. For i = 10, m = l = 6: r = 240, 4.1 MB.
 
 pub mod continuous;
 pub mod error;
+mod gram;
 mod hankel;
 pub mod model;
 mod projection;
@@ -72,7 +75,7 @@ pub fn n4sid(
     let (u_scale, y_scale) = channel_scales(experiments, m, l)?;
     let r = layout.rows();
     let chunk = settings.chunk_rows.unwrap_or(CHUNK_FACTOR * r);
-    let lq = hankel::hankel_lq(
+    let (lq, _route) = hankel::hankel_lq(
         experiments,
         &u_scale,
         &y_scale,

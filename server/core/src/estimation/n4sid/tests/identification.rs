@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::super::hankel::{Layout, dense_hankel, hankel_lq};
+use super::super::hankel::{Layout, LqRoute, dense_hankel, hankel_lq, hankel_lq_qr};
 use super::super::projection::{pinv, subspace};
 use super::super::{N4sidSettings, Weighting, n4sid};
 use super::*;
@@ -211,7 +211,7 @@ fn lq_projection_matches_the_dense_oblique_projection() {
     let oi =
         &yf * &proj * wp.transpose() * pinv(&(&wp * &proj * wp.transpose()), 0.0).unwrap() * &wp;
     let dense_sv = (&oi * &proj).svd(false, false).singular_values;
-    let lq = hankel_lq(
+    let lq = hankel_lq_qr(
         &[(&u, &y)],
         &[1.0; 2],
         &[1.0; 2],
@@ -280,7 +280,7 @@ fn low_pass(u: &DMatrix<f64>, a: f64) -> DMatrix<f64> {
 /// Pole errors (QR, Gram/Cholesky) of the same noise-free data.
 fn gram_vs_qr(sys: &N4sidModel, u: &DMatrix<f64>, y: &DMatrix<f64>, what: &str) -> (f64, f64) {
     let layout = Layout { m: 2, l: 2, i: 8 };
-    let lq = hankel_lq(
+    let lq = hankel_lq_qr(
         &[(u, y)],
         &[1.0; 2],
         &[1.0; 2],
@@ -314,4 +314,67 @@ fn gram_vs_qr(sys: &N4sidModel, u: &DMatrix<f64>, y: &DMatrix<f64>, what: &str) 
     let e_gram = eigen_error(&poles(&l_gram), &sys.eigenvalues());
     eprintln!("{what}: pole error QR {e_qr:.2e}, Gram/Cholesky {e_gram:.2e}");
     (e_qr, e_gram)
+}
+
+/// Poles of the MOESP model (order 4) built on a given L.
+fn poles_from_l(l: &DMatrix<f64>, layout: Layout, columns: usize) -> Vec<nalgebra::Complex<f64>> {
+    let lq = super::super::hankel::HankelLq {
+        layout,
+        l: l.clone(),
+        columns,
+    };
+    let sub = subspace(&lq, Weighting::Moesp, Some(4), 10).unwrap();
+    let fit = super::super::system::fit_state_space(&lq, &sub, false).unwrap();
+    fit.a.complex_eigenvalues().iter().copied().collect()
+}
+
+/// Noisy data take the Gram route, and its model is the QR route's to
+/// rounding; noise-free data (rank-deficient H) take the QR route.
+#[test]
+fn the_gram_route_serves_noisy_data_and_noise_free_data_go_to_the_qr() {
+    let sys = truth(false);
+    let layout = Layout { m: 2, l: 2, i: 8 };
+    let route = |noise: f64, seed: u64| {
+        let (u, y) = simulate(&sys, 3000, seed, noise, &DVector::zeros(4));
+        let (lq, route) = hankel_lq(
+            &[(&u, &y)],
+            &[1.0; 2],
+            &[1.0; 2],
+            layout,
+            256,
+            &mut NoProgress,
+        )
+        .unwrap();
+        let qr = hankel_lq_qr(
+            &[(&u, &y)],
+            &[1.0; 2],
+            &[1.0; 2],
+            layout,
+            256,
+            &mut NoProgress,
+        )
+        .unwrap();
+        (lq, qr, route)
+    };
+    for (noise, seed) in [(0.1, 21u64), (0.01, 22), (1.0, 23)] {
+        let (lq, qr, r) = route(noise, seed);
+        assert_eq!(r, LqRoute::Gram, "noise {noise}");
+        let gram = &qr.l * qr.l.transpose();
+        let err = (&lq.l * lq.l.transpose() - &gram).amax() / gram.amax();
+        assert!(err < 1e-12, "noise {noise}: L Lᵀ differs by {err:e}");
+        let pg = poles_from_l(&lq.l, layout, lq.columns);
+        let pq = poles_from_l(&qr.l, layout, qr.columns);
+        let mut sg: Vec<f64> = pg.iter().map(|z| z.norm()).collect();
+        let mut sq: Vec<f64> = pq.iter().map(|z| z.norm()).collect();
+        sg.sort_by(f64::total_cmp);
+        sq.sort_by(f64::total_cmp);
+        for (a, b) in sg.iter().zip(&sq) {
+            assert!(
+                (a - b).abs() < 1e-9,
+                "noise {noise}: pole moduli {sg:?} vs {sq:?}"
+            );
+        }
+    }
+    let (_, _, r) = route(0.0, 24);
+    assert_eq!(r, LqRoute::Qr, "noise-free data must take the QR route");
 }

@@ -96,9 +96,10 @@ fn memory_does_not_grow_with_the_number_of_samples() {
         eprintln!(
             "N {n}: signals {signals} B, peak extra {peak} B, largest {largest} B, work {work} B"
         );
-        assert_eq!(
-            largest, work,
-            "the QR work matrix is the largest allocation"
+        // The Gram route needs r × r; the QR route's work matrix bounds both.
+        assert!(
+            largest <= work,
+            "largest allocation {largest} B exceeds the QR work matrix {work} B"
         );
         assert!(peak < 2 * work, "peak {peak} B vs work matrix {work} B");
         seen.push(peak);
