@@ -29,6 +29,7 @@ pub mod alignment;
 pub mod discrepancy;
 pub mod estimation;
 pub mod identification;
+pub mod kernels;
 pub mod logs;
 pub mod models;
 pub mod numbers;

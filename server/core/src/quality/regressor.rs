@@ -22,6 +22,7 @@ use nalgebra::{DMatrix, SymmetricEigen};
 
 use super::record::mean_rms;
 use super::{ColumnWeight, DeficientDirection, QualityError, RegressorReport};
+use crate::kernels::dots;
 
 /// Lags `na = nb` when the spec gives none. One lag: the identified model is first order in ν (ν̇ = Aν + Bτ, thesis
 /// eq. 2.10), so Φ = (Φ_y Φ_x) holds ν(t−1) and τ(t−1). Two lags on
@@ -50,8 +51,8 @@ pub const MAX_REGRESSOR_COLUMNS: usize = 256;
 pub const DIRECTION_WEIGHT: f64 = 0.1;
 
 /// Rows per chunk of the Gram accumulation: the chunk of every channel
-/// (12 × 256 doubles) stays in the L1 cache while all its dot products run.
-const CHUNK: usize = 256;
+/// (12 × 2048 doubles) stays in the L2 cache while all its dot products run.
+const CHUNK: usize = 2048;
 
 /// Blocks whose core (rows common to all lags) is shorter than this are
 /// summed row by row.
@@ -422,20 +423,9 @@ fn gram_structured(
     let (core_start, core_end) = (b.start + lags - 1, b.end - lags);
     let z = |c: usize, s: usize| (channels[c][s] - centre[c].0) * centre[c].1;
 
-    // Core sums D[(i·nc + j)·nd + δ + L − 1] for i ≤ j (δ ≤ 0 when i = j).
+    // Core sums D[(i·nc + j)·nd + δ + L − 1] for i ≤ j (δ ≤ 0 when i = j):
+    // channel j's window starts at margin + δ = d in the buffer.
     let mut core = vec![0.0; nc * nc * nd];
-    // For each channel i, the (j, δ + L − 1) sums it takes part in as the
-    // left factor; y window of channel j starts at margin + δ = d.
-    let combos: Vec<Vec<(usize, usize)>> = (0..nc)
-        .map(|i| {
-            (i..nc)
-                .flat_map(|j| {
-                    let d_max = if i == j { margin } else { nd - 1 };
-                    (0..=d_max).map(move |d| (j, d))
-                })
-                .collect()
-        })
-        .collect();
     let width = CHUNK + 2 * margin;
     let mut buf = vec![0.0; nc * width];
     let mut s0 = core_start;
@@ -451,18 +441,25 @@ fn gram_structured(
                 *dst = (v - mean) * scale;
             }
         }
-        for (i, combos) in combos.iter().enumerate() {
+        for i in 0..nc {
             let xi = &buf[i * width + margin..i * width + margin + w];
-            let y = |(j, d): (usize, usize)| &buf[j * width + d..j * width + d + w];
-            let mut groups = combos.chunks_exact(4);
-            for g in &mut groups {
-                let r = dot4(xi, [y(g[0]), y(g[1]), y(g[2]), y(g[3])]);
-                for (&(j, d), v) in g.iter().zip(r) {
-                    core[(i * nc + j) * nd + d] += v;
-                }
-            }
-            for &(j, d) in groups.remainder() {
-                core[(i * nc + j) * nd + d] += dot(xi, y((j, d)));
+            // Every (j ≥ i, d) window of this chunk; d ≤ margin when j = i.
+            let (ys, slots): (Vec<&[f64]>, Vec<usize>) = (i..nc)
+                .flat_map(|j| {
+                    let d_count = if i == j { margin + 1 } else { nd };
+                    (0..d_count).map(move |d| (j, d))
+                })
+                .map(|(j, d)| {
+                    (
+                        &buf[j * width + d..j * width + d + w],
+                        (i * nc + j) * nd + d,
+                    )
+                })
+                .unzip();
+            let mut sums = vec![0.0; ys.len()];
+            dots(xi, &ys, &mut sums);
+            for (slot, v) in slots.into_iter().zip(sums) {
+                core[slot] += v;
             }
         }
         s0 += w;
@@ -488,62 +485,6 @@ fn gram_structured(
             }
         }
     }
-}
-
-/// Four dot products of `x` with `y[0..4]` in one pass (each `x` load
-/// serves four products), with four partial sums each (vectorisable).
-#[inline]
-fn dot4(x: &[f64], y: [&[f64]; 4]) -> [f64; 4] {
-    let n = y.iter().fold(x.len(), |n, s| n.min(s.len()));
-    let x = &x[..n];
-    let [y0, y1, y2, y3] = y.map(|s| &s[..n]);
-    let mut acc = [[0.0f64; 4]; 4];
-    for ((((xs, a), b), c), d) in x
-        .chunks_exact(4)
-        .zip(y0.chunks_exact(4))
-        .zip(y1.chunks_exact(4))
-        .zip(y2.chunks_exact(4))
-        .zip(y3.chunks_exact(4))
-    {
-        for e in 0..4 {
-            acc[0][e] += xs[e] * a[e];
-            acc[1][e] += xs[e] * b[e];
-            acc[2][e] += xs[e] * c[e];
-            acc[3][e] += xs[e] * d[e];
-        }
-    }
-    let tail = n - n % 4;
-    let ys = [y0, y1, y2, y3];
-    let mut out = [0.0; 4];
-    for q in 0..4 {
-        let a = &acc[q];
-        let mut s = (a[0] + a[1]) + (a[2] + a[3]);
-        for e in tail..n {
-            s += x[e] * ys[q][e];
-        }
-        out[q] = s;
-    }
-    out
-}
-
-/// Dot product with eight independent partial sums (vectorisable).
-#[inline]
-fn dot(x: &[f64], y: &[f64]) -> f64 {
-    let n = x.len().min(y.len());
-    let (x, y) = (&x[..n], &y[..n]);
-    let mut acc = [0.0f64; 8];
-    let (xc, yc) = (x.chunks_exact(8), y.chunks_exact(8));
-    let (xr, yr) = (xc.remainder(), yc.remainder());
-    for (a, b) in xc.zip(yc) {
-        for k in 0..8 {
-            acc[k] += a[k] * b[k];
-        }
-    }
-    let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-    for (a, b) in xr.iter().zip(yr) {
-        s += a * b;
-    }
-    s
 }
 
 #[cfg(test)]
@@ -607,20 +548,6 @@ mod tests {
             let want = gram_reference(&refs, &blocks, lags);
             let err = (&got - &want).amax();
             assert!(err < 1e-12, "lags {lags}: max error {err:e}");
-        }
-    }
-
-    #[test]
-    fn dot_kernels_handle_remainders() {
-        let x: Vec<f64> = (0..23).map(|i| i as f64).collect();
-        let y: Vec<f64> = (0..26).map(|i| 1.0 - i as f64 * 0.5).collect();
-        for n in [0, 1, 3, 4, 5, 8, 21, 23] {
-            let want = |o: usize| -> f64 { (0..n).map(|k| x[k] * y[k + o]).sum() };
-            assert!((dot(&x[..n], &y[..n]) - want(0)).abs() < 1e-12);
-            let got = dot4(&x[..n], [&y[..n], &y[1..n + 1], &y[2..n + 2], &y[3..n + 3]]);
-            for (o, g) in got.iter().enumerate() {
-                assert!((g - want(o)).abs() < 1e-12, "n {n} offset {o}");
-            }
         }
     }
 

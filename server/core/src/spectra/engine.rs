@@ -91,6 +91,40 @@ impl SegmentFft {
             })
     }
 
+    /// `out = rfft(window · (samples − offset))` for one segment of
+    /// exactly `nperseg` samples, in one pass into the FFT's input (the
+    /// caller's constant detrend: `offset` is the segment mean).
+    pub(crate) fn transform_offset(
+        &mut self,
+        samples: &[f64],
+        offset: f64,
+        out: &mut [Complex<f64>],
+    ) -> Result<(), SpectraError> {
+        if samples.len() != self.nperseg {
+            return Err(SpectraError::parameter(
+                "nperseg",
+                format!(
+                    "a segment of {} samples given for nperseg {}",
+                    samples.len(),
+                    self.nperseg
+                ),
+            ));
+        }
+        self.input
+            .iter_mut()
+            .zip(samples)
+            .zip(&self.window)
+            .for_each(|((v, x), w)| *v = (x - offset) * w);
+        self.fft
+            .process_with_scratch(&mut self.input, out, &mut self.scratch)
+            .map_err(|e| {
+                SpectraError::parameter(
+                    "nperseg",
+                    format!("real FFT of length {} failed: {e}", self.nperseg),
+                )
+            })
+    }
+
     /// Factor turning the per-bin *sum* over segments of `conj(X)·Y` into
     /// scipy's one-sided density: `c_k / (fs · Σw² · n_segments)` with
     /// `c_k = 2` except for DC and, when `nperseg` is even, Nyquist.

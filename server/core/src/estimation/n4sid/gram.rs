@@ -26,6 +26,7 @@ use nalgebra::DMatrix;
 use super::error::N4sidError;
 use super::hankel::{Layout, column};
 use crate::estimation::{Cancelled, Progress};
+use crate::kernels::lagged_dots;
 
 /// Largest accepted max L_kk / min L_kk of the Cholesky factor.
 pub(crate) const MAX_SPREAD: f64 = 1e4;
@@ -152,83 +153,12 @@ pub(crate) fn well_conditioned_cholesky(g: DMatrix<f64>) -> Option<DMatrix<f64>>
     (lo > 0.0 && hi / lo <= MAX_SPREAD).then_some(l)
 }
 
-/// out[k] += Σ_s a[s] · b[s + k] for k < out.len(); b holds
-/// a.len() + out.len() − 1 samples.
-fn lagged_dots(a: &[f64], b: &[f64], out: &mut [f64]) {
-    debug_assert_eq!(b.len() + 1, a.len() + out.len());
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the CPU has the features the function is compiled for.
-        return unsafe { lagged_dots_avx2_fma(a, b, out) };
-    }
-    lagged_dots_body::<false>(a, b, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn lagged_dots_avx2_fma(a: &[f64], b: &[f64], out: &mut [f64]) {
-    lagged_dots_body::<true>(a, b, out)
-}
-
-/// Lanes of one accumulator; lags sharing one load of `a`.
-const LANES: usize = 8;
-const GROUP: usize = 4;
-
-#[inline(always)]
-fn lagged_dots_body<const FMA: bool>(a: &[f64], b: &[f64], out: &mut [f64]) {
-    let madd = |x: f64, y: f64, acc: f64| if FMA { x.mul_add(y, acc) } else { x * y + acc };
-    let nd = out.len();
-    let full = a.len() / LANES * LANES;
-    for k0 in (0..nd).step_by(GROUP) {
-        // Lags past the end repeat the last one; their sums are dropped.
-        let bq: [&[f64]; GROUP] = std::array::from_fn(|q| {
-            let k = (k0 + q).min(nd - 1);
-            &b[k..k + full]
-        });
-        let mut acc = [[0.0f64; LANES]; GROUP];
-        for (s, av) in a[..full].chunks_exact(LANES).enumerate() {
-            for (accq, bqq) in acc.iter_mut().zip(&bq) {
-                let bv = &bqq[s * LANES..(s + 1) * LANES];
-                for ((c, &x), &y) in accq.iter_mut().zip(av).zip(bv) {
-                    *c = madd(x, y, *c);
-                }
-            }
-        }
-        for (q, accq) in acc.iter().enumerate().take(nd - k0) {
-            let k = k0 + q;
-            let mut sum = accq.iter().sum::<f64>();
-            for s in full..a.len() {
-                sum = madd(a[s], b[s + k], sum);
-            }
-            out[k] += sum;
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::estimation::NoProgress;
     use crate::estimation::n4sid::hankel::dense_hankel;
     use crate::rng::SplitMix64;
-
-    #[test]
-    fn lagged_dots_match_the_plain_sums() {
-        let mut rng = SplitMix64::new(5);
-        for (len, nd) in [(0usize, 3usize), (5, 1), (37, 39), (1024, 39), (9, 9)] {
-            let a: Vec<f64> = (0..len).map(|_| rng.normal()).collect();
-            let b: Vec<f64> = (0..len + nd - 1).map(|_| rng.normal()).collect();
-            let mut out = vec![1.0; nd];
-            lagged_dots(&a, &b, &mut out);
-            for (k, o) in out.iter().enumerate() {
-                let want = 1.0 + (0..len).map(|s| a[s] * b[s + k]).sum::<f64>();
-                assert!(
-                    (o - want).abs() < 1e-12 * (1.0 + want.abs()),
-                    "len {len} k {k}"
-                );
-            }
-        }
-    }
 
     #[test]
     fn gram_equals_the_dense_hankel_product() {
