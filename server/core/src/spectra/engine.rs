@@ -81,14 +81,7 @@ impl SegmentFft {
             .iter_mut()
             .zip(&self.window)
             .for_each(|(v, w)| *v *= w);
-        self.fft
-            .process_with_scratch(&mut self.input, out, &mut self.scratch)
-            .map_err(|e| {
-                SpectraError::parameter(
-                    "nperseg",
-                    format!("real FFT of length {} failed: {e}", self.nperseg),
-                )
-            })
+        self.fft_of_input(out)
     }
 
     /// `out = rfft(window · (samples − offset))` for one segment of
@@ -115,6 +108,11 @@ impl SegmentFft {
             .zip(samples)
             .zip(&self.window)
             .for_each(|((v, x), w)| *v = (x - offset) * w);
+        self.fft_of_input(out)
+    }
+
+    /// `out = rfft(input)` (the input buffer is used as scratch).
+    fn fft_of_input(&mut self, out: &mut [Complex<f64>]) -> Result<(), SpectraError> {
         self.fft
             .process_with_scratch(&mut self.input, out, &mut self.scratch)
             .map_err(|e| {
