@@ -14,6 +14,7 @@ use super::covariance::{axpy, predict, symmetric_rank2_update};
 use super::error::{EkfError, check_finite, check_len, check_variances};
 use super::model::RunModel;
 use crate::estimation::Progress;
+use crate::kernels::has_avx2_fma;
 
 /// Progress is reported (and cancellation checked) every this many samples.
 const PROGRESS_EVERY: usize = 100;
@@ -303,6 +304,47 @@ impl UpdateWorkspace {
         angles: &[usize],
         step: usize,
     ) -> Result<(), EkfError> {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx2_fma() {
+            // SAFETY: the CPU has the features the function is compiled for.
+            return unsafe { self.measure_avx2(pm, xi, h, active, n, r, z, angles, step) };
+        }
+        self.measure_body::<false>(pm, xi, h, active, n, r, z, angles, step)
+    }
+
+    /// [`Self::measure`] compiled for AVX2 and FMA (equal to rounding).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    #[allow(clippy::too_many_arguments)]
+    fn measure_avx2(
+        &mut self,
+        pm: &mut DMatrix<f64>,
+        xi: &mut DVector<f64>,
+        h: &DMatrix<f64>,
+        active: &[usize],
+        n: usize,
+        r: &[f64],
+        z: impl Fn(usize, usize) -> f64,
+        angles: &[usize],
+        step: usize,
+    ) -> Result<(), EkfError> {
+        self.measure_body::<true>(pm, xi, h, active, n, r, z, angles, step)
+    }
+
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn measure_body<const FMA: bool>(
+        &mut self,
+        pm: &mut DMatrix<f64>,
+        xi: &mut DVector<f64>,
+        h: &DMatrix<f64>,
+        active: &[usize],
+        n: usize,
+        r: &[f64],
+        z: impl Fn(usize, usize) -> f64,
+        angles: &[usize],
+        step: usize,
+    ) -> Result<(), EkfError> {
         let m = h.nrows();
         let mm = active.len() * m;
         let dim = pm.nrows();
@@ -324,7 +366,7 @@ impl UpdateWorkspace {
                     for c in 0..n {
                         let a = h[(j, c)];
                         if a != 0.0 {
-                            axpy(col, a, &ps[(i * n + c) * dim..(i * n + c + 1) * dim]);
+                            axpy::<FMA>(col, a, &ps[(i * n + c) * dim..(i * n + c + 1) * dim]);
                         }
                     }
                 }
@@ -366,7 +408,7 @@ impl UpdateWorkspace {
                 let col = &mut ks[l * dim..(l + 1) * dim];
                 col.fill(0.0);
                 for j in 0..mm {
-                    axpy(col, s_inv[(j, l)], &us[j * dim..(j + 1) * dim]);
+                    axpy::<FMA>(col, s_inv[(j, l)], &us[j * dim..(j + 1) * dim]);
                 }
             }
         }
@@ -385,7 +427,7 @@ impl UpdateWorkspace {
             let ks = self.k.as_slice();
             let x = xi.as_mut_slice();
             for l in 0..mm {
-                axpy(x, self.innovation[l], &ks[l * dim..(l + 1) * dim]);
+                axpy::<FMA>(x, self.innovation[l], &ks[l * dim..(l + 1) * dim]);
             }
         }
         // W = K·S/2 − U, then P += K·Wᵀ + W·Kᵀ (Joseph form).
@@ -399,7 +441,7 @@ impl UpdateWorkspace {
                     *wv = -uv;
                 }
                 for j in 0..mm {
-                    axpy(col, 0.5 * self.s[(j, l)], &ks[j * dim..(j + 1) * dim]);
+                    axpy::<FMA>(col, 0.5 * self.s[(j, l)], &ks[j * dim..(j + 1) * dim]);
                 }
             }
         }
