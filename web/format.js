@@ -41,6 +41,18 @@ export function fmt(x, digits = 3) {
   return s.replace('-', MINUS);
 }
 
+/** A number with `n` significant digits (4 by default), e-notation when very big or small. */
+export function fmtSig(x, n = 4) {
+  if (x == null || typeof x !== 'number' || Number.isNaN(x)) return '–';
+  if (!Number.isFinite(x)) return x > 0 ? '∞' : `${MINUS}∞`;
+  if (x === 0) return '0';
+  const a = Math.abs(x);
+  const s = a >= 1e6 || a < 1e-3
+    ? x.toExponential(n - 1).replace(/\.?0+e/, 'e').replace('e+', 'e')
+    : String(Number(x.toPrecision(n)));
+  return s.replace(/-/g, MINUS);
+}
+
 /** A value as entered (grid speeds, settings): no trailing zeros, no float noise. */
 export function fmtShort(x) {
   if (x == null || typeof x !== 'number' || !Number.isFinite(x)) return fmt(x);
