@@ -47,9 +47,11 @@ export function fmtSig(x, n = 4) {
   if (!Number.isFinite(x)) return x > 0 ? '∞' : `${MINUS}∞`;
   if (x === 0) return '0';
   const a = Math.abs(x);
-  const s = a >= 1e6 || a < 1e-3
-    ? x.toExponential(n - 1).replace(/\.?0+e/, 'e').replace('e+', 'e')
-    : String(Number(x.toPrecision(n)));
+  // Trailing zeros kept (3.730 s says 4 digits); whole numbers beyond 10ⁿ stay whole.
+  let s;
+  if (a >= 1e6 || a < 1e-3) s = x.toExponential(n - 1).replace('e+', 'e');
+  else if (a >= 10 ** n) s = String(Math.round(x));
+  else s = x.toPrecision(n);
   return s.replace(/-/g, MINUS);
 }
 
