@@ -42,7 +42,7 @@ export function deleteControl({ what, item, needs, consequence, del, restore }) 
 }
 
 /** The list page's "Deleted vessels"/"Deleted campaigns" section (hidden when there are none). */
-export function deletedListSection({ what, list, href, restore }) {
+export function deletedListSection({ what, list, href, restore, needs }) {
   const host = h('section', { class: 'trash', 'aria-label': `Deleted ${what}s`, 'data-testid': `deleted-${what}s` });
   const msg = h('div', { 'aria-live': 'polite' });
   async function refresh() {
@@ -51,7 +51,7 @@ export function deletedListSection({ what, list, href, restore }) {
     fill(host, items.length
       ? [h('details', { 'data-testid': `deleted-${what}s-details` },
         h('summary', null, `Deleted ${what}s (${items.length})`),
-        h('ul', { class: 'plain' }, items.map((x) => deletedRow(x, `${what} ${x.name}`, href(x), restore, done, msg)))), msg]
+        h('ul', { class: 'plain' }, items.map((x) => deletedRow(x, `${what} ${x.name}`, href(x), restore, done, msg, needs)))), msg]
       : []);
   }
   refresh().catch((e) => fill(host, h('p', { class: 'error-text' }, e.message)));
@@ -65,7 +65,7 @@ export const vesselTrash = {
     consequence: 'It and its campaigns leave the lists; campaigns, runs and models stay readable by id.',
     del: api.deleteVessel, restore: api.restoreVessel,
   }),
-  list: () => deletedListSection({ what: 'vessel', list: api.deletedVessels, href: (v) => `#/vessels/${v.id}`, restore: api.restoreVessel }),
+  list: () => deletedListSection({ what: 'vessel', list: api.deletedVessels, href: (v) => `#/vessels/${v.id}`, restore: api.restoreVessel, needs: 'engineer' }),
 };
 
 /** Campaign pages: the control and the list section. */
@@ -75,5 +75,5 @@ export const campaignTrash = {
     consequence: 'It leaves the lists; its runs and models stay readable by id, so every model keeps its provenance.',
     del: api.deleteCampaign, restore: api.restoreCampaign,
   }),
-  list: () => deletedListSection({ what: 'campaign', list: api.deletedCampaigns, href: (c) => `#/campaigns/${c.id}`, restore: api.restoreCampaign }),
+  list: () => deletedListSection({ what: 'campaign', list: api.deletedCampaigns, href: (c) => `#/campaigns/${c.id}`, restore: api.restoreCampaign, needs: 'supervisor' }),
 };

@@ -6,12 +6,12 @@ import { h, fill } from './forms.js';
 import { fmtDate } from './format.js';
 
 /** One deleted item: its link, who deleted it, when and why, and Restore. */
-export function deletedRow(item, label, href, restore, onDone, msg) {
+export function deletedRow(item, label, href, restore, onDone, msg, needs = 'supervisor') {
   return h('li', { 'data-testid': 'deleted-row', 'data-id': item.id },
     h('a', { href }, label), ' ',
     h('span', { class: 'muted' }, `deleted by ${item.deleted_by || '?'} at ${fmtDate(item.deleted_at)}${item.delete_reason ? ` — ${item.delete_reason}` : ''} `),
     h('button', {
-      type: 'button', class: 'btn small', 'data-testid': 'restore', 'data-needs': 'supervisor',
+      type: 'button', class: 'btn small', 'data-testid': 'restore', 'data-needs': needs,
       onclick: () => restore(item.id).then(onDone, (e) => fill(msg, h('p', { class: 'error-text', role: 'alert' }, e.message))),
     }, 'Restore'));
 }
