@@ -8,7 +8,7 @@ SHELL := /bin/bash
 DB ?= data/seatrial.db
 LISTEN ?= 127.0.0.1:8080
 
-.PHONY: fuzz fuzz-merge load-test schemathesis run test deps web-deps browser spec-validator py-deps client-deps test-rust test-spec test-web client-e2e fmt lint
+.PHONY: fuzz fuzz-merge load-test schemathesis run test deps web-deps browser octave spec-validator py-deps client-deps test-rust test-spec test-web client-e2e fmt lint
 
 run: web-deps
 	cargo run --release --bin seatrial -- --demo --db $(DB) --listen $(LISTEN) --web-dir web
@@ -23,6 +23,17 @@ browser:
 	  echo "installing Debian chromium for the browser tests"; \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium >/dev/null; \
+	fi
+
+# Debian's Octave runs the .m export in tests/python/check_exports.py (discretizes and simulates
+# the step response itself); without it that check is skipped. apt-get update only when the
+# plain install fails (a stale or empty package list).
+octave:
+	@if ! command -v octave >/dev/null && ! command -v octave-cli >/dev/null; then \
+	  echo "installing Debian octave for the export checks"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends octave >/dev/null \
+	  || { $$SUDO apt-get update -qq && $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends octave >/dev/null; }; \
 	fi
 
 # openapi-spec-validator (PyPI, pinned) checks openapi.yaml against the OpenAPI 3.1 schema.
@@ -50,7 +61,7 @@ client-deps: py-deps
 	  || python3 -m pip install -q --disable-pip-version-check openapi-python-client==$(OPENAPI_PYTHON_CLIENT) \
 	  || python3 -m pip install -q --disable-pip-version-check --break-system-packages openapi-python-client==$(OPENAPI_PYTHON_CLIENT)
 
-deps: web-deps browser spec-validator py-deps client-deps
+deps: web-deps browser octave spec-validator py-deps client-deps
 
 test: deps test-spec test-rust test-web client-e2e schemathesis
 

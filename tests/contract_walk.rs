@@ -274,6 +274,26 @@ async fn every_documented_operation_is_exercised_and_answers() {
                     app.call(&method.to_uppercase(), template, &[&id], None)
                         .await
                 }
+                // Vessels and campaigns too: one of their own (restoring, deleted first).
+                (
+                    "delete" | "post",
+                    "/api/vessels/{id}" | "/api/vessels/{id}/restore" | "/api/campaigns/{id}"
+                    | "/api/campaigns/{id}/restore",
+                ) => {
+                    let (create, body) = if template.starts_with("/api/vessels") {
+                        ("/api/vessels", rov_profile())
+                    } else {
+                        ("/api/campaigns", campaign.clone())
+                    };
+                    let r = app.call("POST", create, &[], Some(body)).await;
+                    let id = r.json["id"].as_str().unwrap().to_string();
+                    let item = format!("{create}/{{id}}");
+                    if method == "post" {
+                        app.call("DELETE", &item, &[&id], None).await;
+                    }
+                    app.call(&method.to_uppercase(), template, &[&id], None)
+                        .await
+                }
                 ("delete", "/api/models/{id}") => {
                     let id = stored_model(&app, &cid, &vid).await;
                     app.call("DELETE", template, &[&id], None).await

@@ -90,6 +90,13 @@ export const api = {
   deletedRuns: (id) => request('GET', `/api/campaigns/${enc(id)}/runs?deleted=true`),
   renameRun: (rid, name) => request('PATCH', `/api/runs/${enc(rid)}`, { name }),
   renameVessel: (id, name) => request('PATCH', `/api/vessels/${enc(id)}`, { name }).then(flatVessel),
+  // Soft deletes of vessels and campaigns (an optional reason), their undo and the deleted lists.
+  deleteVessel: (id, reason) => request('DELETE', `/api/vessels/${enc(id)}${reason ? `?reason=${enc(reason)}` : ''}`).then(flatVessel),
+  restoreVessel: (id) => request('POST', `/api/vessels/${enc(id)}/restore`).then(flatVessel),
+  deletedVessels: () => request('GET', '/api/vessels?deleted=true').then(many(flatVessel)),
+  deleteCampaign: (id, reason) => request('DELETE', `/api/campaigns/${enc(id)}${reason ? `?reason=${enc(reason)}` : ''}`).then(flatCampaign),
+  restoreCampaign: (id) => request('POST', `/api/campaigns/${enc(id)}/restore`).then(flatCampaign),
+  deletedCampaigns: () => request('GET', '/api/campaigns?deleted=true').then(many(flatCampaign)),
   renameCampaign: (id, name) => request('PATCH', `/api/campaigns/${enc(id)}`, { name }).then(flatCampaign),
   quality: (rid) => request('GET', urls.quality(rid)),
   // Every channel of a run over a window (`query`: from_s, to_s, points), with the window's statistics.
@@ -116,7 +123,8 @@ export const api = {
   stepResponse: (mid, kind) => request('GET', `/api/models/${enc(mid)}/step-response?kind=${enc(kind || 'step')}`),
   hankel: (mid) => request('GET', `/api/models/${enc(mid)}/hankel`),
   // Several models validated on one run (`ids`: 1–6 model ids).
-  compare: (ids, runId) => request('GET', `/api/models/compare?a=${enc(ids[0])}&b=${enc(ids[1] || ids[0])}${ids.length > 2 ? `&more=${enc(ids.slice(2).join(','))}` : ''}&run_id=${enc(runId)}`),
+  // `win`: {from_s, to_s} validates on that window of the run only.
+  compare: (ids, runId, win) => request('GET', `/api/models/compare?a=${enc(ids[0])}&b=${enc(ids[1] || ids[0])}${ids.length > 2 ? `&more=${enc(ids.slice(2).join(','))}` : ''}&run_id=${enc(runId)}${win && win.from_s != null ? `&from_s=${enc(win.from_s)}` : ''}${win && win.to_s != null ? `&to_s=${enc(win.to_s)}` : ''}`),
   deleteModel: (mid, cascade, reason) => request('DELETE', `/api/models/${enc(mid)}?cascade=${cascade ? 'true' : 'false'}${reason ? `&reason=${enc(reason)}` : ''}`),
   restoreModel: (mid) => request('POST', `/api/models/${enc(mid)}/restore`),
   deletedModels: (campaignId) => request('GET', `/api/models?deleted=true&campaign_id=${enc(campaignId)}`),

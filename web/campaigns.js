@@ -1,6 +1,7 @@
 // Campaigns: list and the create form (grid editor, families, excitation).
 
 import { api } from './api.js';
+import { campaignTrash } from './parenttrash.js';
 import {
   DOFS, FAMILIES, FAMILY_LABEL, KIND_LABEL, KN, SIGNALS, SIGNAL_LABEL, dofUnits, fmt, fmtDate, fmtShort, knots,
 } from './format.js';
@@ -50,7 +51,8 @@ export async function campaignList(view) {
             h('td', { class: 'num' }, c.repetitions ?? '–'),
             h('td', { class: 'num mono' }, c.seed ?? '–'),
             h('td', null, fmtDate(c.created_at)));
-        }))));
+        }))),
+    campaignTrash.list());
 }
 
 // ---- create form -------------------------------------------------------------

@@ -1,7 +1,9 @@
 // Overlay compare (model page): several models of the campaign validated
 // on one chosen run (GET /api/models/compare), their predictions drawn over
 // the measurement for one output, with each model's fits and divergences
-// in words. A window selected on that run's time plot can be shown here.
+// in words, and each model's input–residual cross-correlation. The
+// validation runs on the whole run or a window of it: typed in, taken from
+// the run page's selection, or from a range zoomed on the plot here.
 // Live chart: window.__plots.compare.
 
 import { api, urls } from './api.js';
@@ -12,6 +14,7 @@ import { timeResponsePlot } from './responseplots.js';
 import { exportBar, uplotExportable } from './plotexport.js';
 import { selectedWindow } from './runtraces.js';
 import { fitText } from './modelpage.js';
+import { compareXcorrSection } from './comparexcorr.js';
 
 const SERIES = { simulated: 'free-run simulation', k_step: 'k-step prediction', one_step: '1-step prediction', restarted: 'restarted free runs' };
 const FIT = { simulated: 'fit_simulation', k_step: 'fit_k_step', one_step: 'fit_one_step', restarted: 'fit_restarted' };
@@ -27,8 +30,17 @@ export function compareSection(model, { runs = [], defaultRun = '' } = {}) {
   const modelsHost = h('div', { class: 'compare-models', 'data-testid': 'compare-models' });
   const plotHost = h('div', { class: 'plot', 'data-testid': 'compare-plot' });
   const note = h('div', { 'data-testid': 'compare-note' });
-  const windowHost = h('div');
+  const windowHost = h('div', { class: 'actions' });
+  const fromInput = h('input', { type: 'number', step: 'any', min: 0, placeholder: 'start', 'data-testid': 'compare-from', 'aria-label': 'Window start [s]', class: 'num-input' });
+  const toInput = h('input', { type: 'number', step: 'any', min: 0, placeholder: 'end', 'data-testid': 'compare-to', 'aria-label': 'Window end [s]', class: 'num-input' });
   const go = h('button', { type: 'button', class: 'btn', 'data-testid': 'compare-go', onClick: () => run() }, 'Compare');
+  const xcorr = compareXcorrSection();
+  const setWindow = (w) => {
+    fromInput.value = w ? String(Number(w.from_s.toFixed(3))) : '';
+    toInput.value = w ? String(Number(w.to_s.toFixed(3))) : '';
+    run();
+  };
+  const num = (el) => (el.value.trim() === '' ? null : Number(el.value));
 
   async function loadModels() {
     const all = await api.models(model.campaign_id).catch(() => [model]);
@@ -46,7 +58,7 @@ export function compareSection(model, { runs = [], defaultRun = '' } = {}) {
     go.disabled = true;
     fill(note, h('p', { class: 'loading' }, h('span', { class: 'spinner', 'aria-hidden': 'true' }), 'Validating the models on the run…'));
     try {
-      state.result = await api.compare(ids, runSelect.value);
+      state.result = await api.compare(ids, runSelect.value, { from_s: num(fromInput), to_s: num(toInput) });
       // a = b when one model is asked: show it once.
       if (ids.length === 1) state.result.models = state.result.models.slice(0, 1);
       const outs = state.result.models[0].report.channels.map((c) => c.output);
@@ -84,10 +96,17 @@ export function compareSection(model, { runs = [], defaultRun = '' } = {}) {
         color: PALETTE[(i + 0) % PALETTE.length], width: 1.2,
       }))];
     state.title = `Compare on ${r.run_name}: ${out}, ${SERIES[key]}`;
-    const u = timeResponsePlot(plotHost, plot.time_s, series, { yLabel: out, name: 'compare', height: 260 });
+    // The report's times count from the window's start: drawn in log time, as the run page.
+    const t = plot.time_s.map((x) => x + r.window_s[0]);
+    const u = timeResponsePlot(plotHost, t, series, { yLabel: out, name: 'compare', height: 260 });
     const w = selectedWindow(r.run_id);
-    fill(windowHost, w ? h('button', { type: 'button', class: 'btn small', 'data-testid': 'compare-window', onClick: () => u.setScale('x', { min: w.from_s, max: w.to_s }) },
-      `Show the window selected on the run page (${fmt(w.from_s)}–${fmt(w.to_s)} s)`) : h('span', { class: 'hint' }, 'Select a window on the run’s time plot to show it here.'));
+    fill(windowHost,
+      h('span', { class: 'hint', 'data-testid': 'compare-window-note' }, `Validated on ${fmt(r.window_s[0])}–${fmt(r.window_s[1])} s of ${r.run_name}.`),
+      w ? h('button', { type: 'button', class: 'btn small', 'data-testid': 'compare-window', onClick: () => setWindow(w) },
+        `Use the window selected on the run page (${fmt(w.from_s)}–${fmt(w.to_s)} s)`) : null,
+      h('button', { type: 'button', class: 'btn small', 'data-testid': 'compare-zoomed', title: 'Drag on the plot to zoom, then validate on what is shown', onClick: () => setWindow({ from_s: u.scales.x.min, to_s: u.scales.x.max }) }, 'Validate on the zoomed range'),
+      fromInput.value || toInput.value ? h('button', { type: 'button', class: 'btn small', 'data-testid': 'compare-whole', onClick: () => setWindow(null) }, 'Whole run') : null);
+    xcorr.draw(r, out);
     fill(note,
       h('div', { class: 'table-x' }, h('table', { class: 'grid-table compact', 'data-testid': 'compare-table' },
         h('thead', null, h('tr', null, h('th', null, 'Model'), h('th', { class: 'num' }, '1-step fit'), h('th', { class: 'num' }, 'k-step fit'), h('th', { class: 'num' }, 'Restarted fit'), h('th', { class: 'num' }, 'Simulation fit'), h('th', null, `${out}: ${SERIES[key]}`))),
@@ -103,8 +122,9 @@ export function compareSection(model, { runs = [], defaultRun = '' } = {}) {
 
   const el = h('div', { class: 'plot-card compare-card', 'data-testid': 'compare-card' },
     h('h3', null, 'Compare models on a run ', exportBar(() => (window.__plots.compare ? uplotExportable(window.__plots.compare, state.title) : null), 'compare-card-export')),
-    h('div', { class: 'filters' }, h('label', null, 'Run ', runSelect), h('label', null, 'Show ', seriesSelect), h('label', null, 'Output ', outSelect), go),
-    modelsHost, windowHost, plotHost, note);
+    h('div', { class: 'filters' }, h('label', null, 'Run ', runSelect), h('label', null, 'Show ', seriesSelect), h('label', null, 'Output ', outSelect),
+      h('label', null, 'Window [s] ', fromInput, ' – ', toInput), go),
+    modelsHost, windowHost, plotHost, note, xcorr.el);
 
   return {
     el,

@@ -41,6 +41,20 @@ export function fmt(x, digits = 3) {
   return s.replace('-', MINUS);
 }
 
+/** A number with `n` significant digits (4 by default), e-notation when very big or small. */
+export function fmtSig(x, n = 4) {
+  if (x == null || typeof x !== 'number' || Number.isNaN(x)) return '–';
+  if (!Number.isFinite(x)) return x > 0 ? '∞' : `${MINUS}∞`;
+  if (x === 0) return '0';
+  const a = Math.abs(x);
+  // Trailing zeros kept (3.730 s says 4 digits); whole numbers beyond 10ⁿ stay whole.
+  let s;
+  if (a >= 1e6 || a < 1e-3) s = x.toExponential(n - 1).replace('e+', 'e');
+  else if (a >= 10 ** n) s = String(Math.round(x));
+  else s = x.toPrecision(n);
+  return s.replace(/-/g, MINUS);
+}
+
 /** A value as entered (grid speeds, settings): no trailing zeros, no float noise. */
 export function fmtShort(x) {
   if (x == null || typeof x !== 'number' || !Number.isFinite(x)) return fmt(x);

@@ -15,7 +15,7 @@ function errorBox(host, err) {
 }
 
 /** Asks in the page before `run()`; `label` says what goes. */
-function confirmBox(host, { question, label, run, extra }) {
+export function confirmBox(host, { question, label, run, extra }) {
   const box = h('div', { class: 'confirm-box', role: 'alertdialog', 'aria-label': question, 'data-testid': 'confirm-box' },
     h('p', null, question),
     extra || null,
@@ -80,7 +80,7 @@ export function runManageSection(run) {
 }
 
 /** The reason field of a delete confirmation. */
-function reasonInput() {
+export function reasonInput() {
   return h('input', {
     type: 'text', maxlength: 2000, placeholder: 'why (optional, kept in the audit trail)', 'aria-label': 'Reason for deleting', 'data-testid': 'delete-reason',
   });

@@ -10,7 +10,7 @@
 
 import { api } from './api.js';
 import { h, fill } from './forms.js';
-import { fmt, fmtKn } from './format.js';
+import { fmt, fmtKn, fmtSig } from './format.js';
 import { spectrumPlot, syncX, exact } from './runplots.js';
 import { exportBar, uplotExportable } from './plotexport.js';
 import { poleZeroPlot } from './pzplot.js';
@@ -122,7 +122,16 @@ export function modelViewsSection(model, doc, { runs = [], validation = [] } = {
     const ch = m.channels.find((c) => pairKey(c) === state.pair) || m.channels[0];
     const title = `Pole-zero map — ${model.name} v${model.version} at ${speedText(m.grid_speed_mps)}, zeros of ${ch ? `${ch.input} → ${ch.output}` : '–'}`;
     exps.pz = poleZeroPlot(pzHost, { plane: m.plane, poles: m.poles, zeros: ch ? ch.zeros : [] }, { title });
-    const rootText = (r) => `${exact(r.re)}${r.im ? ` ${r.im < 0 ? '−' : '+'} ${exact(Math.abs(r.im))}j` : ''}${r.time_constant_s != null ? ` (τ ${fmt(r.time_constant_s)} s${r.damping != null && r.im ? `, ζ ${fmt(r.damping)}` : ''})` : ''}`;
+    // 4 significant digits with units: s in rad/s (z is dimensionless), ωn in rad/s, τ in s, ζ without.
+    const unit = m.plane === 'z' ? '' : ' rad/s';
+    const rootText = (r) => {
+      const about = [
+        r.im && r.natural_frequency_rad_s != null ? `ωn ${fmtSig(r.natural_frequency_rad_s)} rad/s` : null,
+        r.im && r.damping != null ? `ζ ${fmtSig(r.damping)}` : null,
+        r.time_constant_s != null ? `τ ${fmtSig(r.time_constant_s)} s` : null,
+      ].filter(Boolean);
+      return `${fmtSig(r.re)}${r.im ? ` ${r.im < 0 ? '−' : '+'} ${fmtSig(Math.abs(r.im))}j` : ''}${unit}${about.length ? ` (${about.join(', ')})` : ''}`;
+    };
     fill(pzNote,
       h('p', null, m.plane === 'z' ? `z plane (discrete, h = ${exact(m.sample_time_s)} s): stable inside the unit circle. ` : 's plane [rad/s]: stable left of the imaginary axis. ',
         h('b', { 'data-testid': 'pz-stability' }, m.stable ? 'All poles stable.' : 'Unstable: a pole is outside the stability region.')),

@@ -4,6 +4,8 @@
 import { api, urls } from './api.js';
 import { renameControl } from './rename.js';
 import { deletedSection } from './trash.js';
+import { campaignTrash } from './parenttrash.js';
+import { deletedBadge } from './manage.js';
 import { sectionNav } from './sectionnav.js';
 import {
   FAMILY_LABEL, KIND_LABEL, SIGNAL_LABEL, bandText, describeWaveform, fmt, fmtDate, fmtKn, hms,
@@ -120,10 +122,11 @@ export async function campaignPage(view, id) {
   fill(view, 
     h('div', { class: 'page-head' },
       h('div', null,
-        h('h1', { 'data-testid': 'campaign-title' }, c.name),
+        h('h1', { 'data-testid': 'campaign-title' }, c.name, deletedBadge(c)),
         h('div', { class: 'muted' }, 'Campaign for ', vessel ? h('a', { href: `#/vessels/${vessel.id}` }, vessel.name) : c.vessel_id,
           vessel ? ` · ${KIND_LABEL[vessel.kind] || vessel.kind}` : '', ` · created ${fmtDate(c.created_at)}`)),
       h('div', { class: 'actions' }, renameControl({ what: 'campaign', name: c.name, needs: 'supervisor', save: (n) => api.renameCampaign(c.id, n) }), loading, exportLinks, genBtn)),
+    campaignTrash.control(c),
     h('dl', { class: 'summary', 'data-testid': 'campaign-summary' },
       h('dt', null, 'Grid'), h('dd', null, gridText(c), h('span', { class: 'muted' }, ` = ${c.grid_speeds_mps.map((x) => fmt(x)).join(', ')} m/s`)),
       h('dt', null, 'Families'), h('dd', null, c.families.map((f) => FAMILY_LABEL[f] || f).join(', ')),

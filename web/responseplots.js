@@ -2,7 +2,7 @@
 // Hankel singular values as log-scale bars, the input–residual
 // cross-correlation as stems with its confidence band, and the overlay of
 // several models' predictions on one run.
-// Live charts: window.__plots.{step, hankel, xcorr, compare}.
+// Live charts: window.__plots.{step, hankel, xcorr, compare, compareXcorr<i>}.
 
 import uPlot from '/node_modules/uplot/dist/uPlot.esm.js';
 import { PALETTE, axisBase, autoSize, register, tick } from './plots.js';
@@ -70,7 +70,7 @@ export function singularBarsPlot(host, values, { order = null, label = 'σᵢ', 
 }
 
 /** Cross-correlation r(τ) as stems with ± its pointwise bound. */
-export function crossCorrelationPlot(host, cc, { confidence = 0.99, height = 220, h = null } = {}) {
+export function crossCorrelationPlot(host, cc, { confidence = 0.99, height = 220, h = null, name = 'xcorr' } = {}) {
   const bars = uPlot.paths.bars({ size: [0.3, 6] });
   const b = cc.lags.map(() => cc.bound);
   const pct = Math.round(confidence * 100);
@@ -93,5 +93,5 @@ export function crossCorrelationPlot(host, cc, { confidence = 0.99, height = 220
   };
   host.replaceChildren();
   const u = new uPlot(opts, [cc.lags, clean(cc.values), b, b.map((v) => -v)], host);
-  return register('xcorr', u, autoSize(u, host, height));
+  return register(name, u, autoSize(u, host, height));
 }

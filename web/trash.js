@@ -5,12 +5,13 @@ import { api, urls } from './api.js';
 import { h, fill } from './forms.js';
 import { fmtDate } from './format.js';
 
-function row(item, label, href, restore, onDone, msg) {
+/** One deleted item: its link, who deleted it, when and why, and Restore. */
+export function deletedRow(item, label, href, restore, onDone, msg, needs = 'supervisor') {
   return h('li', { 'data-testid': 'deleted-row', 'data-id': item.id },
     h('a', { href }, label), ' ',
     h('span', { class: 'muted' }, `deleted by ${item.deleted_by || '?'} at ${fmtDate(item.deleted_at)}${item.delete_reason ? ` — ${item.delete_reason}` : ''} `),
     h('button', {
-      type: 'button', class: 'btn small', 'data-testid': 'restore', 'data-needs': 'supervisor',
+      type: 'button', class: 'btn small', 'data-testid': 'restore', 'data-needs': needs,
       onclick: () => restore(item.id).then(onDone, (e) => fill(msg, h('p', { class: 'error-text', role: 'alert' }, e.message))),
     }, 'Restore'));
 }
@@ -26,8 +27,8 @@ export function deletedSection(id, onRestored) {
       h('h2', { class: 'section-title' }, 'Deleted ', h('span', { class: 'hint' }, 'kept with who, when and why; restore brings an item back into the lists')),
       runs.length || models.length
         ? h('ul', { class: 'plain' },
-          runs.map((r) => row(r, `run ${r.name}`, urls.run(r.id), api.restoreRun, done, msg)),
-          models.map((m) => row(m, `model ${m.name} v${m.version}`, urls.model(m.id), api.restoreModel, done, msg)))
+          runs.map((r) => deletedRow(r, `run ${r.name}`, urls.run(r.id), api.restoreRun, done, msg)),
+          models.map((m) => deletedRow(m, `model ${m.name} v${m.version}`, urls.model(m.id), api.restoreModel, done, msg)))
         : h('p', { class: 'empty', 'data-testid': 'nothing-deleted' }, 'Nothing deleted.'),
       msg);
   }

@@ -2,6 +2,8 @@
 
 import { api } from './api.js';
 import { renameControl } from './rename.js';
+import { vesselTrash } from './parenttrash.js';
+import { deletedBadge } from './manage.js';
 import {
   DOFS, KIND_LABEL, dofUnits, fmt, fmtDate, fmtU, knots, FAMILY_LABEL,
 } from './format.js';
@@ -50,7 +52,8 @@ export async function vesselList(view) {
             h('td', { class: 'num' }, `${fmt(v.controller_rate_hz)} Hz`),
             h('td', { class: 'num' }, `${fmt(v.logger_rate_hz)} Hz`),
             h('td', null, fmtDate(v.created_at)));
-        }))));
+        }))),
+    vesselTrash.list());
 }
 
 // ---- one vessel -------------------------------------------------------------
@@ -88,11 +91,12 @@ export async function vesselPage(view, id) {
   const [v, campaigns] = await Promise.all([api.vessel(id), api.campaigns(id)]);
   fill(view, 
     h('div', { class: 'page-head' },
-      h('h1', null, v.name, h('span', { class: 'tag' }, KIND_LABEL[v.kind] || v.kind)),
+      h('h1', { 'data-testid': 'vessel-title' }, v.name, h('span', { class: 'tag' }, KIND_LABEL[v.kind] || v.kind), deletedBadge(v)),
       h('div', { class: 'actions' },
         renameControl({ what: 'vessel', name: v.name, needs: 'engineer', save: (n) => api.renameVessel(v.id, n) }),
         h('a', { class: 'btn', href: `#/vessels/new?from=${encodeURIComponent(v.id)}`, 'data-needs': 'engineer' }, 'Copy as new vessel'),
         h('a', { class: 'btn primary', href: `#/campaigns/new?vessel=${encodeURIComponent(v.id)}`, 'data-testid': 'new-campaign-for-vessel', 'data-needs': 'supervisor' }, '+ New campaign'))),
+    vesselTrash.control(v),
     h('dl', { class: 'summary' },
       h('dt', null, 'DOFs'), h('dd', null, v.dofs.join(', ')),
       h('dt', null, 'Max forward speed'), h('dd', null, v.limits.surge ? `${fmt(knots(v.limits.surge.max_velocity), 2)} kn (${fmt(v.limits.surge.max_velocity)} m/s)` : '–'),

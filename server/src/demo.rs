@@ -34,7 +34,7 @@ pub fn dp_campaign() -> CampaignSpec {
 
 /// Seeds the demo if there are no vessels yet. Returns whether it did.
 pub async fn seed_if_empty(db: &Db, blobs: &BlobStore) -> anyhow::Result<bool> {
-    if !vessels::list(db).await?.is_empty() {
+    if vessels::any(db).await? {
         return Ok(false);
     }
     for (profile, spec) in [

@@ -103,11 +103,14 @@ pub async fn process_stored(
 pub struct Debris {
     /// Partial uploads removed from the blob store's `tmp/`.
     pub partial_uploads: usize,
+    /// Blob files no row names (a crash after a purge's commit, or between
+    /// an upload's file and its row), removed.
+    pub orphan_blobs: usize,
     /// Runs left `stored`, to process with [`Debris::reprocess`].
     pub stored_runs: Vec<String>,
 }
 
-/// Sweeps the partial uploads and lists the runs left `stored`. Call it
+/// Sweeps the partial uploads and orphan blob files and lists the runs left `stored`. Call it
 /// before serving, so that a run being uploaded now is not in the list.
 pub async fn sweep(db: &Db, blobs: &BlobStore) -> anyhow::Result<Debris> {
     let partial_uploads = blobs.sweep_tmp()?;
@@ -117,9 +120,20 @@ pub async fn sweep(db: &Db, blobs: &BlobStore) -> anyhow::Result<Debris> {
             "removed partial uploads a stopped server left in the blob store's tmp/"
         );
     }
+    let orphans = crate::storage::purge::orphan_blobs(db, blobs).await?;
+    for sha in &orphans {
+        blobs.remove(sha).await?;
+    }
+    if !orphans.is_empty() {
+        tracing::warn!(
+            files = orphans.len(),
+            "removed blob files no run names (a purge or upload cut short)"
+        );
+    }
     let stored_runs = runs::stored_ids(db).await?;
     Ok(Debris {
         partial_uploads,
+        orphan_blobs: orphans.len(),
         stored_runs,
     })
 }

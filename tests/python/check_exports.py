@@ -10,7 +10,8 @@ tests/api_exports.rs):
                  service's ZOH Φ, Γ at h)
   TAG-step.json  the service's step response: y(k) under a unit step on
                  every input from x = 0, per point, computed from that Φ, Γ
-  TAG.m          format=matlab (run in Octave when it is installed)
+  TAG.m          format=matlab (run in Octave when it is installed: it
+                 discretizes and simulates the step response itself)
   TAG.mat        format=mat        (scipy.io.loadmat)
 
 For each model: the npz matrices equal the stored ones exactly; A, B of the
@@ -112,7 +113,7 @@ def check_model(d, tag):
             y = simulate(ad, bd, c, dd, step["steps"])
             close(y, service, f"{tag}[{i}]: dlsim({src}) step response = the service's")
     check_mat(d, tag, z, ss, step, models, continuous)
-    octave(d, tag, doc)
+    octave(d, tag, doc, ss, step, continuous)
 
 
 def page(m, i, stacked):
@@ -148,13 +149,24 @@ def check_mat(d, tag, z, ss, step, models, continuous):
         close(y, np.array(step["points"][i]), f"{tag}[{i}].mat: dlsim step response = the service's")
 
 
-def octave(d, tag, doc):
+def octave_matrix(m):
+    """A matrix as an Octave literal, every float exact (repr round-trips)."""
+    m = np.atleast_2d(np.asarray(m, float))
+    return "[" + "; ".join(" ".join(repr(float(x)) for x in row) for row in m) + "]"
+
+
+def octave(d, tag, doc, ss, step, continuous):
+    """The .m export in Octave: it reads the stored matrix back exactly, and
+    Octave itself discretizes each point's A, B (ZOH by expm([A B; 0 0] h)
+    when continuous, as zoh() does) and runs the step recursion from x = 0:
+    the result is the service's step response to 1e-9."""
     exe = shutil.which("octave") or shutil.which("octave-cli")
     if exe is None:
         print(f"skip {tag}.m: octave is not installed")
         return
+    script = d / (tag + ".m")
     field = {"lpv": "model.lpv.A(:,:,1)", "dp_ship": "model.dp.A_si", "state_space": "model.ss.Phi"}[doc["kind"]]
-    code = f"source('{d / (tag + '.m')}'); printf('%.17g ', ({field})');"
+    code = f"source('{script}'); printf('%.17g ', ({field})');"
     out = subprocess.run([exe, "--no-gui", "--quiet", "--eval", code], capture_output=True, text=True)
     if out.returncode != 0:
         check(False, f"{tag}.m runs in Octave: {out.stderr.strip()}")
@@ -166,6 +178,37 @@ def octave(d, tag, doc):
         "state_space": lambda: doc["state_space"]["phi"],
     }[doc["kind"]]()
     check(np.array_equal(got, np.array(want, float).ravel()), f"{tag}.m: Octave reads the same matrix")
+    for i, p in enumerate(ss["points"]):
+        a, b = {
+            "lpv": (f"model.lpv.A(:,:,{i + 1})", f"model.lpv.B(:,:,{i + 1})"),
+            "dp_ship": ("model.dp.A_si", "model.dp.B_si"),
+            "state_space": ("model.ss.Phi", "model.ss.Gamma"),
+        }[doc["kind"]]
+        # C, D: the script's own for a state-space model; the LPV and DP scripts
+        # have none (the outputs are the velocities), so the ss_json's, as dlsim uses.
+        c, dd = ("model.ss.C", "model.ss.D") if doc["kind"] == "state_space" else (
+            octave_matrix(p["C"]), octave_matrix(p["D"]))
+        code = f"""source('{script}');
+A = {a}; B = {b}; C = {c}; D = {dd};
+h = {step["h"]!r}; steps = {int(step["steps"])};
+n = rows(A); m = columns(B);
+if {1 if continuous else 0}
+  E = expm([A B; zeros(m, n + m)] * h); Ad = E(1:n, 1:n); Bd = E(1:n, n+1:n+m);
+else
+  Ad = A; Bd = B;
+end
+x = zeros(n, 1); u = ones(m, 1); Y = zeros(steps, rows(C));
+for k = 1:steps
+  Y(k, :) = (C * x + D * u)'; x = Ad * x + Bd * u;
+end
+printf('%.17g ', Y');"""
+        out = subprocess.run([exe, "--no-gui", "--quiet", "--eval", code], capture_output=True, text=True)
+        if out.returncode != 0:
+            check(False, f"{tag}[{i}].m: Octave step response: {out.stderr.strip()}")
+            continue
+        service = np.array(step["points"][i], float)
+        y = np.array([float(x) for x in out.stdout.split()]).reshape(service.shape)
+        close(y, service, f"{tag}[{i}].m: Octave's own ZOH and step recursion = the service's step response")
 
 
 def main():

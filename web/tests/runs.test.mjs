@@ -373,3 +373,40 @@ test('a log in milliseconds and degrees: the result card says check units, with 
     await page.locator(`${tid('run-status')}[data-status="check_units"]`).first().waitFor();
   });
 });
+
+test('the campaign page pages its runs 20 at a time: page 2 holds runs 21 and on, counts right', async () => {
+  // A campaign of its own with 23 runs, uploaded oldest first (the list is newest first).
+  const c = await H.api('POST', '/api/campaigns', {
+    vessel_id: (await H.api('GET', `/api/campaigns/${cid}`)).json.vessel_id,
+    name: 'Pager e2e', grid: { unit: 'kn', speeds: [1] }, families: ['dynamic'], seed: 6,
+  });
+  assert.equal(c.status, 201, JSON.stringify(c.json));
+  const pid = c.json.id;
+  assert.equal((await H.api('POST', `/api/campaigns/${pid}/plan`)).status, 201);
+  const log = csv(simulate({ seed: 31, fs: 10, duration: 60, amp: [300, 300, 300, 300, 300, 300], clock: 2, noise: 1e-4, surge: 0.5 }), ALL_COLUMNS);
+  const names = Array.from({ length: 23 }, (_, i) => `pager ${String(i + 1).padStart(2, '0')}`);
+  for (const name of names) {
+    const form = new FormData();
+    form.append('meta', JSON.stringify({ name }));
+    form.append('file', new Blob([log], { type: 'text/csv' }), `${name}.csv`);
+    const res = await fetch(`${H.base}/api/campaigns/${pid}/runs`, { method: 'POST', body: form });
+    assert.equal(res.status, 201, await res.text());
+  }
+  const total = await H.api('GET', `/api/campaigns/${pid}/runs?limit=1`);
+  assert.equal(total.headers.get('x-total-count'), '23');
+  await H.withPage([], async (page) => {
+    await page.goto(`${H.base}/#/campaigns/${pid}`);
+    await page.locator(tid('runs-pager')).waitFor();
+    const rowNames = () => page.locator(`${tid('runs-table')} ${tid('run-link')}`).allTextContents();
+    assert.equal(await page.textContent(tid('runs-page')), '1–20 of 23');
+    assert.match(await page.textContent(`${tid('run-list')} h3`), /^Runs \(23\)/);
+    assert.deepEqual(await rowNames(), names.slice(3).reverse(), 'page 1: the 20 newest');
+    assert.ok(await page.locator(tid('runs-prev')).isDisabled());
+    await page.click(tid('runs-next'));
+    await page.waitForFunction(() => document.querySelector('[data-testid="runs-page"]').textContent === '21–23 of 23');
+    assert.deepEqual(await rowNames(), names.slice(0, 3).reverse(), 'page 2: runs 21–23 of the list');
+    assert.ok(await page.locator(tid('runs-next')).isDisabled());
+    await page.click(tid('runs-prev'));
+    await page.waitForFunction(() => document.querySelector('[data-testid="runs-page"]').textContent === '1–20 of 23');
+  });
+});

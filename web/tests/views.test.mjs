@@ -174,6 +174,13 @@ test('model page: Bode over H1, pole-zero, step, Hankel, residual cross-correlat
     assert.ok(pz.poles >= 1 && pz.plane === 's', JSON.stringify(pz));
     assert.ok(await inked(page.locator(`${tid('pz-plot')} canvas`)) > 1000);
     assert.match(await page.textContent(tid('pz-stability')), /stable/i);
+    // Pole text: 4 significant digits with units (rad/s for the roots and ωn, s for τ).
+    const poleText = await page.textContent(tid('pz-note'));
+    assert.match(poleText, /Poles: −?\d[\d.]* (?:[+−] [\d.]+j )?rad\/s \(/, poleText);
+    assert.match(poleText, /τ \d[\d.]* s/, poleText);
+    for (const n of poleText.match(/\d+\.\d+/g) || []) {
+      assert.ok(n.replace('.', '').replace(/^0+/, '').length <= 4, `4 significant digits: ${n} in ${poleText}`);
+    }
     // Step: every output of the chosen input; then the impulse.
     await page.locator(`${tid('step-plot')} canvas`).waitFor();
     const step = await chartInfo(page, 'step');
@@ -190,12 +197,26 @@ test('model page: Bode over H1, pole-zero, step, Hankel, residual cross-correlat
     const cmp = await chartInfo(page, 'compare');
     assert.ok(cmp.series >= 3, `measured and two models: ${JSON.stringify(cmp)}`);
     assert.ok(await page.locator(tid('compare-row')).count() >= 2);
-    // A window selected on the run page is offered here and zooms the overlay to it.
+    // Each compared model's input–residual cross-correlation with its band.
+    await page.locator(`${tid('compare-xcorr-plot')} canvas`).first().waitFor();
+    const models = await page.locator(tid('compare-row')).count();
+    assert.equal(await page.locator(tid('compare-xcorr-plot')).count(), models);
+    const cx = await chartInfo(page, 'compareXcorr0');
+    assert.equal(cx.series, 3, 'r(τ) and the ± band');
+    assert.match(await page.locator(tid('compare-xcorr-note')).first().textContent(), /99 % band/);
+    // A window selected on the run page is offered here: the models are validated on it.
     await page.evaluate((rid) => sessionStorage.setItem(`seatrial.window.${rid}`, JSON.stringify({ from_s: 100, to_s: 150 })), valRun);
     await page.locator(tid('compare-go')).click();
     await page.locator(tid('compare-window')).click();
-    const x = await page.evaluate(() => [window.__plots.compare.scales.x.min, window.__plots.compare.scales.x.max]);
-    assert.ok(Math.abs(x[0] - 100) < 1 && Math.abs(x[1] - 150) < 1, `compare zoomed to the window: ${x}`);
+    await page.waitForFunction(() => /Validated on 100(\.0+)?–150/.test(document.querySelector('[data-testid="compare-window-note"]')?.textContent || ''));
+    assert.equal(await page.inputValue(tid('compare-from')), '100');
+    const x = await page.evaluate(() => { const t = window.__plots.compare.data[0]; return [t[0], t[t.length - 1]]; });
+    assert.ok(x[0] >= 100 - 1e-6 && x[1] <= 150 + 1e-6 && x[1] - x[0] > 40, `compare drawn on the window: ${x}`);
+    await page.locator(`${tid('compare-xcorr-plot')} canvas`).first().waitFor();
+    const xcard = page.locator(tid('compare-xcorr'));
+    await xcard.scrollIntoViewIfNeeded();
+    await xcard.screenshot({ path: path.join(SHOTS, 'model-compare-xcorr-window.png') });
+    assertPng(await exported(page, xcard, 'png'), 'compare cross-correlation');
     const text = await views.textContent();
     assert.doesNotMatch(text, /NaN|Infinity|undefined|e\+?3\d\b/, 'no absurd numbers');
 

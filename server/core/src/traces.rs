@@ -108,14 +108,13 @@ fn stats(values: &[f64], valid: &[bool]) -> WindowStats {
     }
 }
 
-/// The window [`from_s`, `to_s`] (default: the whole record) with at most
-/// about `points` points per channel. `Err` names the bad field.
-pub fn trace_plot(
+/// The samples `i0..=i1` of the window [`from_s`, `to_s`] (default: the
+/// whole record), clipped to the record. `Err` names the bad field.
+pub fn window_indices(
     rec: &UniformRecord,
     from_s: Option<f64>,
     to_s: Option<f64>,
-    points: usize,
-) -> Result<TracePlot, (&'static str, String)> {
+) -> Result<(usize, usize), (&'static str, String)> {
     let n = rec.len();
     if n == 0 {
         return Err(("run_id", "the record has no samples".into()));
@@ -140,6 +139,45 @@ pub fn trace_plot(
     }
     let i0 = (((from - rec.t0) / dt).ceil().max(0.0) as usize).min(n - 1);
     let i1 = (((to - rec.t0) / dt).floor().max(0.0) as usize).min(n - 1);
+    Ok((i0, i1))
+}
+
+/// The record cut to the window [`from_s`, `to_s`] (see
+/// [`window_indices`]): its samples, valid blocks and start time, as if the
+/// log held only those rows.
+pub fn cut(
+    rec: &UniformRecord,
+    from_s: Option<f64>,
+    to_s: Option<f64>,
+) -> Result<UniformRecord, (&'static str, String)> {
+    let (i0, i1) = window_indices(rec, from_s, to_s)?;
+    Ok(UniformRecord {
+        sample_rate_hz: rec.sample_rate_hz,
+        t0: rec.t0 + i0 as f64 / rec.sample_rate_hz,
+        names: rec.names.clone(),
+        data: rec.data.iter().map(|c| c[i0..=i1].to_vec()).collect(),
+        valid: rec
+            .valid
+            .iter()
+            .map(|r| r.start.max(i0)..r.end.min(i1 + 1))
+            .filter(|r| r.start < r.end)
+            .map(|r| r.start - i0..r.end - i0)
+            .collect(),
+    })
+}
+
+/// The window [`from_s`, `to_s`] (default: the whole record) with at most
+/// about `points` points per channel. `Err` names the bad field.
+pub fn trace_plot(
+    rec: &UniformRecord,
+    from_s: Option<f64>,
+    to_s: Option<f64>,
+    points: usize,
+) -> Result<TracePlot, (&'static str, String)> {
+    let (i0, i1) = window_indices(rec, from_s, to_s)?;
+    let dt = 1.0 / rec.sample_rate_hz;
+    let t_of = |k: usize| rec.t0 + k as f64 * dt;
+    let (t_first, t_last) = (t_of(0), t_of(rec.len() - 1));
     let len = i1 + 1 - i0;
     let mut valid = vec![false; len];
     for r in &rec.valid {
@@ -218,6 +256,31 @@ mod tests {
             ],
             valid: std::iter::once(0..n).collect(),
         }
+    }
+
+    #[test]
+    fn a_cut_record_is_the_window_s_samples_with_its_valid_blocks() {
+        let rec = UniformRecord {
+            sample_rate_hz: 10.0,
+            t0: 5.0,
+            names: vec!["u".into()],
+            data: vec![(0..100).map(f64::from).collect()],
+            valid: vec![0..30, 40..100],
+        };
+        // 6.0–9.0 s: samples 10..=40, the gap 30..40 kept as a gap.
+        let w = super::cut(&rec, Some(6.0), Some(9.0)).unwrap();
+        assert_eq!(w.t0, 6.0);
+        assert_eq!(w.data[0].first(), Some(&10.0));
+        assert_eq!(w.data[0].last(), Some(&40.0));
+        assert_eq!(w.valid, vec![0..20, 30..31]);
+        assert_eq!(
+            super::cut(&rec, Some(9.0), Some(6.0)).unwrap_err().0,
+            "to_s"
+        );
+        assert_eq!(
+            super::cut(&rec, Some(f64::NAN), None).unwrap_err().0,
+            "from_s"
+        );
     }
 
     #[test]

@@ -50,6 +50,9 @@ pub struct NewCampaign {
 pub struct CampaignFilter {
     /// Only campaigns of this vessel.
     pub vessel_id: Option<String>,
+    /// `true`: the deleted campaigns instead of the live ones (default false;
+    /// the campaigns of a deleted vessel are in neither list).
+    pub deleted: Option<bool>,
 }
 
 /// Create a campaign. It is planned once as a dry run, so a campaign that
@@ -60,6 +63,7 @@ pub struct CampaignFilter {
         (status = 201, description = "Created", body = Campaign),
         (status = 400, description = "Malformed JSON; `field` names the JSON path", body = ErrorBody),
         (status = 404, description = "No such vessel", body = ErrorBody),
+        (status = 409, description = "The vessel is deleted (named by name and id)", body = ErrorBody),
         (status = 413, description = "Body too large", body = ErrorBody),
         (status = 415, description = "Not JSON", body = ErrorBody),
         (status = 422, description = "Impossible request: `field` and `limit` name what and why", body = ErrorBody)))]
@@ -73,6 +77,7 @@ pub async fn create_campaign(
             req.vessel_id
         ))
     })?;
+    super::lifecycle_parents::refuse_deleted(&s.db, "vessel", &vessel.id).await?;
     let spec = CampaignSpec {
         name: req.name,
         grid: req.grid,
@@ -93,8 +98,9 @@ pub async fn create_campaign(
     ))
 }
 
-/// List campaigns, oldest first; `limit`/`offset` page the list and the
-/// `X-Total-Count` header gives how many match.
+/// List campaigns, oldest first, without the deleted ones and those of a
+/// deleted vessel (`?deleted=true` lists the deleted ones); `limit`/`offset`
+/// page the list and the `X-Total-Count` header gives how many match.
 #[utoipa::path(get, path = "/api/campaigns", tag = "planning",
     params(CampaignFilter, Paging),
     responses((status = 200, description = "Campaigns, oldest first", body = [Campaign],
@@ -108,12 +114,12 @@ pub async fn list_campaigns(
 ) -> ApiResult<Response> {
     let page = p.page()?;
     Ok(paged(
-        campaigns::list(&s.db, f.vessel_id.as_deref()).await?,
+        campaigns::list(&s.db, f.vessel_id.as_deref(), f.deleted.unwrap_or(false)).await?,
         page,
     ))
 }
 
-/// One campaign.
+/// One campaign (a deleted one too, with `deleted_at`).
 #[utoipa::path(get, path = "/api/campaigns/{id}", tag = "planning",
     params(("id" = String, Path, description = "Campaign id")),
     responses((status = 200, description = "The campaign", body = Campaign),

@@ -47,6 +47,7 @@ async fn get_job_or_404(s: &AppState, id: &str) -> ApiResult<Job> {
         (status = 202, description = "Queued", body = Job),
         (status = 400, description = "Malformed JSON; `field` names the JSON path", body = ErrorBody),
         (status = 404, description = "An id in the request is unknown; `field` names it (`campaign_id`, `run_ids[i]`, `model_id`)", body = ErrorBody),
+        (status = 409, description = "The campaign or its vessel is deleted (named by name and id)", body = ErrorBody),
         (status = 413, description = "Body too large", body = ErrorBody),
         (status = 415, description = "Not JSON", body = ErrorBody),
         (status = 422, description = "Unusable request; `field` names it: an unknown `kind` (the message lists the registered ones), runs of another campaign, an unknown `method`, bad `settings`", body = ErrorBody)))]

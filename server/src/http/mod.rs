@@ -13,6 +13,7 @@ pub mod health;
 pub mod jobs;
 pub mod json;
 pub mod lifecycle;
+pub mod lifecycle_parents;
 pub mod manage;
 pub mod model_cache;
 pub mod model_export;
@@ -142,12 +143,22 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(auth::users::patch_user))
         .routes(routes!(auth::users::list_audit))
         .routes(routes!(vessels::create_vessel, vessels::list_vessels))
-        .routes(routes!(vessels::get_vessel, vessels::patch_vessel))
+        .routes(routes!(
+            vessels::get_vessel,
+            vessels::patch_vessel,
+            lifecycle_parents::delete_vessel
+        ))
+        .routes(routes!(lifecycle_parents::restore_vessel))
         .routes(routes!(
             campaigns::create_campaign,
             campaigns::list_campaigns
         ))
-        .routes(routes!(campaigns::get_campaign, manage::patch_campaign))
+        .routes(routes!(
+            campaigns::get_campaign,
+            manage::patch_campaign,
+            lifecycle_parents::delete_campaign
+        ))
+        .routes(routes!(lifecycle_parents::restore_campaign))
         .routes(routes!(plans::generate_plan, plans::get_plan))
         .routes(routes!(plans::get_experiment))
         .routes(routes!(plans::schedule_csv))

@@ -19,6 +19,7 @@ use crate::processing::{self, RunSummary};
 use crate::storage::models::{self, ModelSummary, StoredModel};
 use crate::storage::runs;
 use seatrial_core::identification::predictor::validate_on_run_with;
+use seatrial_core::traces;
 use seatrial_core::validation::ValidationSettings;
 
 /// Filters of the model list.
@@ -158,6 +159,11 @@ pub struct CompareQuery {
     pub k: Option<usize>,
     /// Period of the restarted free runs in seconds (default 10).
     pub restart_s: Option<f64>,
+    /// Validate on the window from this time only (s, log time; default:
+    /// the first sample).
+    pub from_s: Option<f64>,
+    /// … up to this time (s; default: the last sample).
+    pub to_s: Option<f64>,
 }
 
 /// One model's validation in a comparison.
@@ -180,6 +186,9 @@ pub struct Comparison {
     pub run_id: String,
     /// Its name.
     pub run_name: String,
+    /// The window validated on, `[from, to]` in s of log time (its first and
+    /// last sample): the whole run unless `from_s`/`to_s` cut it.
+    pub window_s: [f64; 2],
     /// The models, in the order asked (a, b, then `more`).
     pub models: Vec<ComparedModel>,
 }
@@ -189,12 +198,14 @@ const MAX_COMPARED: usize = 6;
 
 /// Validate two models (or up to six with `more`) on the same run, side by
 /// side (1-step, k-step, restarted free-run and simulation fits,
-/// divergences; residual tests).
+/// divergences; residual tests with the input–residual cross-correlations),
+/// on the whole run or the window `from_s`–`to_s` of it (as if the log held
+/// only those samples).
 #[utoipa::path(get, path = "/api/models/compare", tag = "models", params(CompareQuery),
     responses((status = 200, description = "Both validations", body = Comparison),
               (status = 400, description = "Missing or malformed query parameter", body = ErrorBody),
               (status = 404, description = "No such model or run", body = ErrorBody),
-              (status = 422, description = "The run cannot validate a model (vessel, columns, kind), `restart_s` is not a positive number of seconds, or more than 6 models", body = ErrorBody)))]
+              (status = 422, description = "The run cannot validate a model (vessel, columns, kind), `restart_s` is not a positive number of seconds, a window (`from_s`, `to_s`) not finite, empty or outside the run, or more than 6 models; `field` names it", body = ErrorBody)))]
 pub async fn compare_models(
     State(s): State<AppState>,
     ApiQuery(q): ApiQuery<CompareQuery>,
@@ -262,36 +273,49 @@ pub async fn compare_models(
         .map(|m| view(m.clone()).map(|v| v.document))
         .collect::<Result<_, _>>()?;
     let profile = vessel.profile.clone();
-    let reports = blocking(move || -> Result<Vec<serde_json::Value>, ApiError> {
-        let mut summary = RunSummary::default();
-        let record = processing::load_record(
-            &profile,
-            &stored_run.files,
-            &stored_run.meta,
-            &stored_run.priors,
-            &mut summary,
-        )
-        .map_err(|e| ApiError::invalid("run_id", e.message))?;
-        let input = stored_run.input(record);
-        let forces = processing::generalized_force_columns(&profile);
-        docs.iter()
-            .zip(fields)
-            .map(|(doc, field)| {
-                let settings = ValidationSettings {
-                    k,
-                    restart_s,
-                    ..ValidationSettings::default()
-                };
-                let rep = validate_on_run_with(doc, &input, &forces, settings)
-                    .map_err(|e| ApiError::invalid(field, e.to_string()))?;
-                serde_json::to_value(&rep).map_err(|e| ApiError::Internal(e.into()))
-            })
-            .collect()
-    })
+    let (from_s, to_s) = (q.from_s, q.to_s);
+    let (window_s, reports) = blocking(
+        move || -> Result<([f64; 2], Vec<serde_json::Value>), ApiError> {
+            let mut summary = RunSummary::default();
+            let record = processing::load_record(
+                &profile,
+                &stored_run.files,
+                &stored_run.meta,
+                &stored_run.priors,
+                &mut summary,
+            )
+            .map_err(|e| ApiError::invalid("run_id", e.message))?;
+            let record = if from_s.is_some() || to_s.is_some() {
+                traces::cut(&record, from_s, to_s)
+                    .map_err(|(field, m)| ApiError::invalid(field, m))?
+            } else {
+                record
+            };
+            let last = record.t0 + record.len().saturating_sub(1) as f64 / record.sample_rate_hz;
+            let window_s = [record.t0, last];
+            let input = stored_run.input(record);
+            let forces = processing::generalized_force_columns(&profile);
+            docs.iter()
+                .zip(fields)
+                .map(|(doc, field)| {
+                    let settings = ValidationSettings {
+                        k,
+                        restart_s,
+                        ..ValidationSettings::default()
+                    };
+                    let rep = validate_on_run_with(doc, &input, &forces, settings)
+                        .map_err(|e| ApiError::invalid(field, e.to_string()))?;
+                    serde_json::to_value(&rep).map_err(|e| ApiError::Internal(e.into()))
+                })
+                .collect::<Result<_, _>>()
+                .map(|reports| (window_s, reports))
+        },
+    )
     .await??;
     Ok(Json(Comparison {
         run_id: run.id.clone(),
         run_name: run.name.clone(),
+        window_s,
         models: stored
             .into_iter()
             .zip(reports)

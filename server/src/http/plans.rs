@@ -95,6 +95,7 @@ pub struct PlanRevision {
         (status = 201, description = "A new version", body = PlanRevision),
         (status = 400, description = "Malformed JSON; `field` names the JSON path", body = ErrorBody),
         (status = 404, description = "No such campaign", body = ErrorBody),
+        (status = 409, description = "The campaign or its vessel is deleted (named by name and id)", body = ErrorBody),
         (status = 413, description = "Body too large", body = ErrorBody),
         (status = 415, description = "A body that is not JSON", body = ErrorBody),
         (status = 422, description = "The campaign cannot be planned: `field` and `limit` name what and why", body = ErrorBody)))]
@@ -104,6 +105,7 @@ pub async fn generate_plan(
     OptionalApiJson(change): OptionalApiJson<CampaignRevision>,
 ) -> ApiResult<(StatusCode, Json<PlanRevision>)> {
     let campaign = found(campaigns::get(&s.db, &id).await?, "campaign", &id)?;
+    super::lifecycle_parents::refuse_deleted(&s.db, "campaign", &id).await?;
     let vessel = vessels::get(&s.db, &campaign.vessel_id)
         .await?
         .ok_or_else(|| ApiError::Internal(anyhow::anyhow!("campaign {id} has no vessel")))?;

@@ -111,6 +111,7 @@ fn run_name_of_file(filename: &str) -> String {
         (status = 201, description = "Stored, parsed and scored", body = Run),
         (status = 400, description = "Malformed upload: missing or unknown parts", body = ErrorBody),
         (status = 404, description = "No such campaign or experiment", body = ErrorBody),
+        (status = 409, description = "The campaign or its vessel is deleted (named by name and id)", body = ErrorBody),
         (status = 413, description = "Over the upload limit", body = ErrorBody),
         (status = 415, description = "Not multipart/form-data", body = ErrorBody),
         (status = 422, description = "Stored but invalid: `field` is the file, with `line` and `column`; `run_id` names the stored run. Or a `meta` field not accepted (`field` = `meta.…`, no run recorded)", body = ErrorBody)))]
@@ -121,6 +122,7 @@ pub async fn upload_run(
     multipart: Result<Multipart, MultipartRejection>,
 ) -> ApiResult<(StatusCode, Json<Run>)> {
     let campaign = found(campaigns::get(&s.db, &id).await?, "campaign", &id)?;
+    super::lifecycle_parents::refuse_deleted(&s.db, "campaign", &id).await?;
     let vessel = found(
         vessels::get(&s.db, &campaign.vessel_id).await?,
         "vessel",

@@ -32,22 +32,35 @@ pub async fn create_vessel(
     ))
 }
 
-/// List vessels, oldest first; `limit`/`offset` page the list and the
-/// `X-Total-Count` header gives how many there are.
-#[utoipa::path(get, path = "/api/vessels", tag = "planning", params(Paging),
+/// Filter of the vessel list.
+#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
+pub struct VesselFilter {
+    /// `true`: the deleted vessels instead of the live ones (default false).
+    pub deleted: Option<bool>,
+}
+
+/// List vessels, oldest first, without the deleted ones (`?deleted=true`
+/// lists those); `limit`/`offset` page the list and the `X-Total-Count`
+/// header gives how many there are.
+#[utoipa::path(get, path = "/api/vessels", tag = "planning", params(VesselFilter, Paging),
     responses((status = 200, description = "Vessels, oldest first", body = [Vessel],
                 headers(("x-total-count" = i64, description = "Vessels (all pages)"))),
               (status = 400, description = "Malformed query parameter", body = ErrorBody),
               (status = 422, description = "`limit` outside 1–1000", body = ErrorBody)))]
 pub async fn list_vessels(
     State(s): State<AppState>,
+    ApiQuery(f): ApiQuery<VesselFilter>,
     ApiQuery(p): ApiQuery<Paging>,
 ) -> ApiResult<Response> {
     let page = p.page()?;
-    Ok(paged(vessels::list(&s.db).await?, page))
+    Ok(paged(
+        vessels::list(&s.db, f.deleted.unwrap_or(false)).await?,
+        page,
+    ))
 }
 
-/// One vessel.
+/// One vessel (a deleted one too, with `deleted_at`).
 #[utoipa::path(get, path = "/api/vessels/{id}", tag = "planning",
     params(("id" = String, Path, description = "Vessel id")),
     responses((status = 200, description = "The vessel", body = Vessel),

@@ -7,7 +7,7 @@ use super::handler::JobContext;
 use super::service::Jobs;
 use crate::error::ApiError;
 use crate::storage::jobs::{self, Job, JobRequest};
-use crate::storage::{campaigns, runs};
+use crate::storage::{campaigns, runs, trash};
 
 /// Validates `request` and queues it.
 pub async fn submit(jobs: &Jobs, cx: &JobContext, request: JobRequest) -> Result<Job, ApiError> {
@@ -43,6 +43,13 @@ async fn check_campaign_and_runs(cx: &JobContext, request: &JobRequest) -> Resul
         })?),
         None => None,
     };
+    if let Some(c) = &campaign
+        && let Some(g) = trash::deleted_self_or_parent(&cx.db, "campaign", &c.id).await?
+    {
+        return Err(ApiError::Conflict(format!(
+            "{g} is deleted: restore it first (POST …/restore)"
+        )));
+    }
     if request.run_ids.is_empty() {
         return Ok(());
     }

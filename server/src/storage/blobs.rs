@@ -56,6 +56,22 @@ impl BlobStore {
         Ok(n)
     }
 
+    /// The names of the stored blob files (their SHA-256), without `tmp/`.
+    pub fn files(&self) -> std::io::Result<Vec<String>> {
+        let mut names = Vec::new();
+        for entry in std::fs::read_dir(&self.dir)? {
+            let entry = entry?;
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if entry.file_type()?.is_file()
+                && name.len() == 64
+                && name.bytes().all(|b| b.is_ascii_hexdigit())
+            {
+                names.push(name);
+            }
+        }
+        Ok(names)
+    }
+
     /// Path of a blob.
     pub fn path(&self, sha256: &str) -> PathBuf {
         self.dir.join(sha256)

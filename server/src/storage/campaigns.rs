@@ -3,6 +3,7 @@
 use seatrial_core::planning::CampaignSpec;
 use serde::Serialize;
 
+use super::trash::Deletion;
 use super::{Db, lock_row, new_id, now};
 
 /// A stored campaign.
@@ -20,6 +21,9 @@ pub struct Campaign {
     pub spec: CampaignSpec,
     /// Version of the newest plan; none before the first is generated.
     pub plan_version: Option<i64>,
+    /// Who deleted it, when and why (its runs and models stay readable by id).
+    #[serde(flatten)]
+    pub deletion: Deletion,
 }
 
 #[derive(sqlx::FromRow)]
@@ -29,6 +33,8 @@ struct Row {
     spec: String,
     created_at: String,
     plan_version: Option<i64>,
+    #[sqlx(flatten)]
+    deletion: Deletion,
 }
 
 impl TryFrom<Row> for Campaign {
@@ -42,12 +48,17 @@ impl TryFrom<Row> for Campaign {
             grid_speeds_mps: spec.grid.speeds_si(),
             spec,
             plan_version: r.plan_version,
+            deletion: r.deletion,
         })
     }
 }
 
-const SELECT: &str = "SELECT id, vessel_id, spec, created_at, \
+const SELECT: &str = "SELECT id, vessel_id, spec, created_at, deleted_at, deleted_by, delete_reason, \
     (SELECT MAX(p.version) FROM plan p WHERE p.campaign_id = campaign.id) AS plan_version FROM campaign";
+
+/// Campaigns the lists show: not deleted, on a vessel that is not deleted.
+const LIVE: &str = "campaign.deleted_at IS NULL AND \
+    (SELECT v.deleted_at FROM vessel v WHERE v.id = campaign.vessel_id) IS NULL";
 
 /// Inserts a validated campaign.
 pub async fn insert(db: &Db, vessel_id: &str, spec: CampaignSpec) -> anyhow::Result<Campaign> {
@@ -58,6 +69,7 @@ pub async fn insert(db: &Db, vessel_id: &str, spec: CampaignSpec) -> anyhow::Res
         grid_speeds_mps: spec.grid.speeds_si(),
         spec,
         plan_version: None,
+        deletion: Deletion::default(),
     };
     sqlx::query(
         "INSERT INTO campaign (id, vessel_id, name, spec, created_at) VALUES ($1, $2, $3, $4, $5)",
@@ -72,27 +84,30 @@ pub async fn insert(db: &Db, vessel_id: &str, spec: CampaignSpec) -> anyhow::Res
     Ok(c)
 }
 
-/// All campaigns, oldest first, optionally of one vessel.
-pub async fn list(db: &Db, vessel_id: Option<&str>) -> anyhow::Result<Vec<Campaign>> {
-    let rows = match vessel_id {
-        Some(v) => {
-            sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!(
-                "{SELECT} WHERE vessel_id = $1 ORDER BY id"
-            )))
-            .bind(v)
-            .fetch_all(db)
-            .await?
-        }
-        None => {
-            sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!("{SELECT} ORDER BY id")))
-                .fetch_all(db)
-                .await?
-        }
+/// Campaigns, oldest first, optionally of one vessel: the live ones (not
+/// deleted, on a live vessel) or, `deleted`, the deleted ones.
+pub async fn list(
+    db: &Db,
+    vessel_id: Option<&str>,
+    deleted: bool,
+) -> anyhow::Result<Vec<Campaign>> {
+    let which = if deleted {
+        "campaign.deleted_at IS NOT NULL"
+    } else {
+        LIVE
     };
-    rows.into_iter().map(Campaign::try_from).collect()
+    sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!(
+        "{SELECT} WHERE ($1 IS NULL OR vessel_id = $1) AND {which} ORDER BY id"
+    )))
+    .bind(vessel_id)
+    .fetch_all(db)
+    .await?
+    .into_iter()
+    .map(Campaign::try_from)
+    .collect()
 }
 
-/// One campaign.
+/// One campaign (deleted or not).
 pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Campaign>> {
     sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!("{SELECT} WHERE id = $1")))
         .bind(id)

@@ -12,7 +12,9 @@ pub mod jobs;
 pub mod models;
 pub mod plan_revision;
 pub mod plans;
+pub mod purge;
 pub mod runs;
+pub mod trash;
 pub mod vessels;
 
 use std::path::Path;
@@ -86,6 +88,8 @@ pub enum Restored {
     NotFound,
     /// It was not deleted; nothing changed.
     NotDeleted,
+    /// A parent (`kind 'name' (id)`) is deleted: restore it first.
+    ParentDeleted(String),
     /// Restored.
     Done,
 }

@@ -306,7 +306,9 @@ pub async fn delete(
     reason: Option<&str>,
 ) -> anyhow::Result<Deleted> {
     let mut tx = db.begin().await?;
-    if !lock_row(&mut tx, "model", id).await? || is_deleted(&mut tx, id).await? {
+    if !lock_row(&mut tx, "model", id).await?
+        || super::trash::is_deleted(&mut tx, "model", id).await?
+    {
         return Ok(Deleted::NotFound);
     }
     // The model and everything live derived from it, parents before children.
@@ -339,9 +341,17 @@ pub async fn delete(
         .bind(format!("%\"model_id\":\"{m}\"%"))
         .fetch_all(&mut *tx)
         .await?;
+        if jobs.is_empty() {
+            continue;
+        }
+        let (name, v): (String, i64) =
+            sqlx::query_as("SELECT name, version FROM model WHERE id = $1")
+                .bind(m)
+                .fetch_one(&mut *tx)
+                .await?;
         busy.extend(
             jobs.into_iter()
-                .map(|(j, kind)| format!("{kind} job {j} works on model {m}")),
+                .map(|(j, kind)| format!("{kind} job {j} works on model '{name}' v{v} ({m})")),
         );
     }
     if !busy.is_empty() {
@@ -363,30 +373,8 @@ pub async fn delete(
     Ok(Deleted::Gone(ids))
 }
 
-async fn is_deleted(conn: &mut SqliteConnection, id: &str) -> anyhow::Result<bool> {
-    let at: Option<Option<String>> =
-        sqlx::query_scalar("SELECT deleted_at FROM model WHERE id = $1")
-            .bind(id)
-            .fetch_optional(conn)
-            .await?;
-    Ok(at.flatten().is_some())
-}
-
-/// Undoes the soft delete of one model version, in one transaction.
+/// Undoes the soft delete of one model version, in one transaction
+/// (refused while its campaign or vessel is deleted).
 pub async fn restore(db: &Db, id: &str) -> anyhow::Result<Restored> {
-    let mut tx = db.begin().await?;
-    if !lock_row(&mut tx, "model", id).await? {
-        return Ok(Restored::NotFound);
-    }
-    if !is_deleted(&mut tx, id).await? {
-        return Ok(Restored::NotDeleted);
-    }
-    sqlx::query(
-        "UPDATE model SET deleted_at = NULL, deleted_by = NULL, delete_reason = NULL WHERE id = $1",
-    )
-    .bind(id)
-    .execute(&mut *tx)
-    .await?;
-    tx.commit().await?;
-    Ok(Restored::Done)
+    super::trash::restore(db, "model", id).await
 }

@@ -500,17 +500,22 @@ pub async fn update(
     Ok(true)
 }
 
-/// What is built from a run: the live models (estimation or validation)
-/// and the discovery reports that used it, as `kind 'name' v<version> (id)`
-/// phrases.
-pub async fn users(conn: &mut SqliteConnection, id: &str) -> anyhow::Result<Vec<String>> {
+/// What is built from a run: the models (estimation or validation; only
+/// the live ones unless `deleted_too`) and the discovery reports that used
+/// it, as `kind 'name' v<version> (id)` phrases.
+pub async fn users(
+    conn: &mut SqliteConnection,
+    id: &str,
+    deleted_too: bool,
+) -> anyhow::Result<Vec<String>> {
     // Ids are UUIDs: a quoted id matches exactly one element of a JSON list.
     let quoted = format!("%\"{id}\"%");
     let models: Vec<(String, String, i64)> = sqlx::query_as(
         "SELECT id, name, version FROM model WHERE (run_ids LIKE $1 OR validation_run_ids LIKE $1) \
-         AND deleted_at IS NULL ORDER BY created_at",
+         AND ($2 OR deleted_at IS NULL) ORDER BY created_at",
     )
     .bind(&quoted)
+    .bind(deleted_too)
     .fetch_all(&mut *conn)
     .await?;
     let reports: Vec<(String,)> = sqlx::query_as(
@@ -546,46 +551,17 @@ pub enum Deleted {
 /// provenance), with who deleted it, when and why.
 pub async fn delete(db: &Db, id: &str, by: &str, reason: Option<&str>) -> anyhow::Result<Deleted> {
     let mut tx = db.begin().await?;
-    if !lock_row(&mut tx, "run", id).await? || deleted_at(&mut tx, id).await?.is_some() {
+    if !lock_row(&mut tx, "run", id).await? || super::trash::is_deleted(&mut tx, "run", id).await? {
         return Ok(Deleted::NotFound);
     }
-    let users = users(&mut tx, id).await?;
-    sqlx::query(
-        "UPDATE run SET deleted_at = $1, deleted_by = $2, delete_reason = $3 WHERE id = $4",
-    )
-    .bind(now())
-    .bind(by)
-    .bind(reason)
-    .bind(id)
-    .execute(&mut *tx)
-    .await?;
+    let users = users(&mut tx, id, false).await?;
+    super::trash::mark(&mut tx, "run", id, by, reason).await?;
     tx.commit().await?;
     Ok(Deleted::Gone(users))
 }
 
-async fn deleted_at(conn: &mut SqliteConnection, id: &str) -> anyhow::Result<Option<String>> {
-    let at: Option<Option<String>> = sqlx::query_scalar("SELECT deleted_at FROM run WHERE id = $1")
-        .bind(id)
-        .fetch_optional(conn)
-        .await?;
-    Ok(at.flatten())
-}
-
-/// Undoes the soft delete of a run, in one transaction.
+/// Undoes the soft delete of a run, in one transaction (refused while its
+/// campaign or vessel is deleted).
 pub async fn restore(db: &Db, id: &str) -> anyhow::Result<Restored> {
-    let mut tx = db.begin().await?;
-    if !lock_row(&mut tx, "run", id).await? {
-        return Ok(Restored::NotFound);
-    }
-    if deleted_at(&mut tx, id).await?.is_none() {
-        return Ok(Restored::NotDeleted);
-    }
-    sqlx::query(
-        "UPDATE run SET deleted_at = NULL, deleted_by = NULL, delete_reason = NULL WHERE id = $1",
-    )
-    .bind(id)
-    .execute(&mut *tx)
-    .await?;
-    tx.commit().await?;
-    Ok(Restored::Done)
+    super::trash::restore(db, "run", id).await
 }

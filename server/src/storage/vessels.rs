@@ -3,6 +3,7 @@
 use seatrial_core::planning::VesselProfile;
 use serde::Serialize;
 
+use super::trash::Deletion;
 use super::{Db, lock_row, new_id, now};
 
 /// A stored vessel.
@@ -14,6 +15,9 @@ pub struct Vessel {
     pub created_at: String,
     /// The profile.
     pub profile: VesselProfile,
+    /// Who deleted it, when and why (a deleted vessel's campaigns leave the lists too).
+    #[serde(flatten)]
+    pub deletion: Deletion,
 }
 
 #[derive(sqlx::FromRow)]
@@ -21,7 +25,12 @@ struct Row {
     id: String,
     profile: String,
     created_at: String,
+    #[sqlx(flatten)]
+    deletion: Deletion,
 }
+
+const SELECT: &str =
+    "SELECT id, profile, created_at, deleted_at, deleted_by, delete_reason FROM vessel";
 
 impl TryFrom<Row> for Vessel {
     type Error = anyhow::Error;
@@ -30,6 +39,7 @@ impl TryFrom<Row> for Vessel {
             id: r.id,
             created_at: r.created_at,
             profile: serde_json::from_str(&r.profile)?,
+            deletion: r.deletion,
         })
     }
 }
@@ -40,6 +50,7 @@ pub async fn insert(db: &Db, profile: VesselProfile) -> anyhow::Result<Vessel> {
         id: new_id(),
         created_at: now(),
         profile,
+        deletion: Deletion::default(),
     };
     sqlx::query(
         "INSERT INTO vessel (id, name, kind, profile, created_at) VALUES ($1, $2, $3, $4, $5)",
@@ -59,19 +70,30 @@ pub async fn insert(db: &Db, profile: VesselProfile) -> anyhow::Result<Vessel> {
     Ok(v)
 }
 
-/// All vessels, oldest first.
-pub async fn list(db: &Db) -> anyhow::Result<Vec<Vessel>> {
-    sqlx::query_as::<_, Row>("SELECT id, profile, created_at FROM vessel ORDER BY id")
-        .fetch_all(db)
-        .await?
-        .into_iter()
-        .map(Vessel::try_from)
-        .collect()
+/// The live vessels (or, `deleted`, the deleted ones), oldest first.
+pub async fn list(db: &Db, deleted: bool) -> anyhow::Result<Vec<Vessel>> {
+    let gone = if deleted { "NOT NULL" } else { "NULL" };
+    sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!(
+        "{SELECT} WHERE deleted_at IS {gone} ORDER BY id"
+    )))
+    .fetch_all(db)
+    .await?
+    .into_iter()
+    .map(Vessel::try_from)
+    .collect()
 }
 
-/// One vessel.
+/// Whether any vessel is stored, deleted ones included.
+pub async fn any(db: &Db) -> anyhow::Result<bool> {
+    Ok(sqlx::query_scalar::<_, i64>("SELECT COUNT(*) FROM vessel")
+        .fetch_one(db)
+        .await?
+        > 0)
+}
+
+/// One vessel (deleted or not).
 pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<Vessel>> {
-    sqlx::query_as::<_, Row>("SELECT id, profile, created_at FROM vessel WHERE id = $1")
+    sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!("{SELECT} WHERE id = $1")))
         .bind(id)
         .fetch_optional(db)
         .await?
@@ -86,7 +108,7 @@ pub async fn rename(db: &Db, id: &str, name: &str) -> anyhow::Result<Option<Vess
     if !lock_row(&mut tx, "vessel", id).await? {
         return Ok(None);
     }
-    let row = sqlx::query_as::<_, Row>("SELECT id, profile, created_at FROM vessel WHERE id = $1")
+    let row = sqlx::query_as::<_, Row>(sqlx::AssertSqlSafe(format!("{SELECT} WHERE id = $1")))
         .bind(id)
         .fetch_one(&mut *tx)
         .await?;

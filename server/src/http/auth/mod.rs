@@ -154,13 +154,16 @@ pub fn access(method: &Method, route: &str) -> Access {
         ("POST", "/api/campaigns" | "/api/campaigns/{id}/plan" | "/api/campaigns/{id}/runs") => {
             Supervisor
         }
-        ("PATCH", "/api/campaigns/{id}") => Supervisor,
+        ("PATCH" | "DELETE", "/api/campaigns/{id}") | ("POST", "/api/campaigns/{id}/restore") => {
+            Supervisor
+        }
         ("PATCH" | "DELETE", "/api/runs/{id}") | ("POST", "/api/runs/{id}/restore") => Supervisor,
         ("PUT", "/api/runs/{id}/clock-offset") => Supervisor,
         ("POST", "/api/jobs" | "/api/jobs/{id}/cancel" | "/api/jobs/{id}/retry") => Supervisor,
         // Settings: vessel profiles (limits, priors, thrusters), a campaign's
         // clock offset (it re-aligns every run); models.
-        ("POST", "/api/vessels") | ("PATCH", "/api/vessels/{id}") => Engineer,
+        ("POST", "/api/vessels" | "/api/vessels/{id}/restore")
+        | ("PATCH" | "DELETE", "/api/vessels/{id}") => Engineer,
         ("PUT", "/api/campaigns/{id}/clock-offset") => Engineer,
         ("PATCH" | "DELETE", "/api/models/{id}") | ("POST", "/api/models/{id}/restore") => Engineer,
         _ => Admin,
