@@ -6,7 +6,7 @@
 import { h, fill } from './forms.js';
 import { crossCorrelationPlot } from './responseplots.js';
 import { exportBar, uplotExportable } from './plotexport.js';
-import { exact } from './runplots.js';
+import { fmtSig } from './format.js';
 
 /** The section; `draw(result, output)` redraws it for a comparison. */
 export function compareXcorrSection() {
@@ -36,7 +36,7 @@ export function compareXcorrSection() {
         h('h5', null, `${m.model.name} v${m.model.version} `, exportBar(() => (window.__plots[`compareXcorr${i}`] ? uplotExportable(window.__plots[`compareXcorr${i}`], title) : null), `compare-xcorr-export-${i}`)),
         host,
         h('p', { class: 'hint', 'data-testid': 'compare-xcorr-note' }, cc
-          ? `${cc.lags_outside.length} of ${cc.lags.length} lags outside the ${Math.round(m.report.confidence * 100)} % band ±${exact(cc.bound)}${cc.leak ? ` — the input reaches the residual (peak r = ${exact(cc.peak_value)} at lag ${cc.peak_lag})` : cc.feedback ? ' — only negative lags: feedback, expected in closed loop' : ' — no leak'}.`
+          ? `${cc.lags_outside.length} of ${cc.lags.length} lags outside the ${Math.round(m.report.confidence * 100)} % band ±${fmtSig(cc.bound, 3)}${cc.leak ? ` — the input reaches the residual (peak r = ${fmtSig(cc.peak_value, 3)} at lag ${cc.peak_lag})` : cc.feedback ? ' — only negative lags: feedback, expected in closed loop' : ' — no leak'}.`
           : `No cross-correlation of ${input} with this model’s residual of ${state.output}.`));
       if (cc) requestAnimationFrame(() => crossCorrelationPlot(host, cc, { confidence: m.report.confidence, h: m.report.sample_time_s, height: 180, name: `compareXcorr${i}` }));
       return card;

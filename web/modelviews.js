@@ -197,8 +197,8 @@ export function modelViewsSection(model, doc, { runs = [], validation = [] } = {
     if (!cc) { fill(xcHost, h('p', { class: 'empty' }, 'No cross-correlation in this report.')); return; }
     exps.xcorr = `Input–residual cross-correlation — ${model.name} v${model.version} on ${rv.run_name}: ${cc.input} → residual of ${c.output}`;
     crossCorrelationPlot(xcHost, cc, { confidence: rv.report.confidence, h: rv.report.sample_time_s });
-    fill(xcNote, `1-step residual of ${c.output} against ${cc.input} on ${rv.run_name}: ${cc.lags_outside.length} of ${cc.lags.length} lags outside the ${Math.round(rv.report.confidence * 100)} % band ±${exact(cc.bound)}. `
-      + (cc.leak ? `The input reaches the residual (peak r = ${exact(cc.peak_value)} at lag ${cc.peak_lag}): a missed coupling or delay.` : cc.feedback ? 'Only negative lags exceed the band: feedback from a controller, expected in closed loop.' : 'No leak: the model explains what this input does.'));
+    fill(xcNote, `1-step residual of ${c.output} against ${cc.input} on ${rv.run_name}: ${cc.lags_outside.length} of ${cc.lags.length} lags outside the ${Math.round(rv.report.confidence * 100)} % band ±${fmtSig(cc.bound, 3)}. `
+      + (cc.leak ? `The input reaches the residual (peak r = ${fmtSig(cc.peak_value, 3)} at lag ${cc.peak_lag}): a missed coupling or delay.` : cc.feedback ? 'Only negative lags exceed the band: feedback from a controller, expected in closed loop.' : 'No leak: the model explains what this input does.'));
   }
 
   // ---- layout --------------------------------------------------------------------
