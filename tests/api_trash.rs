@@ -124,6 +124,15 @@ async fn campaigns_are_deleted_and_restored_keeping_their_runs_and_models_readab
         "provenance names the run: {}",
         m.text
     );
+    // The models list leaves its models out, as it does the campaign; the
+    // campaign's own list still has them.
+    let r = app.call("GET", "/api/models", &[], None).await;
+    assert!(!r.text.contains(&mid), "{}", r.text);
+    assert_eq!(r.headers["x-total-count"], "0");
+    let r = app
+        .call("GET", "/api/models?campaign_id={id}", &[&cid], None)
+        .await;
+    assert!(r.text.contains(&mid), "{}", r.text);
     // A second delete is a 404; nothing new goes under it (409 naming it).
     let r = app
         .call("DELETE", "/api/campaigns/{id}", &[&cid], None)
@@ -167,6 +176,8 @@ async fn campaigns_are_deleted_and_restored_keeping_their_runs_and_models_readab
     assert!(r.json["deleted_at"].is_null(), "{}", r.text);
     let r = app.call("GET", "/api/campaigns", &[], None).await;
     assert_eq!(ids(&r), vec![cid.clone(), other.clone()]);
+    let r = app.call("GET", "/api/models", &[], None).await;
+    assert!(r.text.contains(&mid), "{}", r.text);
     let r = app
         .call("POST", "/api/campaigns/{id}/restore", &[&cid], None)
         .await;

@@ -57,7 +57,7 @@ const SELECT: &str = "SELECT id, vessel_id, spec, created_at, deleted_at, delete
     (SELECT MAX(p.version) FROM plan p WHERE p.campaign_id = campaign.id) AS plan_version FROM campaign";
 
 /// Campaigns the lists show: not deleted, on a vessel that is not deleted.
-const LIVE: &str = "campaign.deleted_at IS NULL AND \
+pub(crate) const LIVE: &str = "campaign.deleted_at IS NULL AND \
     (SELECT v.deleted_at FROM vessel v WHERE v.id = campaign.vessel_id) IS NULL";
 
 /// Inserts a validated campaign.

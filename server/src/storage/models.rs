@@ -225,6 +225,9 @@ pub async fn get(db: &Db, id: &str) -> anyhow::Result<Option<StoredModel>> {
 
 /// A page of models, newest first, optionally of one campaign or lineage,
 /// the live ones or (`deleted`) the deleted ones, and the number that match.
+/// Without a campaign, live models of a deleted campaign (or of one on a
+/// deleted vessel) are left out, as their campaign is; the campaign's own
+/// list still shows them.
 pub async fn page(
     db: &Db,
     campaign_id: Option<&str>,
@@ -232,9 +235,17 @@ pub async fn page(
     deleted: bool,
     page: Page,
 ) -> anyhow::Result<(Vec<ModelSummary>, i64)> {
+    let state = if deleted {
+        "deleted_at IS NOT NULL".to_string()
+    } else {
+        format!(
+            "deleted_at IS NULL AND ($1 IS NOT NULL OR campaign_id IN \
+             (SELECT campaign.id FROM campaign WHERE {}))",
+            super::campaigns::LIVE
+        )
+    };
     let filter = format!(
-        "WHERE ($1 IS NULL OR campaign_id = $1) AND ($2 IS NULL OR lineage_id = $2) AND deleted_at IS {}",
-        if deleted { "NOT NULL" } else { "NULL" }
+        "WHERE ($1 IS NULL OR campaign_id = $1) AND ($2 IS NULL OR lineage_id = $2) AND {state}"
     );
     let (total,): (i64,) = sqlx::query_as(sqlx::AssertSqlSafe(format!(
         "SELECT COUNT(*) FROM model {filter}"
