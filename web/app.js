@@ -27,6 +27,12 @@ function parse() {
   return { parts, query: new URLSearchParams(qs || '') };
 }
 
+/** The page's `data-page-*` attributes (e.g. a deleted campaign) moved onto #view, for style.css. */
+function pageState(from) {
+  for (const a of [...view.attributes]) if (a.name.startsWith('data-page-')) view.removeAttribute(a.name);
+  if (from) for (const a of [...from.attributes]) if (a.name.startsWith('data-page-')) view.setAttribute(a.name, a.value);
+}
+
 async function route() {
   const { parts, query } = parse();
   const my = ++seq;
@@ -44,6 +50,7 @@ async function route() {
   destroyPlots();
   clearBanner();
   fill(view, h('p', { class: 'loading' }, h('span', { class: 'spinner', 'aria-hidden': 'true' }), 'Loading…'));
+  pageState(null);
   const target = h('div');
   try {
     let ctl = null;
@@ -68,6 +75,7 @@ async function route() {
     }
     if (my !== seq) { if (ctl && ctl.destroy) ctl.destroy(); return; }
     fill(view, ...target.childNodes);
+    pageState(target);
     current = ctl;
     showFlash();
     const h1 = view.querySelector('h1');

@@ -34,7 +34,8 @@ export function deleteControl({ what, item, needs, consequence, del, restore }) 
         question: `Delete ${what} “${item.name}”? ${consequence} Undo brings it back.`,
         label: `Delete ${what}`,
         extra: why,
-        run: () => del(item.id, why.value).then((now) => { fill(msg); showDeleted(now); }, (e) => errorBox(msg, e)),
+        // Re-rendered: a deleted campaign's page drops its new-work controls.
+        run: () => del(item.id, why.value).then(() => reloadPage(), (e) => errorBox(msg, e)),
       });
     },
   }, `Delete ${what}…`), msg);

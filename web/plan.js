@@ -119,6 +119,9 @@ export async function campaignPage(view, id) {
 
   const c = campaign;
   const durs = c.durations || {};
+  // A deleted campaign is read-only: no new plan, upload, job or discovery
+  // (the server answers 409); style.css hides those controls.
+  if (c.deleted_at) view.setAttribute('data-page-deleted', '');
   fill(view, 
     h('div', { class: 'page-head' },
       h('div', null,

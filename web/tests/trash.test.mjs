@@ -56,6 +56,10 @@ test('a campaign is deleted with a reason, undone, deleted again and restored fr
     await page.locator(tid('deleted-note')).waitFor();
     assert.match(await page.textContent(tid('deleted-note')), /wrong grid/);
     await shot(page, 'campaign-deleted-undo');
+    // Read-only while deleted: no plan, upload or identify controls.
+    for (const t of ['generate-plan', 'upload-form', 'identify-form']) {
+      assert.equal(await page.locator(tid(t)).isVisible(), false, `${t} hidden on a deleted campaign`);
+    }
     let r = await H.api('GET', `/api/campaigns/${cid}`);
     assert.equal(r.json.delete_reason, 'wrong grid');
     r = await H.api('GET', '/api/campaigns');
@@ -63,6 +67,7 @@ test('a campaign is deleted with a reason, undone, deleted again and restored fr
     // Undo on the spot.
     await page.click(tid('undo-delete'));
     await page.locator(tid('delete-campaign')).waitFor();
+    await page.locator(tid('generate-plan')).waitFor();
     r = await H.api('GET', `/api/campaigns/${cid}`);
     assert.equal(r.json.deleted_at, null);
     // Deleted again, then restored from the campaign list.
