@@ -336,25 +336,20 @@ fn the_gram_route_serves_noisy_data_and_noise_free_data_go_to_the_qr() {
     let layout = Layout { m: 2, l: 2, i: 8 };
     let route = |noise: f64, seed: u64| {
         let (u, y) = simulate(&sys, 3000, seed, noise, &DVector::zeros(4));
-        let (lq, route) = hankel_lq(
-            &[(&u, &y)],
-            &[1.0; 2],
-            &[1.0; 2],
-            layout,
-            256,
-            &mut NoProgress,
-        )
-        .unwrap();
-        let qr = hankel_lq_qr(
-            &[(&u, &y)],
-            &[1.0; 2],
-            &[1.0; 2],
-            layout,
-            256,
-            &mut NoProgress,
-        )
-        .unwrap();
+        let data = [(&u, &y)];
+        let (lq, route) =
+            hankel_lq(&data, &[1.0; 2], &[1.0; 2], layout, 256, &mut NoProgress).unwrap();
+        let qr = hankel_lq_qr(&data, &[1.0; 2], &[1.0; 2], layout, 256, &mut NoProgress).unwrap();
         (lq, qr, route)
+    };
+    // Pole moduli of the model built on an L, ascending.
+    let moduli = |lq: &super::super::hankel::HankelLq| {
+        let mut m: Vec<f64> = poles_from_l(&lq.l, layout, lq.columns)
+            .iter()
+            .map(|z| z.norm())
+            .collect();
+        m.sort_by(f64::total_cmp);
+        m
     };
     for (noise, seed) in [(0.1, 21u64), (0.01, 22), (1.0, 23)] {
         let (lq, qr, r) = route(noise, seed);
@@ -362,12 +357,7 @@ fn the_gram_route_serves_noisy_data_and_noise_free_data_go_to_the_qr() {
         let gram = &qr.l * qr.l.transpose();
         let err = (&lq.l * lq.l.transpose() - &gram).amax() / gram.amax();
         assert!(err < 1e-12, "noise {noise}: L Lᵀ differs by {err:e}");
-        let pg = poles_from_l(&lq.l, layout, lq.columns);
-        let pq = poles_from_l(&qr.l, layout, qr.columns);
-        let mut sg: Vec<f64> = pg.iter().map(|z| z.norm()).collect();
-        let mut sq: Vec<f64> = pq.iter().map(|z| z.norm()).collect();
-        sg.sort_by(f64::total_cmp);
-        sq.sort_by(f64::total_cmp);
+        let (sg, sq) = (moduli(&lq), moduli(&qr));
         for (a, b) in sg.iter().zip(&sq) {
             assert!(
                 (a - b).abs() < 1e-9,
