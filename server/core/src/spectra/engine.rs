@@ -8,6 +8,7 @@ use realfft::{RealFftPlanner, RealToComplex};
 
 use super::detrend::detrend_in_place;
 use super::{Detrend, SpectraError, WelchConfig};
+use crate::kernels::has_avx2_fma;
 
 /// Windowed, detrended real FFTs of the successive segments of a signal.
 ///
@@ -23,6 +24,9 @@ pub(crate) struct SegmentFft {
     n_segments: usize,
     input: Vec<f64>,
     scratch: Vec<Complex<f64>>,
+    /// `W = rfft(window)` at the bins where it is not zero to rounding
+    /// (bins 0 and 1 of a periodic Hann): what a constant shifts.
+    window_dft: Vec<(usize, Complex<f64>)>,
 }
 
 impl SegmentFft {
@@ -31,8 +35,9 @@ impl SegmentFft {
         let fft = RealFftPlanner::<f64>::new().plan_fft_forward(cfg.nperseg);
         let window = cfg.window.coefficients(cfg.nperseg);
         let window_power = window.iter().map(|w| w * w).sum();
-        let input = fft.make_input_vec();
-        let scratch = fft.make_scratch_vec();
+        let mut input = fft.make_input_vec();
+        let mut scratch = fft.make_scratch_vec();
+        let window_dft = sparse_dft(&*fft, &window, &mut input, &mut scratch);
         SegmentFft {
             fft,
             window,
@@ -43,6 +48,7 @@ impl SegmentFft {
             n_segments: cfg.n_segments(n_samples),
             input,
             scratch,
+            window_dft,
         }
     }
 
@@ -84,15 +90,25 @@ impl SegmentFft {
         self.fft_of_input(out)
     }
 
-    /// `out = rfft(window · (samples − offset))` for one segment of
-    /// exactly `nperseg` samples, in one pass into the FFT's input (the
-    /// caller's constant detrend: `offset` is the segment mean).
-    pub(crate) fn transform_offset(
+    /// `out = rfft(window · (samples − mean(samples)))` for one segment of
+    /// exactly `nperseg` samples, reading each sample once: the window is
+    /// applied to `samples − shift` while `Σ (samples − shift)` is summed,
+    /// and the constant `mean − shift` is then removed in the frequency
+    /// domain (`out[k] −= (mean − shift)·W[k]`, W the window's DFT, nonzero
+    /// at two bins for Hann). Returns `mean − shift`, non-finite when a
+    /// sample is (or the sum overflows).
+    ///
+    /// `shift` should be close to the mean (the previous segment's mean,
+    /// or a sample): the bins it corrects lose `|mean − shift| / σ` of
+    /// their relative precision to cancellation. `prefetch` (may be empty)
+    /// is asked into the cache meanwhile: the next segment's new samples.
+    pub(crate) fn transform_centred(
         &mut self,
         samples: &[f64],
-        offset: f64,
+        shift: f64,
+        prefetch: &[f64],
         out: &mut [Complex<f64>],
-    ) -> Result<(), SpectraError> {
+    ) -> Result<f64, SpectraError> {
         if samples.len() != self.nperseg {
             return Err(SpectraError::parameter(
                 "nperseg",
@@ -103,12 +119,13 @@ impl SegmentFft {
                 ),
             ));
         }
-        self.input
-            .iter_mut()
-            .zip(samples)
-            .zip(&self.window)
-            .for_each(|((v, x), w)| *v = (x - offset) * w);
-        self.fft_of_input(out)
+        let sum = window_shifted(&mut self.input, samples, &self.window, shift, prefetch);
+        self.fft_of_input(out)?;
+        let offset = sum / self.nperseg as f64;
+        for &(k, w) in &self.window_dft {
+            out[k] -= w * offset;
+        }
+        Ok(offset)
     }
 
     /// `out = rfft(input)` (the input buffer is used as scratch).
@@ -138,6 +155,114 @@ impl SegmentFft {
     }
 }
 
+/// The bins of `rfft(window)` that are not zero to rounding (all of them
+/// but ~64 ε · Σ|w|), computed with the engine's own plan.
+fn sparse_dft(
+    fft: &dyn RealToComplex<f64>,
+    window: &[f64],
+    input: &mut [f64],
+    scratch: &mut [Complex<f64>],
+) -> Vec<(usize, Complex<f64>)> {
+    input.copy_from_slice(window);
+    let mut out = fft.make_output_vec();
+    if fft.process_with_scratch(input, &mut out, scratch).is_err() {
+        return Vec::new();
+    }
+    let noise = 64.0 * f64::EPSILON * window.iter().map(|w| w.abs()).sum::<f64>();
+    out.into_iter()
+        .enumerate()
+        .filter(|(_, w)| w.norm() > noise)
+        .collect()
+}
+
+/// `input = window · (samples − shift)`, returning `Σ (samples − shift)`
+/// (eight partial sums), with prefetches of `prefetch` spread over the loop.
+fn window_shifted(
+    input: &mut [f64],
+    samples: &[f64],
+    window: &[f64],
+    shift: f64,
+    prefetch: &[f64],
+) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2_fma() {
+        // SAFETY: the CPU has the features the function is compiled for.
+        return unsafe { window_shifted_avx2(input, samples, window, shift, prefetch) };
+    }
+    window_shifted_body(input, samples, window, shift, prefetch)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn window_shifted_avx2(
+    input: &mut [f64],
+    samples: &[f64],
+    window: &[f64],
+    shift: f64,
+    prefetch: &[f64],
+) -> f64 {
+    window_shifted_body(input, samples, window, shift, prefetch)
+}
+
+/// Samples per cache line.
+const LINE: usize = 8;
+
+#[inline(always)]
+fn window_shifted_body(
+    input: &mut [f64],
+    samples: &[f64],
+    window: &[f64],
+    shift: f64,
+    prefetch: &[f64],
+) -> f64 {
+    let n = input.len().min(samples.len()).min(window.len());
+    let full = n / LINE * LINE;
+    // One prefetched line of `prefetch` per `stride` lines of samples.
+    let lines = prefetch.len().div_ceil(LINE);
+    let stride = (full / LINE)
+        .checked_div(lines)
+        .map_or(usize::MAX, |s| s.max(1));
+    let mut acc = [0.0f64; LINE];
+    let mut next = 0;
+    for (line, ((v, x), w)) in input[..full]
+        .chunks_exact_mut(LINE)
+        .zip(samples[..full].chunks_exact(LINE))
+        .zip(window[..full].chunks_exact(LINE))
+        .enumerate()
+    {
+        if line % stride == 0 && next < prefetch.len() {
+            prefetch_line(&prefetch[next]);
+            next += LINE;
+        }
+        for k in 0..LINE {
+            let d = x[k] - shift;
+            acc[k] += d;
+            v[k] = d * w[k];
+        }
+    }
+    let mut tail = 0.0;
+    for k in full..n {
+        let d = samples[k] - shift;
+        tail += d;
+        input[k] = d * window[k];
+    }
+    ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + tail
+}
+
+/// Asks the cache line holding `x` into L2 (a hint, no effect on values).
+#[inline(always)]
+fn prefetch_line(x: &f64) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch never faults and reads nothing; SSE is baseline
+    // on x86_64.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T1, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T1>((x as *const f64).cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -163,6 +288,53 @@ mod tests {
                 }
                 assert!((o - acc).norm() < 1e-12, "seg {m} bin {k}: {o} vs {acc}");
             }
+        }
+    }
+
+    #[test]
+    fn centred_transform_is_the_dft_of_the_mean_removed_segment() {
+        // Odd and even lengths; shifts at, near and far from the mean.
+        for n in [6usize, 7, 64] {
+            let cfg = WelchConfig::hann(1.0, n);
+            let x: Vec<f64> = (0..n)
+                .map(|i| 40.0 + ((i * i) % 7) as f64 - 0.3 * i as f64)
+                .collect();
+            let mean = x.iter().sum::<f64>() / n as f64;
+            let w = cfg.window.coefficients(n);
+            let mut eng = SegmentFft::new(&cfg, n);
+            let mut out = eng.make_output();
+            for shift in [mean, x[0], 0.0, -1e3] {
+                let offset = eng.transform_centred(&x, shift, &x[..3], &mut out).unwrap();
+                assert!((shift + offset - mean).abs() < 1e-12 * mean.abs());
+                let scale: f64 = x.iter().map(|v| v.abs()).sum();
+                for (k, o) in out.iter().enumerate() {
+                    let mut acc = Complex::new(0.0, 0.0);
+                    for (i, s) in x.iter().enumerate() {
+                        let ang = -2.0 * std::f64::consts::PI * (k * i) as f64 / n as f64;
+                        acc += Complex::from_polar(w[i] * (s - mean), ang);
+                    }
+                    // Rounding of the samples' size (the reference's own
+                    // too), and cancellation at the corrected bins that
+                    // grows with the shift's distance from the mean.
+                    let tol = 1e-14 * (scale + n as f64 * (mean - shift).abs());
+                    assert!(
+                        (o - acc).norm() < tol,
+                        "n {n} shift {shift} bin {k}: {o} vs {acc}"
+                    );
+                }
+            }
+            // A non-finite sample makes the returned offset non-finite.
+            for bad in [f64::NAN, f64::INFINITY] {
+                let mut y = x.clone();
+                y[n - 1] = bad;
+                let offset = eng.transform_centred(&y, y[0], &[], &mut out).unwrap();
+                assert!(!offset.is_finite());
+            }
+            // The window's DFT is kept at Hann's two nonzero bins only.
+            assert_eq!(
+                eng.window_dft.iter().map(|(k, _)| *k).collect::<Vec<_>>(),
+                vec![0, 1]
+            );
         }
     }
 

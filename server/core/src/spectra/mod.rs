@@ -28,6 +28,7 @@
 //! Each call plans one real FFT (realfft) and reuses its buffers for all
 //! segments: no allocation per segment.
 
+mod accumulators;
 mod config;
 mod cross;
 mod detrend;

@@ -11,17 +11,19 @@
 //! `block.start + m·(nperseg − noverlap)`, trailing samples that do not fill
 //! a segment ignored), and the mean runs over all segments of all blocks.
 //! With a single block covering the record, every spectrum is the one of
-//! [`super::welch`] / [`super::csd`] (same operations in the same order: bit
-//! for bit, or to the rounding of fused multiply–adds on CPUs with AVX2 and
-//! FMA), hence equal to scipy's to ~1e-12.
+//! [`super::welch`] / [`super::csd`] to rounding (the constant detrend is
+//! removed partly in the frequency domain, see
+//! [`SegmentFft::transform_centred`]; sums of products are fused
+//! multiply–adds on CPUs with AVX2 and FMA), hence equal to scipy's to
+//! ~1e-12.
 
 use std::ops::Range;
 
 use realfft::num_complex::Complex;
 
+use super::accumulators::{Accumulators, BATCH};
 use super::engine::SegmentFft;
 use super::{Detrend, SpectraError, WelchConfig};
-use crate::kernels::{has_avx2_fma, madd};
 
 /// Borrowed `(P_ij, P_ii, P_jj)` of one pair.
 type PairParts<'a> = (&'a [Complex<f64>], &'a [f64], &'a [f64]);
@@ -128,8 +130,27 @@ pub fn multi_welch(
     cfg: &WelchConfig,
 ) -> Result<MultiSpectra, SpectraError> {
     let n_segments = validate(channels, blocks, pairs, cfg)?;
-    require_finite(channels, blocks)?;
-    compute(channels, blocks, pairs, cfg, n_segments)
+    if cfg.detrend == Detrend::Constant {
+        // The segments' sums flag their non-finite samples (see `compute`);
+        // only the samples no segment reads are scanned here.
+        let uncovered: Vec<Range<usize>> = blocks
+            .iter()
+            .map(|b| b.start + covered(cfg, b.len()).min(b.len())..b.end)
+            .collect();
+        require_finite(channels, &uncovered)?;
+        compute(channels, blocks, pairs, cfg, n_segments, true)
+    } else {
+        require_finite(channels, blocks)?;
+        compute(channels, blocks, pairs, cfg, n_segments, false)
+    }
+}
+
+/// Samples at the start of a block of `len` that its segments read.
+fn covered(cfg: &WelchConfig, len: usize) -> usize {
+    match cfg.n_segments(len) {
+        0 => 0,
+        m => (m - 1) * cfg.step() + cfg.nperseg,
+    }
 }
 
 /// [`multi_welch`] for channels the caller has already checked to be
@@ -143,16 +164,19 @@ pub(crate) fn multi_welch_finite(
     cfg: &WelchConfig,
 ) -> Result<MultiSpectra, SpectraError> {
     let n_segments = validate(channels, blocks, pairs, cfg)?;
-    compute(channels, blocks, pairs, cfg, n_segments)
+    compute(channels, blocks, pairs, cfg, n_segments, false)
 }
 
-/// The estimate on validated inputs, over `n_segments ≥ 1` segments.
+/// The estimate on validated inputs, over `n_segments ≥ 1` segments; with
+/// `check_finite` (constant detrend only), a non-finite sample inside a
+/// segment is a [`SpectraError::NonFinite`].
 fn compute(
     channels: &[&[f64]],
     blocks: &[Range<usize>],
     pairs: &[(usize, usize)],
     cfg: &WelchConfig,
     n_segments: usize,
+    check_finite: bool,
 ) -> Result<MultiSpectra, SpectraError> {
     // `SegmentFft` scales by its own segment count: give it a length that
     // holds exactly `n_segments` segments, nperseg + (n_segments − 1)·step.
@@ -161,8 +185,9 @@ fn compute(
         .checked_mul(step)
         .and_then(|v| v.checked_add(cfg.nperseg))
         .ok_or_else(|| SpectraError::input("blocks", "too many segments"))?;
-    // Constant detrend (the default) is done here with a vectorised mean,
-    // the engine subtracts it while windowing; see `mean`.
+    // Constant detrend (the default) is done here: the engine removes each
+    // segment's mean while windowing, reading every sample once (see
+    // `SegmentFft::transform_centred`).
     let own_mean = cfg.detrend == Detrend::Constant;
     let engine_cfg = if own_mean {
         cfg.clone().with_detrend(Detrend::None)
@@ -175,40 +200,44 @@ fn compute(
     let mut acc = Accumulators::new(channels.len(), pairs, cfg.n_freqs());
     let mut spec = engine.make_output();
     for block in blocks {
-        for m in 0..cfg.n_segments(block.len()) {
+        let n_block = cfg.n_segments(block.len());
+        // Up to BATCH consecutive segments of one channel after another:
+        // the samples they share are read while still in cache.
+        for first in (0..n_block).step_by(BATCH) {
+            let count = BATCH.min(n_block - first);
             for (c, channel) in channels.iter().enumerate() {
-                if own_mean {
+                // The channel's last segment mean: the next segment's shift.
+                let mut mean = f64::NAN;
+                for slot in 0..count {
+                    let m = first + slot;
                     let start = block.start + m * step;
-                    let samples = &channel[start..start + cfg.nperseg];
-                    engine.transform_offset(samples, mean(samples), &mut spec)?;
-                } else {
-                    engine.transform(&channel[block.clone()], m, &mut spec)?;
+                    let end = start + cfg.nperseg;
+                    if own_mean {
+                        let samples = &channel[start..end];
+                        let shift = if mean.is_finite() { mean } else { samples[0] };
+                        // The samples the next segment adds (within the block).
+                        let ahead = end.min(block.end)..(end + step).min(block.end);
+                        let offset =
+                            engine.transform_centred(samples, shift, &channel[ahead], &mut spec)?;
+                        if check_finite && !offset.is_finite() {
+                            require_finite_channel(
+                                c,
+                                channel,
+                                std::slice::from_ref(&(start..end)),
+                            )?;
+                        }
+                        mean = shift + offset;
+                    } else {
+                        engine.transform(&channel[block.clone()], m, &mut spec)?;
+                    }
+                    acc.add_channel(slot, c, &spec);
                 }
-                acc.add_channel(c, &spec);
             }
-            acc.end_segment(pairs);
+            acc.add_segments(count);
         }
     }
-    acc.flush(pairs);
     let factors = engine.density_factors(cfg.fs);
     Ok(acc.finish(pairs, &factors, cfg.frequencies(), n_segments))
-}
-
-/// The mean of `x` (scipy's `detrend='constant'` removes it), summed with
-/// eight partial sums so that it vectorises: the shared sequential
-/// `detrend_in_place` costs about 40 % of a 4096-point FFT per segment.
-/// Equal to that function's mean up to rounding.
-fn mean(x: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 8];
-    let chunks = x.chunks_exact(8);
-    let tail: f64 = chunks.remainder().iter().sum();
-    for ch in chunks {
-        for (a, v) in acc.iter_mut().zip(ch) {
-            *a += v;
-        }
-    }
-    let sum = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-    (sum + tail) / x.len().max(1) as f64
 }
 
 /// True when every sample is finite: `v · 0` is 0 for a finite `v` and NaN
@@ -294,230 +323,32 @@ fn validate(
 /// Checks that every sample inside the blocks is finite.
 fn require_finite(channels: &[&[f64]], blocks: &[Range<usize>]) -> Result<(), SpectraError> {
     for (i, c) in channels.iter().enumerate() {
-        for b in blocks {
-            if all_finite(&c[b.clone()]) {
-                continue;
-            }
-            if let Some(k) = c[b.clone()].iter().position(|v| !v.is_finite()) {
-                let index = b.start + k;
-                let field = format!("channels[{i}]");
-                return Err(SpectraError::NonFinite {
-                    message: format!("{field}[{index}] = {} is not finite", c[index]),
-                    field,
-                    index,
-                });
-            }
-        }
+        require_finite_channel(i, c, blocks)?;
     }
     Ok(())
 }
 
-/// Sums over segments. The spectra of the current segment (and the
-/// previous one, until they are added) are kept split into real and
-/// imaginary planes (`[slot][channel][bin]`, contiguous) so the per-pair
-/// loops are plain element-wise multiply-adds that the compiler vectorises.
-///
-/// The cross accumulators (36 pairs × 2049 bins × 16 B = 1.2 MB) outgrow
-/// a core's L2 cache, so reading and writing them is what bounds the
-/// accumulation: segments are added two at a time, halving that traffic.
-/// Every sum still runs over the segments in order (`(acc + s₁) + s₂`),
-/// exactly as [`super::csd`] does. (Wider batches were slower: more
-/// streams, larger buffers.)
-struct Accumulators {
-    nf: usize,
-    n_channels: usize,
-    /// Segments stored in `re`/`im` and not yet added to the pairs (0..=2).
-    held: usize,
-    re: Vec<f64>,
-    im: Vec<f64>,
-    auto: Vec<f64>,
-    cross_re: Vec<f64>,
-    cross_im: Vec<f64>,
-}
-
-impl Accumulators {
-    fn new(n_channels: usize, pairs: &[(usize, usize)], nf: usize) -> Self {
-        let slots = if pairs.is_empty() { 1 } else { 2 };
-        Accumulators {
-            nf,
-            n_channels,
-            held: 0,
-            re: scratch::zeroed(slots * n_channels * nf),
-            im: scratch::zeroed(slots * n_channels * nf),
-            auto: scratch::zeroed(n_channels * nf),
-            cross_re: scratch::zeroed(pairs.len() * nf),
-            cross_im: scratch::zeroed(pairs.len() * nf),
+/// Checks that every sample of channel `i` inside the blocks is finite.
+fn require_finite_channel(
+    i: usize,
+    c: &[f64],
+    blocks: &[Range<usize>],
+) -> Result<(), SpectraError> {
+    for b in blocks {
+        if all_finite(&c[b.clone()]) {
+            continue;
+        }
+        if let Some(k) = c[b.clone()].iter().position(|v| !v.is_finite()) {
+            let index = b.start + k;
+            let field = format!("channels[{i}]");
+            return Err(SpectraError::NonFinite {
+                message: format!("{field}[{index}] = {} is not finite", c[index]),
+                field,
+                index,
+            });
         }
     }
-
-    /// Stores channel `c`'s spectrum of the current segment and adds `|X|²`
-    /// to its PSD.
-    fn add_channel(&mut self, c: usize, spec: &[Complex<f64>]) {
-        #[cfg(target_arch = "x86_64")]
-        if has_avx2_fma() {
-            // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { self.add_channel_fma(c, spec) };
-        }
-        self.add_channel_body::<false>(c, spec)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn add_channel_fma(&mut self, c: usize, spec: &[Complex<f64>]) {
-        self.add_channel_body::<true>(c, spec)
-    }
-
-    #[inline(always)]
-    fn add_channel_body<const FMA: bool>(&mut self, c: usize, spec: &[Complex<f64>]) {
-        let nf = self.nf;
-        let off = (self.held * self.n_channels + c) * nf;
-        let re = &mut self.re[off..off + nf];
-        let im = &mut self.im[off..off + nf];
-        let auto = &mut self.auto[c * nf..(c + 1) * nf];
-        for (((s, r), i), a) in spec.iter().zip(re).zip(im).zip(auto) {
-            *r = s.re;
-            *i = s.im;
-            // Without FMA the same expression as `Complex::norm_sqr`
-            // (bit-identical to `welch`).
-            *a += madd::<FMA>(s.re, s.re, s.im * s.im);
-        }
-    }
-
-    /// Closes the current segment; adds the held pair of segments to the
-    /// cross spectra once there are two.
-    fn end_segment(&mut self, pairs: &[(usize, usize)]) {
-        self.held += 1;
-        if pairs.is_empty() {
-            self.held = 0;
-        } else if self.held == 2 {
-            self.add_two(pairs);
-            self.held = 0;
-        }
-    }
-
-    /// Adds a last odd segment, if one is held.
-    fn flush(&mut self, pairs: &[(usize, usize)]) {
-        if self.held == 1 {
-            self.add_one(pairs);
-        }
-        self.held = 0;
-    }
-
-    /// Channel `c`'s real and imaginary planes in slot `slot`.
-    fn planes(&self, slot: usize, c: usize) -> (&[f64], &[f64]) {
-        let off = (slot * self.n_channels + c) * self.nf;
-        (&self.re[off..off + self.nf], &self.im[off..off + self.nf])
-    }
-
-    /// Adds `conj(X_i)·X_j` of the segment in slot 0 to every pair.
-    fn add_one(&mut self, pairs: &[(usize, usize)]) {
-        #[cfg(target_arch = "x86_64")]
-        if has_avx2_fma() {
-            // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { self.add_one_fma(pairs) };
-        }
-        self.add_one_body::<false>(pairs)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn add_one_fma(&mut self, pairs: &[(usize, usize)]) {
-        self.add_one_body::<true>(pairs)
-    }
-
-    #[inline(always)]
-    fn add_one_body<const FMA: bool>(&mut self, pairs: &[(usize, usize)]) {
-        let nf = self.nf;
-        let mut cross_re = std::mem::take(&mut self.cross_re);
-        let mut cross_im = std::mem::take(&mut self.cross_im);
-        for (p, &(i, j)) in pairs.iter().enumerate() {
-            let ((xr, xi), (yr, yi)) = (self.planes(0, i), self.planes(0, j));
-            let acc_re = &mut cross_re[p * nf..(p + 1) * nf];
-            let acc_im = &mut cross_im[p * nf..(p + 1) * nf];
-            for k in 0..nf {
-                // conj(x)·y; without FMA rounded as num_complex's `x.conj() * y`.
-                acc_re[k] += madd::<FMA>(xr[k], yr[k], xi[k] * yi[k]);
-                acc_im[k] += madd::<FMA>(xr[k], yi[k], -(xi[k] * yr[k]));
-            }
-        }
-        self.cross_re = cross_re;
-        self.cross_im = cross_im;
-    }
-
-    /// Adds `conj(X_i)·X_j` of the segments in slots 0 then 1 to every
-    /// pair, in one pass over the accumulators.
-    fn add_two(&mut self, pairs: &[(usize, usize)]) {
-        #[cfg(target_arch = "x86_64")]
-        if has_avx2_fma() {
-            // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { self.add_two_fma(pairs) };
-        }
-        self.add_two_body::<false>(pairs)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn add_two_fma(&mut self, pairs: &[(usize, usize)]) {
-        self.add_two_body::<true>(pairs)
-    }
-
-    #[inline(always)]
-    fn add_two_body<const FMA: bool>(&mut self, pairs: &[(usize, usize)]) {
-        let nf = self.nf;
-        let mut cross_re = std::mem::take(&mut self.cross_re);
-        let mut cross_im = std::mem::take(&mut self.cross_im);
-        for (p, &(i, j)) in pairs.iter().enumerate() {
-            let ((xr, xi), (yr, yi)) = (self.planes(0, i), self.planes(0, j));
-            let ((ur, ui), (vr, vi)) = (self.planes(1, i), self.planes(1, j));
-            let acc_re = &mut cross_re[p * nf..(p + 1) * nf];
-            let acc_im = &mut cross_im[p * nf..(p + 1) * nf];
-            for k in 0..nf {
-                let re = acc_re[k] + madd::<FMA>(xr[k], yr[k], xi[k] * yi[k]);
-                acc_re[k] = re + madd::<FMA>(ur[k], vr[k], ui[k] * vi[k]);
-                let im = acc_im[k] + madd::<FMA>(xr[k], yi[k], -(xi[k] * yr[k]));
-                acc_im[k] = im + madd::<FMA>(ur[k], vi[k], -(ui[k] * vr[k]));
-            }
-        }
-        self.cross_re = cross_re;
-        self.cross_im = cross_im;
-    }
-
-    fn finish(
-        self,
-        pairs: &[(usize, usize)],
-        factors: &[f64],
-        freqs: Vec<f64>,
-        n_segments: usize,
-    ) -> MultiSpectra {
-        let nf = self.nf;
-        let auto = self
-            .auto
-            .chunks_exact(nf.max(1))
-            .map(|c| c.iter().zip(factors).map(|(v, f)| v * f).collect())
-            .collect();
-        let cross = self
-            .cross_re
-            .chunks_exact(nf.max(1))
-            .zip(self.cross_im.chunks_exact(nf.max(1)))
-            .map(|(r, i)| {
-                r.iter()
-                    .zip(i)
-                    .zip(factors)
-                    .map(|((r, i), f)| Complex::new(r * f, i * f))
-                    .collect()
-            })
-            .collect();
-        for buffer in [self.re, self.im, self.auto, self.cross_re, self.cross_im] {
-            scratch::give_back(buffer);
-        }
-        MultiSpectra {
-            freqs,
-            auto,
-            pairs: pairs.to_vec(),
-            cross,
-            n_segments,
-        }
-    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -649,9 +480,6 @@ mod tests {
     #[test]
     fn kernels_match_their_plain_versions() {
         let x: Vec<f64> = (0..37).map(|i| 1e6 + (i as f64 * 0.7).sin()).collect();
-        let plain = x.iter().sum::<f64>() / 37.0;
-        assert!((mean(&x) - plain).abs() < 1e-9);
-        assert_eq!(mean(&[]), 0.0);
         assert!(all_finite(&x) && all_finite(&[]));
         for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
             for at in [0, 7, 8, 36] {
@@ -749,6 +577,25 @@ mod tests {
         }
         // Outside the blocks a NaN is never read.
         assert!(multi_welch(&[&x, &bad], &[0..40, 43..100], &[(0, 1)], &cfg).is_ok());
+        // Inside a segment of a later batch, in a block's tail that no
+        // segment reads, and with the other detrends: still found.
+        let long: Vec<f64> = (0..400).map(|i| (i as f64 * 0.37).sin()).collect();
+        for (at, block_end) in [(0, 400), (130, 400), (391, 400), (399, 400)] {
+            for bad_value in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                let mut y = long.clone();
+                y[at] = bad_value;
+                for detrend in [Detrend::Constant, Detrend::Linear, Detrend::None] {
+                    let cfg = WelchConfig::hann(1.0, 16).with_detrend(detrend);
+                    // 400 samples: 48 segments cover 0..392, 392..400 is a tail.
+                    match multi_welch(&[&long, &y], &[0..block_end], &[(0, 1)], &cfg) {
+                        Err(SpectraError::NonFinite { field, index, .. }) => {
+                            assert_eq!((field.as_str(), index), ("channels[1]", at))
+                        }
+                        other => panic!("{at} {bad_value} {detrend:?}: {other:?}"),
+                    }
+                }
+            }
+        }
     }
 
     #[test]
@@ -757,54 +604,5 @@ mod tests {
         let s = multi_welch(&[&x], &whole(64), &[(0, 0)], &WelchConfig::hann(1.0, 16)).unwrap();
         assert!(s.coherence(1).is_empty() && s.h1(7).is_empty());
         assert_eq!(s.coherence(0).len(), 9);
-    }
-}
-
-/// Accumulator buffers kept per thread between calls. A report's spectra
-/// need about 2 MB of zeroed sums; allocated afresh, each call would fault
-/// those pages in from the kernel again (a third of the time of a 1-hour
-/// report), reused they are only zeroed.
-mod scratch {
-    use std::cell::RefCell;
-
-    /// Buffers kept per thread.
-    const KEPT: usize = 8;
-
-    thread_local! {
-        static FREE: RefCell<Vec<Vec<f64>>> = const { RefCell::new(Vec::new()) };
-    }
-
-    /// A zeroed buffer of `len` values, reusing a kept one when there is.
-    pub(super) fn zeroed(len: usize) -> Vec<f64> {
-        let kept = FREE.with(|f| {
-            let mut f = f.borrow_mut();
-            // The smallest kept buffer that holds `len`, else the largest.
-            let best = f
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| v.capacity() >= len)
-                .min_by_key(|(_, v)| v.capacity())
-                .or_else(|| f.iter().enumerate().max_by_key(|(_, v)| v.capacity()))
-                .map(|(i, _)| i);
-            best.map(|i| f.swap_remove(i))
-        });
-        match kept {
-            Some(mut v) => {
-                v.clear();
-                v.resize(len, 0.0);
-                v
-            }
-            None => vec![0.0; len],
-        }
-    }
-
-    /// Keeps `buffer` for the next call on this thread.
-    pub(super) fn give_back(buffer: Vec<f64>) {
-        FREE.with(|f| {
-            let mut f = f.borrow_mut();
-            if f.len() < KEPT {
-                f.push(buffer);
-            }
-        });
     }
 }

@@ -1,0 +1,235 @@
+//! The sums of a multichannel Welch estimate: `Σ |X_c|²` per channel and
+//! `Σ conj(X_i)·X_j` per requested pair, over segments.
+//!
+//! The spectra of up to [`BATCH`] segments are held split into real and
+//! imaginary planes, so that the per-pair loops are plain element-wise
+//! multiply–adds the compiler vectorises, then added to the cross sums in
+//! one pass over them (the sums of a 6 × 6 report outgrow a core's L2
+//! cache). Every sum still runs over the segments in order. (Adding pairs
+//! that share a channel together, to load its values once, was slower:
+//! the compiler spilled the wider kernel's registers.)
+
+use realfft::num_complex::Complex;
+
+use super::multichannel::MultiSpectra;
+use crate::kernels::{has_avx2_fma, madd};
+
+/// Segments whose spectra are held before they are added to the cross
+/// spectra: the 36 cross sums of a 6 × 6 report at `nperseg = 4096` take
+/// 1.2 MB, so each pass over them is paid by four segments, not one.
+pub(super) const BATCH: usize = 4;
+
+/// See the [module documentation](self).
+pub(super) struct Accumulators {
+    nf: usize,
+    /// Held spectra, `[channel][slot][re | im][bin]`: channel c, slot s at
+    /// `(c·BATCH + s)·2nf`, its imaginary plane `nf` further.
+    planes: Vec<f64>,
+    auto: Vec<f64>,
+    /// Cross sums, `[pair][re | im][bin]`.
+    cross: Vec<f64>,
+    pairs: Vec<(usize, usize)>,
+}
+
+impl Accumulators {
+    /// Zeroed sums for `n_channels` spectra of `nf` bins and `pairs`.
+    pub(super) fn new(n_channels: usize, pairs: &[(usize, usize)], nf: usize) -> Self {
+        let slots = if pairs.is_empty() { 0 } else { BATCH };
+        Accumulators {
+            nf,
+            planes: scratch::zeroed(n_channels * slots * 2 * nf),
+            auto: scratch::zeroed(n_channels * nf),
+            cross: scratch::zeroed(pairs.len() * 2 * nf),
+            pairs: pairs.to_vec(),
+        }
+    }
+
+    /// Adds `|X|²` of channel `c`'s spectrum to its PSD and, when there are
+    /// pairs, holds the spectrum in slot `slot < BATCH`.
+    pub(super) fn add_channel(&mut self, slot: usize, c: usize, spec: &[Complex<f64>]) {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx2_fma() {
+            // SAFETY: the CPU has the features the function is compiled for.
+            return unsafe { self.add_channel_fma(slot, c, spec) };
+        }
+        self.add_channel_body::<false>(slot, c, spec)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn add_channel_fma(&mut self, slot: usize, c: usize, spec: &[Complex<f64>]) {
+        self.add_channel_body::<true>(slot, c, spec)
+    }
+
+    #[inline(always)]
+    fn add_channel_body<const FMA: bool>(&mut self, slot: usize, c: usize, spec: &[Complex<f64>]) {
+        let nf = self.nf;
+        let auto = &mut self.auto[c * nf..(c + 1) * nf];
+        if self.planes.is_empty() {
+            for (s, a) in spec.iter().zip(auto) {
+                *a += madd::<FMA>(s.re, s.re, s.im * s.im);
+            }
+            return;
+        }
+        let off = (c * BATCH + slot) * 2 * nf;
+        let (re, im) = self.planes[off..off + 2 * nf].split_at_mut(nf);
+        for (((s, r), i), a) in spec.iter().zip(re).zip(im).zip(auto) {
+            *r = s.re;
+            *i = s.im;
+            // Without FMA the same expression as `Complex::norm_sqr`
+            // (bit-identical to `welch`).
+            *a += madd::<FMA>(s.re, s.re, s.im * s.im);
+        }
+    }
+
+    /// Adds the cross products of the segments held in slots `0..count`
+    /// (in slot order) to every pair.
+    pub(super) fn add_segments(&mut self, count: usize) {
+        match count {
+            0 => {}
+            1 => self.add::<1>(),
+            2 => self.add::<2>(),
+            3 => self.add::<3>(),
+            _ => self.add::<BATCH>(),
+        }
+    }
+
+    fn add<const S: usize>(&mut self) {
+        #[cfg(target_arch = "x86_64")]
+        if has_avx2_fma() {
+            // SAFETY: the CPU has the features the function is compiled for.
+            return unsafe { self.add_fma::<S>() };
+        }
+        self.add_body::<false, S>()
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn add_fma<const S: usize>(&mut self) {
+        self.add_body::<true, S>()
+    }
+
+    #[inline(always)]
+    fn add_body<const FMA: bool, const S: usize>(&mut self) {
+        let nf = self.nf;
+        let planes = &self.planes[..];
+        let plane = |c: usize, s: usize| {
+            let off = (c * BATCH + s) * 2 * nf;
+            planes[off..off + 2 * nf].split_at(nf)
+        };
+        for (sums, &(i, j)) in self.cross.chunks_exact_mut(2 * nf).zip(&self.pairs) {
+            let x: [_; S] = std::array::from_fn(|s| plane(i, s));
+            let y: [_; S] = std::array::from_fn(|s| plane(j, s));
+            let (acc_re, acc_im) = sums.split_at_mut(nf);
+            for k in 0..nf {
+                let (mut re, mut im) = (acc_re[k], acc_im[k]);
+                for s in 0..S {
+                    let ((xr, xi), (yr, yi)) = (x[s], y[s]);
+                    (re, im) = term::<FMA>(xr[k], xi[k], yr[k], yi[k], re, im);
+                }
+                acc_re[k] = re;
+                acc_im[k] = im;
+            }
+        }
+    }
+
+    /// The spectra: sums times the density `factors`.
+    pub(super) fn finish(
+        self,
+        pairs: &[(usize, usize)],
+        factors: &[f64],
+        freqs: Vec<f64>,
+        n_segments: usize,
+    ) -> MultiSpectra {
+        let nf = self.nf;
+        let auto = self
+            .auto
+            .chunks_exact(nf.max(1))
+            .map(|c| c.iter().zip(factors).map(|(v, f)| v * f).collect())
+            .collect();
+        let cross = self
+            .cross
+            .chunks_exact(2 * nf.max(1))
+            .map(|sums| {
+                let (r, i) = sums.split_at(nf.max(1));
+                r.iter()
+                    .zip(i)
+                    .zip(factors)
+                    .map(|((r, i), f)| Complex::new(r * f, i * f))
+                    .collect()
+            })
+            .collect();
+        for buffer in [self.planes, self.auto, self.cross] {
+            scratch::give_back(buffer);
+        }
+        MultiSpectra {
+            freqs,
+            auto,
+            pairs: pairs.to_vec(),
+            cross,
+            n_segments,
+        }
+    }
+}
+
+/// `(re, im) + conj(x)·y`.
+#[inline(always)]
+fn term<const FMA: bool>(xr: f64, xi: f64, yr: f64, yi: f64, re: f64, im: f64) -> (f64, f64) {
+    if FMA {
+        (
+            madd::<true>(xi, yi, madd::<true>(xr, yr, re)),
+            madd::<true>(-xi, yr, madd::<true>(xr, yi, im)),
+        )
+    } else {
+        (re + (xr * yr + xi * yi), im + (xr * yi + -(xi * yr)))
+    }
+}
+
+/// Accumulator buffers kept per thread between calls. A report's spectra
+/// need about 2 MB of zeroed sums; allocated afresh, each call would fault
+/// those pages in from the kernel again (a third of the time of a 1-hour
+/// report), reused they are only zeroed.
+mod scratch {
+    use std::cell::RefCell;
+
+    /// Buffers kept per thread.
+    const KEPT: usize = 8;
+
+    thread_local! {
+        static FREE: RefCell<Vec<Vec<f64>>> = const { RefCell::new(Vec::new()) };
+    }
+
+    /// A zeroed buffer of `len` values, reusing a kept one when there is.
+    pub(super) fn zeroed(len: usize) -> Vec<f64> {
+        let kept = FREE.with(|f| {
+            let mut f = f.borrow_mut();
+            // The smallest kept buffer that holds `len`, else the largest.
+            let best = f
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.capacity() >= len)
+                .min_by_key(|(_, v)| v.capacity())
+                .or_else(|| f.iter().enumerate().max_by_key(|(_, v)| v.capacity()))
+                .map(|(i, _)| i);
+            best.map(|i| f.swap_remove(i))
+        });
+        match kept {
+            Some(mut v) => {
+                v.clear();
+                v.resize(len, 0.0);
+                v
+            }
+            None => vec![0.0; len],
+        }
+    }
+
+    /// Keeps `buffer` for the next call on this thread.
+    pub(super) fn give_back(buffer: Vec<f64>) {
+        FREE.with(|f| {
+            let mut f = f.borrow_mut();
+            if f.len() < KEPT {
+                f.push(buffer);
+            }
+        });
+    }
+}
