@@ -3,6 +3,7 @@
 import { api } from './api.js';
 import { renameControl } from './rename.js';
 import { vesselTrash } from './parenttrash.js';
+import { thrusterLayout } from './thrusterlayout.js';
 import { deletedBadge } from './manage.js';
 import {
   DOFS, KIND_LABEL, dofUnits, fmt, fmtDate, fmtU, knots, FAMILY_LABEL,
@@ -108,6 +109,7 @@ export async function vesselPage(view, id) {
     h('h2', null, 'Limits'),
     limitsTable(v),
     thrusterTables(v),
+    thrusterLayout(v),
     h('h2', null, 'Campaigns'),
     campaigns.length === 0 ? h('p', { class: 'empty' }, 'No campaigns for this vessel yet.')
       : h('ul', { class: 'plain' }, campaigns.map((c) => h('li', null,

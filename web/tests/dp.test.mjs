@@ -79,3 +79,30 @@ test('identify the demo supply vessel by the parallel EKF and read its model pag
     if (process.env.DP_SCREENSHOT) await page.screenshot({ path: process.env.DP_SCREENSHOT, fullPage: true });
   });
 });
+
+test('the supply vessel page draws its thruster layout from T', async () => {
+  const c = await H.api('GET', `/api/campaigns/${cid}`);
+  assert.equal(c.status, 200);
+  await H.withPage([], async (page) => {
+    await page.goto(`${H.base}/#/vessels/${c.json.vessel_id}`);
+    await page.locator(tid('thruster-layout')).waitFor();
+    const marks = await page.locator(tid('thruster-mark')).evaluateAll((gs) => gs.map((g) => ({
+      n: Number(g.dataset.thruster), x: g.dataset.x === '' ? null : Number(g.dataset.x), y: Number(g.dataset.y),
+    })));
+    assert.equal(marks.length, 6, 'all six thrusters push in the horizontal plane');
+    const at = (n) => marks.find((m) => m.n === n);
+    // Mains: x is open in T, the offset is y = −N/X: port (y < 0) and starboard.
+    assert.equal(at(1).x, null);
+    assert.ok(Math.abs(at(1).y + 0.0472) < 1e-9 && Math.abs(at(2).y - 0.0472) < 1e-9, JSON.stringify(marks));
+    // Tunnels and the azimuth on the centreline at x = N/Y: two aft, two forward.
+    assert.ok(Math.abs(at(3).x + 0.4108) < 1e-9 && Math.abs(at(4).x + 0.3858) < 1e-9);
+    assert.ok(Math.abs(at(5).x - 0.4554) < 1e-9 && Math.abs(at(6).x - 0.3373) < 1e-9);
+    // Drawn where they are: the bow tunnel right of (forward of) the aft ones.
+    const cxOf = (n) => page.locator(`${tid('thruster-mark')}[data-thruster="${n}"] circle`).getAttribute('cx').then(Number);
+    assert.ok(await cxOf(5) > await cxOf(3));
+    const rows = await page.locator(`${tid('thruster-positions')} tbody tr`).allTextContents();
+    assert.equal(rows.length, 6);
+    assert.match(rows[0], /at the stern .*y = −N \/ X/);
+    assert.match(rows[4], /on the centreline, x = N \/ Y/);
+  });
+});
