@@ -19,8 +19,8 @@ use super::document::{
     DpNoiseDoc, DpShipDoc, Method, ModelDocument, ModelKind, ParameterRow, to_rows,
 };
 use super::ekf_checks::{every_stage, stage_of};
-use super::ekf_refine::{RefineOutcome, refine_campaign};
 use super::ekf_init::{InitBlock, WITHOUT_PRIOR_FINDING, ls_start, without_prior_note};
+use super::ekf_refine::{RefineOutcome, refine_campaign};
 pub use super::ekf_settings::EkfCampaignSettings;
 use super::ekf_settings::{check_settings, nine};
 use super::error::IdentifyError;

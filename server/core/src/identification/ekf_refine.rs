@@ -52,8 +52,9 @@ pub(crate) fn refine_campaign(
         Ok(r) => r,
         Err(EkfError::Cancelled) => return Err(IdentifyError::Cancelled),
         Err(e) => {
-            out.findings
-                .push(kept(format!("The prediction-error refinement failed ({e})")));
+            out.findings.push(kept(format!(
+                "The prediction-error refinement failed ({e})"
+            )));
             return Ok(out);
         }
     };
@@ -74,7 +75,7 @@ pub(crate) fn refine_campaign(
         _ => None,
     };
     if let Some((before, after)) = held
-        && !(after <= before + HELD_OUT_TOLERANCE)
+        && (after.is_nan() || after > before + HELD_OUT_TOLERANCE)
     {
         out.findings.push(kept(format!(
             "The prediction-error refinement predicts the held-out runs worse (their negative log-likelihood rises by {})",

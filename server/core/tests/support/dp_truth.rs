@@ -7,6 +7,7 @@
 #![allow(dead_code)]
 
 use seatrial_core::estimation::NoProgress;
+use seatrial_core::identification::outcome::Identified;
 use seatrial_core::identification::{
     EkfCampaignSettings, ModelDocument, RunInput, identify_ekf_campaign,
 };
@@ -48,12 +49,12 @@ pub fn runs(profile: &VesselProfile, trial: &DpTrial, seed: u64) -> Vec<RunInput
         .collect()
 }
 
-/// The campaign identified with `settings`.
-pub fn identify(
+/// The campaign identified with `settings`, with its held-out validation.
+pub fn identify_validated(
     profile: &VesselProfile,
     runs: &[RunInput],
     settings: &EkfCampaignSettings,
-) -> ModelDocument {
+) -> Identified {
     identify_ekf_campaign(
         profile,
         &input_columns(profile),
@@ -62,7 +63,15 @@ pub fn identify(
         &mut NoProgress,
     )
     .unwrap()
-    .document
+}
+
+/// The model document of the campaign identified with `settings`.
+pub fn identify(
+    profile: &VesselProfile,
+    runs: &[RunInput],
+    settings: &EkfCampaignSettings,
+) -> ModelDocument {
+    identify_validated(profile, runs, settings).document
 }
 
 /// The truth's θ″ (eq. 48–49): A″_h entries, then K″1, K″3, K″5, K″6.

@@ -39,6 +39,10 @@ pub struct RefineSettings {
     /// at θ̂ is below this (log-likelihood units: the remaining step is
     /// √(2·tolerance) standard deviations long, 0.14 for the default 0.01).
     pub decrement_tolerance: f64,
+    /// When no damped step lowers V any more, converged if the predicted
+    /// decrease is below this (default 0.5: the remaining step is under one
+    /// standard deviation).
+    pub stall_tolerance: f64,
 }
 
 impl Default for RefineSettings {
@@ -46,6 +50,7 @@ impl Default for RefineSettings {
         RefineSettings {
             max_iterations: 20,
             decrement_tolerance: 1e-2,
+            stall_tolerance: 0.5,
         }
     }
 }
@@ -153,9 +158,9 @@ pub fn refine_theta(
             break;
         }
         let mut accepted = false;
-        while lambda < 1e8 {
+        while lambda < 1e4 {
             let Some(step) = lm_step(&cur.info, &cur.grad, lambda) else {
-                lambda *= 10.0;
+                lambda *= 100.0;
                 continue;
             };
             let trial = &theta + &step;
@@ -167,11 +172,15 @@ pub fn refine_theta(
                     accepted = true;
                     break;
                 }
-                Ok(_) | Err(EkfError::Diverged { .. }) => lambda *= 10.0,
+                Ok(_) | Err(EkfError::Diverged { .. }) => lambda *= 100.0,
                 Err(e) => return Err(e),
             }
         }
         if !accepted {
+            // No damped step lowers V: the gain held fixed in g and J no
+            // longer describes V this close to its minimum. Within a
+            // standard deviation of it, that is convergence.
+            converged = decrement < settings.stall_tolerance;
             break;
         }
         iterations += 1;

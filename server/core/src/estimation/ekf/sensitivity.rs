@@ -194,14 +194,7 @@ pub fn predictor_pass(
             for (c, v) in u.iter_mut().enumerate() {
                 *v = run.u[(k, c)];
             }
-            model.transition(
-                x.as_slice(),
-                &u,
-                theta,
-                &mut x_next,
-                &mut phi_x,
-                &mut phi_t,
-            );
+            model.transition(x.as_slice(), &u, theta, &mut x_next, &mut phi_x, &mut phi_t);
             x.copy_from_slice(&x_next);
             // Φ·P·Φᵀ = Φ·(Φ·P)ᵀ for symmetric P, then symmetrized.
             tmp.gemm(1.0, &phi_x, &pm, 0.0);
