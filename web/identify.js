@@ -19,7 +19,7 @@ export const METHOD_LABEL = {
 export const METHOD_HELP = {
   lambda_kf: 'LPV model on forward speed: restoring forces from the static holds, then M ν̇ + D̄ ν = γ per grid point by the state-variable filter λ(s) = 1/(1+sT) and a Kalman filter over the parameters (thesis sec. 2.5).',
   n4sid: 'Black-box LTI model about the mean operating point by subspace identification (N4SID): a comparison model, no physical parameters.',
-  parallel_ekf: 'DP ship (Fossen, Sagatun & Sørensen 1995): state-augmented EKF in parallel over the runs of each manoeuvre, staged SI1 surge → SI2 sway–yaw → SI3 azimuth; M″ and T″ from the vessel profile, A″_h and K″ estimated from position and heading (Bis units).',
+  parallel_ekf: 'DP ship (Fossen, Sagatun & Sørensen 1995): state-augmented EKF in parallel over the runs of each manoeuvre, staged SI1 surge → SI2 sway–yaw → SI3 azimuth; M″ and T″ from the vessel profile, A″_h and K″ estimated from position and heading (Bis units); then refined on all runs by prediction error, with std from the Cramér–Rao bound, inflated where the residuals ask for it.',
 };
 /** The parallel-EKF stage of a DP experiment family. */
 const DP_STAGE = { dp_surge: 'SI1', dp_sway_yaw: 'SI2', dp_azimuth: 'SI3' };
@@ -71,6 +71,8 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
   const methodHelp = h('p', { class: 'hint method-help', 'data-testid': 'identify-method-help', 'aria-live': 'polite' });
   const sweepsIn = h('input', { type: 'number', min: '1', max: '20', step: '1', value: '2', class: 'short', 'data-field': 'settings.sweeps', 'data-testid': 'identify-sweeps' });
   const sweepsFld = labelled('Sweeps', sweepsIn, 'passes through SI1 → SI2 → SI3');
+  const refineIn = h('input', { type: 'checkbox', checked: true, 'data-field': 'settings.refine', 'data-testid': 'identify-refine' });
+  const refineFld = labelled('Refine', refineIn, 'after the staging, all θ″ jointly on every run by prediction error (off: the paper\'s staging alone)');
   const methodSel = h('select', { 'data-field': 'method', 'data-testid': 'identify-method', onChange: (e) => { m.method = e.target.value; renderStructure(); renderRunsTable(); } },
     methods.map((k) => h('option', { value: k, selected: k === m.method }, METHOD_LABEL[k])));
   const structSel = h('select', { 'data-field': 'settings.structure', 'data-testid': 'identify-structure', onChange: (e) => { m.structure = e.target.value; } },
@@ -85,7 +87,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
 
   fill(form,
     h('h3', null, 'Identify ', h('span', { class: 'hint' }, 'estimate a model from the accepted runs and validate it on held-out runs')),
-    h('div', { class: 'row' }, labelled('Method', methodSel), structFld, ctrlFld, sweepsFld),
+    h('div', { class: 'row' }, labelled('Method', methodSel), structFld, ctrlFld, sweepsFld, refineFld),
     methodHelp,
     runsBox,
     rolesNote,
@@ -96,6 +98,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
     structFld.hidden = m.method !== 'lambda_kf';
     ctrlFld.hidden = m.method !== 'lambda_kf';
     sweepsFld.hidden = m.method !== 'parallel_ekf';
+    refineFld.hidden = m.method !== 'parallel_ekf';
     methodHelp.textContent = METHOD_HELP[m.method] || '';
   }
 
@@ -191,6 +194,7 @@ export async function identifySection(host, { campaign, vessel, plan: plan0, run
     if (m.method === 'parallel_ekf') {
       const sw = Number(sweepsIn.value);
       settings.sweeps = sweepsIn.value.trim() === '' || !Number.isFinite(sw) ? sweepsIn.value : sw;
+      settings.refine = refineIn.checked;
     }
     if (explicit) settings.validation_run_ids = used.filter((r) => m.holdOut.has(r.id)).map((r) => r.id);
     const body = { kind: 'identify', campaign_id: id, run_ids: used.map((r) => r.id), method: m.method, settings };

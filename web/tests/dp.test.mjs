@@ -36,6 +36,9 @@ test('identify the demo supply vessel by the parallel EKF and read its model pag
     const methods = await page.locator(`${tid('identify-method')} option`).evaluateAll((os) => os.map((o) => o.value));
     assert.deepEqual(methods, ['parallel_ekf', 'n4sid']);
     assert.match(await page.textContent(tid('identify-method-help')), /SI1 surge → SI2 sway–yaw → SI3 azimuth/);
+    // The prediction-error refinement is on by default and can be turned off (staging alone).
+    assert.ok(await page.locator(tid('identify-refine')).isVisible());
+    assert.ok(await page.locator(tid('identify-refine')).isChecked());
     const roles = await page.locator(tid('identify-role')).allTextContents();
     assert.deepEqual(roles.filter((r) => /SI/.test(r)).sort(), ['estimation (SI1)', 'estimation (SI1)', 'estimation (SI2)', 'estimation (SI2)', 'estimation (SI3)', 'estimation (SI3)']);
     assert.match(await page.textContent(tid('identify-roles')), /8 of 8 accepted runs: 6 to estimate from, 2 held out/);

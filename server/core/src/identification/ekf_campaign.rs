@@ -20,6 +20,7 @@ use super::document::{
 };
 use super::ekf_checks::{every_stage, stage_of};
 use super::ekf_init::{InitBlock, WITHOUT_PRIOR_FINDING, ls_start, without_prior_note};
+use super::ekf_refine::{RefineOutcome, refine_campaign};
 pub use super::ekf_settings::EkfCampaignSettings;
 use super::ekf_settings::{check_settings, nine};
 use super::error::IdentifyError;
@@ -56,6 +57,9 @@ const GROUPS: [usize; 6] = [0, 0, 1, 1, 2, 3];
 
 /// The pose columns the EKF measures (Fossen et al. eq. 39: z = [x, y, ψ]).
 pub const EKF_POSE: [&str; 3] = ["x", "y", "psi"];
+
+/// Why a campaign without M″ keeps the staged EKF's θ″.
+const NO_REFINEMENT_WITHOUT_PRIOR: &str = "Not refined after the staging: without M″ the θ″ rest on the rough least-squares inertia, and a likelihood refinement would only fit them tighter to it; θ″ and std are the staged EKF's.";
 
 /// Checks that `profile` can be identified by the parallel EKF: a DP vessel
 /// with surge, sway, yaw, a ship length L, and thrusters in the layout of
@@ -336,9 +340,35 @@ pub fn identify_ekf_campaign(
             runs: b.iter().map(|b| RunData { u: &b.u, z: &b.z }).collect(),
         })
         .collect();
-    let id = {
-        let mut sub = SubProgress::new(progress, 0.0, 0.85);
+    // Without M″ the θ″ rest on a rough least-squares inertia: a likelihood
+    // refinement would only fit them tighter to it.
+    let refine = settings.refine && prior_m.is_some();
+    let mut id = {
+        let width = if refine { 0.5 } else { 0.85 };
+        let mut sub = SubProgress::new(progress, 0.0, width);
         identify_dp_ship(&cfg, &stages, &mut sub).map_err(ekf_error)?
+    };
+    let held_out = roles
+        .validation
+        .iter()
+        .map(|r| blocks(r, inputs, &scale).map(|b| (r, b)))
+        .collect::<Result<Vec<_>, _>>()?;
+    let refined = if refine {
+        let estimation: Vec<RunData<'_>> =
+            stages.iter().flat_map(|s| s.runs.iter().copied()).collect();
+        let check: Vec<RunData<'_>> = held_out
+            .iter()
+            .flat_map(|(_, bs)| bs.iter().map(|b| RunData { u: &b.u, z: &b.z }))
+            .collect();
+        let mut sub = SubProgress::new(progress, 0.5, 0.35);
+        refine_campaign(&mut id, &cfg, &estimation, &check, &mut sub)?
+    } else if settings.refine {
+        RefineOutcome {
+            notes: vec![NO_REFINEMENT_WITHOUT_PRIOR.into()],
+            findings: Vec::new(),
+        }
+    } else {
+        RefineOutcome::default()
     };
     progress.update(0.85, "validating on held-out runs")?;
     let model = SiDpShip {
@@ -358,8 +388,7 @@ pub fn identify_ekf_campaign(
         ..ValidationSettings::default()
     };
     let mut validation = Vec::new();
-    for r in &roles.validation {
-        let bs = blocks(r, inputs, &scale)?;
+    for (r, bs) in &held_out {
         let longest = bs
             .iter()
             .max_by_key(|b| b.z.nrows())
@@ -383,6 +412,8 @@ pub fn identify_ekf_campaign(
     }
     progress.update(1.0, "done")?;
     let mut document = document(&id, &cfg, &scale, inputs, &staged);
+    document.notes.extend(refined.notes);
+    document.structure_findings.extend(refined.findings);
     if let Some(st) = &start {
         document.notes[2] = without_prior_note(&st.m);
         document

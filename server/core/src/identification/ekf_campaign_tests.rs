@@ -139,6 +139,41 @@ fn campaign_identifies_the_supply_vessel_within_five_percent() {
     assert!((doc.a_si[0][0] - doc.a[0][0] / t).abs() < 1e-12);
 }
 
+/// `refine: false` is the paper's staging alone; the default adds the
+/// prediction-error refinement, whose θ″ the document carries with the
+/// EKF's θ″ in a note, and whose std are never larger than half of θ″'s.
+#[test]
+fn refinement_is_on_by_default_and_the_staging_stays_available() {
+    let profile = supply_vessel();
+    let runs = flown_runs(1995, 7);
+    let inputs = input_columns(&profile);
+    let go = |refine| {
+        let s = EkfCampaignSettings {
+            refine,
+            ..Default::default()
+        };
+        identify_ekf_campaign(&profile, &inputs, &runs, &s, &mut NoProgress)
+            .unwrap()
+            .document
+    };
+    let staged = go(false);
+    let refined = go(true);
+    let note = |d: &ModelDocument| d.notes.iter().any(|n| n.starts_with("Refined after"));
+    assert!(!note(&staged), "{:?}", staged.notes);
+    assert!(note(&refined), "{:?}", refined.notes);
+    assert!(refined.notes.iter().any(|n| n.contains("Cramér–Rao")));
+    let (a, b) = (staged.dp_ship.unwrap(), refined.dp_ship.unwrap());
+    assert_ne!(a.theta, b.theta);
+    for p in 0..N_THETA {
+        assert!(b.theta_std[p] > 0.0 && b.theta_std[p] < 0.5 * b.theta[p].abs());
+        assert!(
+            (b.theta[p] / paper::THETA[p] - 1.0).abs() < 0.15,
+            "θ″{}",
+            p + 1
+        );
+    }
+}
+
 #[test]
 fn bad_settings_and_runs_name_the_field() {
     let profile = supply_vessel();

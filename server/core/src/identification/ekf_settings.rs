@@ -49,6 +49,16 @@ pub struct EkfCampaignSettings {
     /// Horizon of the k-step predictions of validation.
     #[serde(default = "default_k")]
     pub k: usize,
+    /// After the staged EKF, refine all nine θ″ jointly on every estimation
+    /// run by prediction error (maximum likelihood of the Kalman predictor's
+    /// innovations) and report the calibrated std; `false`: the paper's
+    /// staging alone (θ″ and std of the EKF).
+    #[serde(default = "default_refine")]
+    pub refine: bool,
+}
+
+fn default_refine() -> bool {
+    true
 }
 
 fn default_sweeps() -> usize {
@@ -87,6 +97,7 @@ impl Default for EkfCampaignSettings {
             q_theta: 0.0,
             validation_run_ids: None,
             k: default_k(),
+            refine: default_refine(),
         }
     }
 }

@@ -37,6 +37,7 @@ pub mod document;
 pub mod ekf_campaign;
 pub mod ekf_checks;
 pub mod ekf_init;
+mod ekf_refine;
 mod ekf_settings;
 pub mod error;
 pub mod export;

@@ -1,2 +1,3 @@
+pub mod dp_truth;
 pub mod open_world;
 pub mod open_world_discovery;

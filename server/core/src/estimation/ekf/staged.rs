@@ -104,6 +104,37 @@ impl DpIdentConfig {
     }
 }
 
+impl DpIdentConfig {
+    /// Diagonals of P(0) and Q of one run's states [h; η; b_h]: P(0) of η is
+    /// R (the first measured pose), η has no process noise.
+    pub fn state_noise(&self) -> (Vec<f64>, Vec<f64>) {
+        let p0 = [self.p0_h, self.r, self.p0_b].concat();
+        let q = [self.q_h, [0.0; 3], self.q_b].concat();
+        (p0, q)
+    }
+}
+
+/// Each run's x(0): at rest (h = 0) at its first measured pose, bias 0.
+pub fn initial_states(runs: &[RunData<'_>]) -> Result<Vec<Vec<f64>>, EkfError> {
+    runs.iter()
+        .enumerate()
+        .map(|(i, run)| {
+            if run.z.ncols() != 3 || run.z.nrows() == 0 {
+                return Err(EkfError::Shape {
+                    field: format!("runs[{i}].z"),
+                    expected: "N × 3 (x, y, ψ), N ≥ 1".into(),
+                    got: format!("{} × {}", run.z.nrows(), run.z.ncols()),
+                });
+            }
+            let mut x = vec![0.0; DP_STATES];
+            for j in 0..3 {
+                x[3 + j] = run.z[(0, j)];
+            }
+            Ok(x)
+        })
+        .collect()
+}
+
 /// The result of one stage.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DpStageResult {
@@ -262,34 +293,8 @@ fn run_stage(
             model: DpMomentumModel::new(cfg.m, cfg.t, *theta, stage.free.clone()),
             h: cfg.h,
         };
-        // Each run starts at rest at its first measured pose, bias unknown.
-        let x0 = stage
-            .runs
-            .iter()
-            .enumerate()
-            .map(|(i, run)| {
-                if run.z.ncols() != 3 || run.z.nrows() == 0 {
-                    return Err(EkfError::Shape {
-                        field: format!("stages[{s}].runs[{i}].z"),
-                        expected: "N × 3 (x, y, ψ), N ≥ 1".into(),
-                        got: format!("{} × {}", run.z.nrows(), run.z.ncols()),
-                    });
-                }
-                let mut x = vec![0.0; DP_STATES];
-                for j in 0..3 {
-                    x[3 + j] = run.z[(0, j)];
-                }
-                Ok(x)
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let mut p0_x = Vec::with_capacity(DP_STATES);
-        p0_x.extend_from_slice(&cfg.p0_h);
-        p0_x.extend_from_slice(&cfg.r);
-        p0_x.extend_from_slice(&cfg.p0_b);
-        let mut q_x = Vec::with_capacity(DP_STATES);
-        q_x.extend_from_slice(&cfg.q_h);
-        q_x.extend_from_slice(&[0.0; 3]);
-        q_x.extend_from_slice(&cfg.q_b);
+        let x0 = initial_states(&stage.runs).map_err(|e| prefix_runs(e, s))?;
+        let (p0_x, q_x) = cfg.state_noise();
         let settings = EkfSettings {
             x0,
             theta0: stage.free.iter().map(|&f| theta[f]).collect(),

@@ -35,10 +35,7 @@ fn stages(runs: &[DpRun]) -> Vec<DpStage<'_>> {
 
 #[test]
 fn staged_parallel_ekf_recovers_the_supply_vessel() {
-    let truth = DpShip::supply_vessel();
-    let trial = TrialConfig::supply_vessel();
-    let runs = simulate_campaign(&truth, &trial, paper::SAMPLES_PER_RUN, 2024);
-    let cfg = DpIdentConfig::supply_vessel(&trial);
+    let (truth, trial, runs, cfg) = super::supply_campaign(2024);
     let mut reports = Vec::new();
     let mut sink = |f: f64, stage: &str| {
         reports.push((f, stage.to_string()));
@@ -120,10 +117,7 @@ fn staged_parallel_ekf_recovers_the_supply_vessel() {
 
 #[test]
 fn identified_ship_predicts_validation_runs() {
-    let truth = DpShip::supply_vessel();
-    let trial = TrialConfig::supply_vessel();
-    let runs = simulate_campaign(&truth, &trial, paper::SAMPLES_PER_RUN, 77);
-    let cfg = DpIdentConfig::supply_vessel(&trial);
+    let (truth, trial, runs, cfg) = super::supply_campaign(77);
     let model = |ship: DpShip| IdentifiedDpShip {
         ship,
         r: cfg.r,
