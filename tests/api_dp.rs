@@ -69,6 +69,17 @@ async fn parallel_ekf_identifies_the_supply_vessel_through_rest() {
     }
     assert_eq!(doc["parameters"].as_array().unwrap().len(), 9);
     assert!(doc["parameters"][0]["std"].as_f64().unwrap() > 0.0);
+    // The refinement after the staging is on by default and says what it did.
+    let rec = &doc["dp_ship"]["refinement"];
+    assert!(rec["applied"].is_boolean(), "{rec}");
+    assert_eq!(rec["ekf_theta"].as_array().unwrap().len(), 9, "{rec}");
+    assert_eq!(rec["ekf_theta_std"].as_array().unwrap().len(), 9, "{rec}");
+    if rec["applied"] == true {
+        assert!(rec["iterations"].as_u64().unwrap() >= 1, "{rec}");
+        assert_eq!(rec["std_inflation"].as_array().unwrap().len(), 9, "{rec}");
+    } else {
+        assert!(rec["reason"].as_str().is_some_and(|r| !r.is_empty()), "{rec}");
+    }
     assert_eq!(doc["structure_findings"].as_array().unwrap().len(), 0);
     // Validation on the held-out run in x, y, ψ.
     assert_eq!(m.json["validation_run_ids"].as_array().unwrap().len(), 2);

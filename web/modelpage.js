@@ -104,7 +104,30 @@ function dpShipSection(dp, inputs) {
       pm('B″ = M″⁻¹T″K″', '(eq. 52, Bis)', dp.b, { rowNames: NU3, colNames: inputs, testid: 'dp-b' })),
     h('div', { class: 'matrix-pair' },
       pm('A [1/s]', 'SI: ν in m/s, m/s, rad/s', dp.a_si, { rowNames: NU3, colNames: NU3, testid: 'dp-a-si' }),
-      pm('B [SI per unit command]', 'm/s², m/s², rad/s²', dp.b_si, { rowNames: NU3, colNames: inputs, testid: 'dp-b-si' })));
+      pm('B [SI per unit command]', 'm/s², m/s², rad/s²', dp.b_si, { rowNames: NU3, colNames: inputs, testid: 'dp-b-si' })),
+    refinementPart(dp));
+}
+
+/** What the prediction-error refinement after the staged EKF did, with the EKF's θ″ beside the stored ones. */
+function refinementPart(dp) {
+  const r = dp.refinement;
+  if (!r) return null;
+  const facts = [`${r.iterations} step(s)`];
+  if (r.variance_ratio != null) facts.push(`innovations' variance ratio ${fmt(r.variance_ratio, 3)}`);
+  if (r.held_out_nll_change != null) facts.push(`held-out negative log-likelihood ${r.held_out_nll_change <= 0 ? '' : '+'}${fmt(r.held_out_nll_change, 3)}`);
+  const head = r.applied
+    ? `θ″ refined after the staged EKF by prediction error on all runs (${facts.join('; ')}); std: Cramér–Rao, inflated where the residuals ask for it.`
+    : `θ″ and std are the staged EKF's: ${r.reason || 'the refinement was not taken'}.`;
+  const pm = (v, sd) => `${exact(v)} ± ${exact(sd)}`;
+  return h('div', { class: 'dp-refinement', 'data-testid': 'dp-refinement', 'data-applied': String(r.applied) },
+    h('p', { class: 'hint' }, head),
+    r.applied ? h('table', { class: 'grid-table compact', 'data-testid': 'dp-refinement-table' },
+      h('thead', null, h('tr', null, h('th', null, 'θ″'), h('th', { class: 'num' }, 'staged EKF'), h('th', { class: 'num' }, 'refined (stored)'), h('th', { class: 'num' }, 'std inflation'))),
+      h('tbody', null, r.ekf_theta.map((v, i) => h('tr', null,
+        h('th', { scope: 'row' }, `θ″${i + 1}`),
+        h('td', { class: 'num mono' }, pm(v, r.ekf_theta_std[i])),
+        h('td', { class: 'num mono' }, pm(dp.theta[i], dp.theta_std[i])),
+        h('td', { class: 'num' }, r.std_inflation[i] == null ? '–' : `×${fmt(r.std_inflation[i], 3)}`))))) : null);
 }
 
 /** The model page. Returns a controller whose mount() draws the plots. */

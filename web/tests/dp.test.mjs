@@ -60,6 +60,15 @@ test('identify the demo supply vessel by the parallel EKF and read its model pag
       assert.equal(await page.locator(tid(t)).count(), 1, t);
     }
     assert.match(await page.textContent(tid('dp-a-h')), /±/);
+    // The refinement after the staging: what it did, and the staged EKF's θ″ beside the stored ones.
+    const ref = page.locator(tid('dp-refinement'));
+    assert.equal(await ref.count(), 1);
+    if (await ref.getAttribute('data-applied') === 'true') {
+      assert.match(await ref.textContent(), /refined after the staged EKF by prediction error.*step/);
+      assert.equal(await page.locator(`${tid('dp-refinement-table')} tbody tr`).count(), 9);
+    } else {
+      assert.match(await ref.textContent(), /are the staged EKF's: \S/);
+    }
     assert.equal(await page.locator(`${tid('dp-b')} td`).count(), 18);
     // Validation of x, y, ψ with plots drawn.
     const chans = await page.locator(tid('fit-row')).evaluateAll((rs) => rs.map((r) => r.dataset.channel));

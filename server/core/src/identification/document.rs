@@ -241,6 +241,41 @@ pub struct DpShipDoc {
     /// The state estimator's noise model (Bis, per sample), used to
     /// estimate momentum and bias when the model predicts k steps ahead.
     pub noise: DpNoiseDoc,
+    /// The prediction-error refinement after the staged EKF, when it was
+    /// attempted (absent with `refine: false` and in models stored before
+    /// it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<DpRefinementDoc>,
+}
+
+/// What the prediction-error refinement after the staged EKF did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct DpRefinementDoc {
+    /// The refined θ″ and std replaced the EKF's (`theta`, `theta_std`
+    /// of the document are the refined ones).
+    pub applied: bool,
+    /// Why not, when not applied.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// The staged EKF's θ″1 … θ″9, the refinement's start.
+    pub ekf_theta: Vec<f64>,
+    /// Their std as the EKF reported them.
+    pub ekf_theta_std: Vec<f64>,
+    /// Accepted Levenberg–Marquardt steps (0 when it did not run).
+    pub iterations: u32,
+    /// χ²/(N − p) of the innovations at the refined θ″ (≈ 1 when the
+    /// stated noise is right), when it ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variance_ratio: Option<f64>,
+    /// Per θ″, the factor on the Cramér–Rao std (≥ 1) the residuals asked
+    /// for (empty when it did not run).
+    #[serde(default)]
+    pub std_inflation: Vec<f64>,
+    /// Change of the held-out runs' negative log-likelihood from the EKF's
+    /// θ″ to the refined ones (negative: predicted better), when computed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub held_out_nll_change: Option<f64>,
 }
 
 /// Noise model of the momentum/bias estimator (Bis units, per sample).

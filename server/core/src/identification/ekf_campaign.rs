@@ -20,7 +20,7 @@ use super::document::{
 };
 use super::ekf_checks::{every_stage, stage_of};
 use super::ekf_init::{InitBlock, WITHOUT_PRIOR_FINDING, ls_start, without_prior_note};
-use super::ekf_refine::{RefineOutcome, refine_campaign};
+use super::ekf_refine::{RefineOutcome, not_run, refine_campaign};
 pub use super::ekf_settings::EkfCampaignSettings;
 use super::ekf_settings::{check_settings, nine};
 use super::error::IdentifyError;
@@ -366,6 +366,7 @@ pub fn identify_ekf_campaign(
         RefineOutcome {
             notes: vec![NO_REFINEMENT_WITHOUT_PRIOR.into()],
             findings: Vec::new(),
+            record: Some(not_run(&id, NO_REFINEMENT_WITHOUT_PRIOR)),
         }
     } else {
         RefineOutcome::default()
@@ -414,6 +415,9 @@ pub fn identify_ekf_campaign(
     let mut document = document(&id, &cfg, &scale, inputs, &staged);
     document.notes.extend(refined.notes);
     document.structure_findings.extend(refined.findings);
+    if let Some(dp) = document.dp_ship.as_mut() {
+        dp.refinement = refined.record;
+    }
     if let Some(st) = &start {
         document.notes[2] = without_prior_note(&st.m);
         document
@@ -516,6 +520,7 @@ fn document(
                 q_h: cfg.q_h.to_vec(),
                 q_b: cfg.q_b.to_vec(),
             },
+            refinement: None,
         }),
         state_space: None,
         parameters,

@@ -164,6 +164,29 @@ fn refinement_is_on_by_default_and_the_staging_stays_available() {
     assert!(refined.notes.iter().any(|n| n.contains("Cramér–Rao")));
     let (a, b) = (staged.dp_ship.unwrap(), refined.dp_ship.unwrap());
     assert_ne!(a.theta, b.theta);
+    // The structured record: none when not asked for; when taken, the
+    // EKF's θ″ (the staging's own result) beside the refined ones.
+    assert_eq!(a.refinement, None);
+    let rec = b.refinement.as_ref().expect("a refinement record");
+    assert!(rec.applied && rec.reason.is_none(), "{rec:?}");
+    assert_eq!(rec.ekf_theta, a.theta);
+    assert_eq!(rec.ekf_theta_std, a.theta_std);
+    assert!(rec.iterations >= 1);
+    assert_eq!(rec.std_inflation.len(), N_THETA);
+    assert!(rec.std_inflation.iter().all(|f| *f >= 1.0 && f.is_finite()));
+    assert!(rec.variance_ratio.is_some_and(|v| v > 0.0));
+    assert!(rec.held_out_nll_change.is_some_and(|d| d <= 2.0));
+    // Without M″ it is not run, and the record says why.
+    let mut no_m = profile.clone();
+    if let Some(prior) = no_m.dp_prior.as_mut() {
+        prior.inertia_bis = None;
+    }
+    let doc = identify_ekf_campaign(&no_m, &inputs, &runs, &Default::default(), &mut NoProgress)
+        .unwrap()
+        .document;
+    let rec = doc.dp_ship.unwrap().refinement.expect("a record");
+    assert!(!rec.applied && rec.iterations == 0, "{rec:?}");
+    assert!(rec.reason.is_some_and(|r| r.contains("without M″")));
     for p in 0..N_THETA {
         assert!(b.theta_std[p] > 0.0 && b.theta_std[p] < 0.5 * b.theta[p].abs());
         assert!(

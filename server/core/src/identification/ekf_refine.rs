@@ -6,6 +6,7 @@
 //! them rises by at most [`HELD_OUT_TOLERANCE`]). Otherwise the EKF's θ″
 //! are kept and a structure finding says why; the job never fails for it.
 
+use super::document::DpRefinementDoc;
 use super::error::IdentifyError;
 use crate::estimation::Progress;
 use crate::estimation::ekf::{
@@ -27,6 +28,22 @@ pub(crate) struct RefineOutcome {
     pub notes: Vec<String>,
     /// Why the EKF's θ″ were kept, if they were.
     pub findings: Vec<String>,
+    /// The structured record for the document (None: not attempted).
+    pub record: Option<DpRefinementDoc>,
+}
+
+/// The record of a refinement that did not run or was not taken, for `why`.
+pub(crate) fn not_run(id: &DpIdentification, why: &str) -> DpRefinementDoc {
+    DpRefinementDoc {
+        applied: false,
+        reason: Some(why.to_owned()),
+        ekf_theta: id.theta.to_vec(),
+        ekf_theta_std: id.theta_std.to_vec(),
+        iterations: 0,
+        variance_ratio: None,
+        std_inflation: Vec::new(),
+        held_out_nll_change: None,
+    }
 }
 
 /// Refines `id` in place on `estimation` (all stages' blocks), checked on
@@ -52,19 +69,31 @@ pub(crate) fn refine_campaign(
         Ok(r) => r,
         Err(EkfError::Cancelled) => return Err(IdentifyError::Cancelled),
         Err(e) => {
-            out.findings.push(kept(format!(
-                "The prediction-error refinement failed ({e})"
-            )));
+            let why = format!("The prediction-error refinement failed ({e})");
+            out.record = Some(not_run(id, &why));
+            out.findings.push(kept(why));
             return Ok(out);
         }
     };
     let fit = &r.refinement;
+    // The record of a refinement that ran, whether taken or not.
+    let ran = |why: Option<String>, held_change: Option<f64>| DpRefinementDoc {
+        applied: why.is_none(),
+        reason: why,
+        iterations: u32::try_from(fit.iterations).unwrap_or(u32::MAX),
+        variance_ratio: Some(fit.variance_ratio).filter(|v| v.is_finite()),
+        std_inflation: fit.inflation.iter().copied().collect(),
+        held_out_nll_change: held_change.filter(|v| v.is_finite()),
+        ..not_run(id, "")
+    };
     if !fit.converged || r.theta.iter().chain(&r.theta_std).any(|v| !v.is_finite()) {
-        out.findings.push(kept(format!(
+        let why = format!(
             "The prediction-error refinement did not converge in {} step(s) (predicted decrease {} left)",
             fit.iterations,
             sig3(fit.decrement)
-        )));
+        );
+        out.record = Some(ran(Some(why.clone()), None));
+        out.findings.push(kept(why));
         return Ok(out);
     }
     let held = match (
@@ -77,12 +106,15 @@ pub(crate) fn refine_campaign(
     if let Some((before, after)) = held
         && (after.is_nan() || after > before + HELD_OUT_TOLERANCE)
     {
-        out.findings.push(kept(format!(
+        let why = format!(
             "The prediction-error refinement predicts the held-out runs worse (their negative log-likelihood rises by {})",
             sig3(after - before)
-        )));
+        );
+        out.record = Some(ran(Some(why.clone()), Some(after - before)));
+        out.findings.push(kept(why));
         return Ok(out);
     }
+    out.record = Some(ran(None, held.map(|(b, a)| a - b)));
     let ekf = id.theta;
     let inflated: Vec<String> = (0..N_THETA)
         .filter(|&p| fit.inflation[p] > 1.05)
