@@ -78,7 +78,10 @@ async fn parallel_ekf_identifies_the_supply_vessel_through_rest() {
         assert!(rec["iterations"].as_u64().unwrap() >= 1, "{rec}");
         assert_eq!(rec["std_inflation"].as_array().unwrap().len(), 9, "{rec}");
     } else {
-        assert!(rec["reason"].as_str().is_some_and(|r| !r.is_empty()), "{rec}");
+        assert!(
+            rec["reason"].as_str().is_some_and(|r| !r.is_empty()),
+            "{rec}"
+        );
     }
     assert_eq!(doc["structure_findings"].as_array().unwrap().len(), 0);
     // Validation on the held-out run in x, y, ψ.
