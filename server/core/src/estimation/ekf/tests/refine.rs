@@ -92,3 +92,118 @@ fn refinement_refuses_bad_requests() {
     let nll = dp_predictor_nll(&cfg, &d, &paper::THETA).unwrap();
     assert!(nll.is_finite());
 }
+
+/// x(k+1) = a·x + θ₁·u₁ + θ₂·u₂, z = x: the gain and S do not depend on θ
+/// and e is affine in θ, so V is exactly quadratic in θ and the pass's
+/// gradient and Gauss–Newton Hessian are its exact derivatives.
+struct InputGains {
+    a: f64,
+    h: DMatrix<f64>,
+}
+
+impl RunModel for InputGains {
+    fn n_states(&self) -> usize {
+        1
+    }
+    fn n_params(&self) -> usize {
+        2
+    }
+    fn n_inputs(&self) -> usize {
+        2
+    }
+    fn measurement_matrix(&self) -> &DMatrix<f64> {
+        &self.h
+    }
+    fn transition(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        x_next: &mut [f64],
+        phi_x: &mut DMatrix<f64>,
+        phi_theta: &mut DMatrix<f64>,
+    ) {
+        x_next[0] = self.a * x[0] + theta[0] * u[0] + theta[1] * u[1];
+        phi_x[(0, 0)] = self.a;
+        phi_theta[(0, 0)] = u[0];
+        phi_theta[(0, 1)] = u[1];
+    }
+}
+
+#[test]
+fn sensitivities_are_the_exact_derivatives_of_a_quadratic_criterion() {
+    let model = InputGains {
+        a: 0.9,
+        h: DMatrix::from_element(1, 1, 1.0),
+    };
+    let mut rng = crate::rng::SplitMix64::new(11);
+    let truth = [0.5, -0.2];
+    let runs: Vec<(DMatrix<f64>, DMatrix<f64>)> = (0..2)
+        .map(|_| {
+            let n = 300;
+            let u = DMatrix::from_fn(n, 2, |_, _| rng.normal());
+            let mut x = 0.0;
+            let z = DMatrix::from_fn(n, 1, |k, _| {
+                let out = x + 0.05 * rng.normal();
+                x = 0.9 * x + truth[0] * u[(k, 0)] + truth[1] * u[(k, 1)] + 0.01 * rng.normal();
+                out
+            });
+            (u, z)
+        })
+        .collect();
+    let data: Vec<RunData<'_>> = runs.iter().map(|(u, z)| RunData { u, z }).collect();
+    let noise = PredictorNoise {
+        x0: vec![vec![0.0]; 2],
+        p0_x: vec![1e-2],
+        q_x: vec![1e-4],
+        r: vec![0.0025],
+    };
+    let theta = [0.3, 0.1];
+    let pass = predictor_pass(&model, &data, &noise, &theta, true).unwrap();
+    let nll = |t: [f64; 2]| {
+        predictor_pass(&model, &data, &noise, &t, false)
+            .unwrap()
+            .nll
+    };
+    let d = 1e-4;
+    for j in 0..2 {
+        let (mut up, mut down) = (theta, theta);
+        up[j] += d;
+        down[j] -= d;
+        // V quadratic: the central difference is exact up to rounding.
+        let fd = (nll(up) - nll(down)) / (2.0 * d);
+        assert!(
+            (pass.grad[j] - fd).abs() < 1e-6 * pass.grad[j].abs().max(1.0),
+            "g{j}: {} vs {fd}",
+            pass.grad[j]
+        );
+        let g_up = predictor_pass(&model, &data, &noise, &up, true)
+            .unwrap()
+            .grad;
+        let g_down = predictor_pass(&model, &data, &noise, &down, true)
+            .unwrap()
+            .grad;
+        for i in 0..2 {
+            let h = (g_up[i] - g_down[i]) / (2.0 * d);
+            assert!(
+                (pass.info[(i, j)] - h).abs() < 1e-6 * pass.info[(i, j)].abs().max(1.0),
+                "J{i}{j}"
+            );
+        }
+    }
+    // One Gauss–Newton step from any start lands on the minimum.
+    let step = pass.info.clone().lu().solve(&pass.grad).unwrap();
+    let min = [theta[0] - step[0], theta[1] - step[1]];
+    let at_min = predictor_pass(&model, &data, &noise, &min, true).unwrap();
+    assert!(at_min.grad.norm() < 1e-8 * pass.grad.norm());
+    // And it is near the truth, within a few Cramér–Rao std.
+    let cov = at_min.info.clone().try_inverse().unwrap();
+    for j in 0..2 {
+        assert!(
+            (min[j] - truth[j]).abs() < 4.0 * cov[(j, j)].sqrt(),
+            "θ{j}: {} vs {}",
+            min[j],
+            truth[j]
+        );
+    }
+}
