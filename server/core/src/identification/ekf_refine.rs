@@ -82,7 +82,12 @@ pub(crate) fn refine_campaign(
         reason: why,
         iterations: u32::try_from(fit.iterations).unwrap_or(u32::MAX),
         variance_ratio: Some(fit.variance_ratio).filter(|v| v.is_finite()),
-        std_inflation: fit.inflation.iter().copied().collect(),
+        // Only when every factor is a number (a failed pass may leave NaN).
+        std_inflation: if fit.inflation.iter().all(|f| f.is_finite()) {
+            fit.inflation.iter().copied().collect()
+        } else {
+            Vec::new()
+        },
         held_out_nll_change: held_change.filter(|v| v.is_finite()),
         ..not_run(id, "")
     };
