@@ -2,8 +2,10 @@
 //! (noisy) state, as on the Surveyor ROV (thesis §1.4: SISO PID loops per
 //! degree of freedom, automatic roll and pitch):
 //! - PI loops on u, v, w, r: τᵢ = Kpᵢ eᵢ + Kiᵢ ∫eᵢ, e = ν_ref − ν_meas;
-//! - PD attitude loops on φ, θ: τ = Kp (Θ_ref − Θ_meas) − Kd ω_meas, with
-//!   Kp = Î ω² + ½ ẑ_G W and Kd = 2ζ √(Kp Î);
+//! - PD attitude loops on φ, θ: τ = Kp (Θ_ref − Θ_meas) + Kd (ω_ref − ω_meas),
+//!   with Kp = Î ω² + ½ ẑ_G W and Kd = 2ζ √(Kp Î); the rate feed-forward
+//!   ω_ref = (p_ref, q_ref) is zero in the truth's own campaign (pure rate
+//!   damping) and set only when an external schedule asks for roll/pitch rates;
 //! - feed-forward of a NOMINAL ĝ(η_meas) (eq. 4.6 with the team's W − B and
 //!   z_G W − z_B B, off the truth by 20–40 %);
 //! - τ_cmd = feedback + ĝ(η), clipped at per-DOF limits, with conditional
@@ -30,7 +32,9 @@ pub const VELOCITY_DOFS: [usize; 4] = [0, 1, 2, 5];
 /// Set-points at one controller sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reference {
-    /// Velocity set-points; entries 0, 1, 2, 5 (u, v, w, r) are used.
+    /// Velocity set-points: entries 0, 1, 2, 5 (u, v, w, r) drive the PI
+    /// loops; entries 3, 4 (p, q) are the attitude loops' rate feed-forward
+    /// (zero: pure rate damping).
     pub nu: Vector6<f64>,
     /// Roll set-point φ_ref (rad).
     pub phi: f64,
@@ -185,8 +189,8 @@ impl Controller {
             e[i] = r.nu[i] - nu[i];
             fb[i] = c.kp[i] * e[i] + c.ki[i] * self.integ[i];
         }
-        fb[3] = c.kp[3] * (r.phi - eta[3]) - c.kd[3] * nu[3];
-        fb[4] = c.kp[4] * (r.theta - eta[4]) - c.kd[4] * nu[4];
+        fb[3] = c.kp[3] * (r.phi - eta[3]) + c.kd[3] * (r.nu[3] - nu[3]);
+        fb[4] = c.kp[4] * (r.theta - eta[4]) + c.kd[4] * (r.nu[4] - nu[4]);
         let raw = fb + c.nominal_restoring(eta[3], eta[4]);
         let mut sat = [false; 6];
         let tau = Vector6::from_fn(|i, _| {

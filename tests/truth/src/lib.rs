@@ -33,8 +33,9 @@ pub mod vessel;
 mod vessel_draw;
 
 pub use campaign::{
-    Campaign, CampaignSpec, Dof, Log, NavLog, NoiseSpec, Role, Run, RunMeta, TruthRecord,
-    fly_campaign,
+    Campaign, CampaignSpec, Channel, Dof, ExternalRun, Log, NavLog, NoiseSpec, Role, Run, RunMeta,
+    TruthRecord, campaign_as_external, external_envelope, fly_campaign, fly_external,
+    fly_external_campaign, fly_external_runs, run_seed,
 };
 pub use linearization::{Linearization, effective_linearization};
 pub use plant::{Plant, State};

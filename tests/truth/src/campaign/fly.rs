@@ -26,34 +26,70 @@ fn measure(x: &State, noise: &NoiseSpec, rng: &mut Rng) -> (Vector6<f64>, Vector
     (nu, eta)
 }
 
-/// Everything one run needs besides its plan.
-struct Flight<'a> {
-    plant: &'a Plant,
-    cfg: &'a ControllerConfig,
-    spec: &'a CampaignSpec,
-    offset: f64,
+/// The generator of a run's initial pose, from the run seed.
+pub(crate) fn start_pose_rng(run_seed: u64) -> Rng {
+    Rng::new(derive_seed(run_seed, 3))
 }
 
-impl Flight<'_> {
+/// Initial depth 20–80 m and heading in (−π, π) (rad).
+pub(crate) fn draw_start_pose(rng: &mut Rng) -> (f64, f64) {
+    let depth = rng.range(20.0, 80.0);
+    (
+        depth,
+        rng.range(-std::f64::consts::PI, std::f64::consts::PI),
+    )
+}
+
+/// Everything one run needs besides its plan: the one flying routine of the
+/// truth's own campaign and of external schedules.
+pub(crate) struct Flight<'a> {
+    pub plant: &'a Plant,
+    pub cfg: &'a ControllerConfig,
+    /// Noise on the controller's measurements and the single/control logs.
+    pub noise: NoiseSpec,
+    /// Noise of the nav computer's file.
+    pub nav_noise: NoiseSpec,
+    /// Nav file rate (Hz).
+    pub nav_rate_hz: f64,
+    /// Internal RK4 rate (Hz), a multiple of 20.
+    pub integration_rate_hz: f64,
+    /// Clock offset (s): nav t + offset = control t.
+    pub offset: f64,
+}
+
+impl<'a> Flight<'a> {
+    /// The flight settings of `spec` with clock offset `offset`.
+    pub fn from_spec(
+        plant: &'a Plant,
+        cfg: &'a ControllerConfig,
+        spec: &CampaignSpec,
+        offset: f64,
+    ) -> Self {
+        Flight {
+            plant,
+            cfg,
+            noise: spec.noise,
+            nav_noise: spec.nav_noise,
+            nav_rate_hz: spec.nav_rate_hz,
+            integration_rate_hz: spec.integration_rate_hz,
+            offset,
+        }
+    }
+
     /// Flies `plan` with its first log stamp at control time `t0`.
-    fn fly(&self, plan: &RunPlan, t0: f64, seed: u64) -> Run {
-        let spec = self.spec;
+    pub fn fly(&self, plan: &RunPlan, t0: f64, seed: u64) -> Run {
         let mut meas_rng = Rng::new(derive_seed(seed, 1));
         let mut nav_rng = Rng::new(derive_seed(seed, 2));
-        let mut init_rng = Rng::new(derive_seed(seed, 3));
-        let substeps = (spec.integration_rate_hz * CONTROL_DT).round().max(1.0) as i64;
+        let mut init_rng = start_pose_rng(seed);
+        let substeps = (self.integration_rate_hz * CONTROL_DT).round().max(1.0) as i64;
         let h = CONTROL_DT / substeps as f64;
 
         // Start in trim at the program's first set-point, loops preset.
         let r0 = plan.program.reference(0.0);
-        let eta0 = Vector6::new(
-            0.0,
-            0.0,
-            init_rng.range(20.0, 80.0),
-            0.0,
-            0.0,
-            init_rng.range(-std::f64::consts::PI, std::f64::consts::PI),
-        );
+        let (depth, heading) = plan
+            .start_pose
+            .unwrap_or_else(|| draw_start_pose(&mut init_rng));
+        let eta0 = Vector6::new(0.0, 0.0, depth, 0.0, 0.0, heading);
         let nu0 = Vector6::new(r0.nu[0], 0.0, 0.0, 0.0, 0.0, 0.0);
         let mut x = State::new(eta0, nu0);
         let v = self.plant.vessel();
@@ -66,11 +102,11 @@ impl Flight<'_> {
 
         let rows = (plan.duration_s * 10.0).round() as i64;
         let ticks = rows * LOG_EVERY;
-        let pre = (spec.preroll_s / CONTROL_DT).round() as i64;
+        let pre = (plan.preroll_s / CONTROL_DT).round() as i64;
         let tick_time = |j: i64| t0 + j as f64 * CONTROL_DT;
 
         // Nav samples n/rate on the nav clock, at control time n/rate + offset.
-        let rate = spec.nav_rate_hz;
+        let rate = self.nav_rate_hz;
         let last_log = tick_time(ticks - LOG_EVERY);
         let mut n_nav = ((t0 - self.offset) * rate).ceil() as i64;
         let n_last = ((last_log - self.offset) * rate).floor() as i64;
@@ -83,9 +119,16 @@ impl Flight<'_> {
         let mut saturated = 0usize;
 
         for j in -pre..ticks {
-            let (y_nu, y_eta) = measure(&x, &spec.noise, &mut meas_rng);
+            let (y_nu, y_eta) = measure(&x, &self.noise, &mut meas_rng);
             let run_t = j as f64 * CONTROL_DT;
-            let (tau, sat) = ctrl.update(&y_nu, &y_eta, &plan.program.reference(run_t));
+            let (mut tau, mut sat) = ctrl.update(&y_nu, &y_eta, &plan.program.reference(run_t));
+            // open-loop DOFs: the schedule's τ replaces the autopilot's
+            for (i, f) in plan.program.open_loop(run_t).into_iter().enumerate() {
+                if let Some(f) = f {
+                    tau[i] = f;
+                    sat[i] = false;
+                }
+            }
             if j >= 0 {
                 saturated += usize::from(sat.iter().any(|s| *s));
                 cmd20.push(tau);
@@ -110,7 +153,7 @@ impl Flight<'_> {
                             break;
                         }
                         let xn = self.plant.rk4_step(&x, &tau, (tc - ts).max(0.0));
-                        let (m_nu, m_eta) = measure(&xn, &spec.nav_noise, &mut nav_rng);
+                        let (m_nu, m_eta) = measure(&xn, &self.nav_noise, &mut nav_rng);
                         nav_t.push(n_nav as f64 / rate);
                         nav_nu.push(m_nu);
                         nav_eta.push(m_eta);
@@ -158,6 +201,55 @@ impl Flight<'_> {
     }
 }
 
+/// Control-clock start times of `plans` flown one after the other: the
+/// first 100–1000 s into the clock, then 30–180 s gaps (all on the 10 Hz grid).
+pub(crate) fn start_times(plans: &[RunPlan], rng: &mut Rng) -> Vec<f64> {
+    let mut t0 = (rng.range(100.0, 1000.0) * 10.0).round() / 10.0;
+    let mut starts = Vec::with_capacity(plans.len());
+    for p in plans {
+        starts.push(t0);
+        t0 += p.duration_s + (rng.range(30.0, 180.0) * 10.0).round() / 10.0;
+    }
+    starts
+}
+
+/// The noise seed of run `index` of a campaign flown with `seed` (own plans
+/// and external campaigns alike): different indices or seeds give
+/// independent noise, the same pair the same noise.
+pub fn run_seed(seed: u64, index: usize) -> u64 {
+    derive_seed(seed, 1000 + index as u64)
+}
+
+impl Flight<'_> {
+    /// Flies every plan, plan i from `starts[i]` with noise seed
+    /// [`run_seed`]`(seed, i)`. Runs are independent (own seeds), so flying
+    /// them on a few threads changes nothing in the result.
+    pub fn fly_all(&self, plans: &[RunPlan], starts: &[f64], seed: u64) -> Vec<Run> {
+        let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(4));
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let mut done: Vec<(usize, Run)> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..workers)
+                .map(|_| {
+                    s.spawn(|| {
+                        let mut out = Vec::new();
+                        loop {
+                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                            let Some(p) = plans.get(i) else { break out };
+                            out.push((i, self.fly(p, starts[i], run_seed(seed, i))));
+                        }
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().expect("a run panicked"))
+                .collect()
+        });
+        done.sort_by_key(|(i, _)| *i);
+        done.into_iter().map(|(_, r)| r).collect()
+    }
+}
+
 /// Flies the campaign `spec` with `vessel`, everything drawn from `seed`:
 /// the team's controller (nominal inertia and ĝ), the clock offset, run
 /// durations and signals, initial depth and heading, and all noise. Runs
@@ -169,43 +261,9 @@ pub fn fly_campaign(vessel: &Vessel, spec: &CampaignSpec, seed: u64) -> Campaign
     let offset = rng.range(lo, hi);
     let plans = plan_campaign(spec, &mut rng);
     let plant = Plant::new(vessel);
-    let flight = Flight {
-        plant: &plant,
-        cfg: &cfg,
-        spec,
-        offset,
-    };
-    let mut t0 = (rng.range(100.0, 1000.0) * 10.0).round() / 10.0;
-    let mut starts = Vec::with_capacity(plans.len());
-    for p in &plans {
-        starts.push(t0);
-        t0 += p.duration_s + (rng.range(30.0, 180.0) * 10.0).round() / 10.0;
-    }
-    // Runs are independent (own seeds), so flying them on a few threads
-    // changes nothing in the result.
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(4));
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut done: Vec<(usize, Run)> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                s.spawn(|| {
-                    let mut out = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(p) = plans.get(i) else { break out };
-                        let run_seed = derive_seed(seed, 1000 + i as u64);
-                        out.push((i, flight.fly(p, starts[i], run_seed)));
-                    }
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("a run panicked"))
-            .collect()
-    });
-    done.sort_by_key(|(i, _)| *i);
-    let runs = done.into_iter().map(|(_, r)| r).collect();
+    let flight = Flight::from_spec(&plant, &cfg, spec, offset);
+    let starts = start_times(&plans, &mut rng);
+    let runs = flight.fly_all(&plans, &starts, seed);
     Campaign {
         vessel: vessel.clone(),
         spec: spec.clone(),

@@ -3,12 +3,17 @@
 //! validation run between and beyond the grid, each logged at 10 Hz as one
 //! file and as a control/nav pair on two unsynchronized clocks.
 
+mod external;
 mod fly;
 mod io;
 mod plan;
 mod spec;
 
-pub use fly::fly_campaign;
+pub use external::{
+    Channel, ExternalRun, campaign_as_external, external_envelope, fly_external,
+    fly_external_campaign, fly_external_runs,
+};
+pub use fly::{fly_campaign, run_seed};
 pub use spec::{CampaignSpec, NoiseSpec};
 
 use nalgebra::DMatrix;

@@ -2,6 +2,7 @@
 
 use nalgebra::Vector6;
 
+use super::external::Schedule;
 use super::{CampaignSpec, Dof, Role};
 use crate::controller::Reference;
 use crate::rng::Rng;
@@ -20,6 +21,8 @@ pub(crate) enum Program {
         stairs: Staircase,
         extra: Vec<(Dof, Signal)>,
     },
+    /// An external reference schedule (see [`super::external`]).
+    External(Box<Schedule>),
 }
 
 fn add(r: &mut Reference, dof: Dof, value: f64) {
@@ -49,8 +52,18 @@ impl Program {
                     add(&mut r, *d, s.at(t));
                 }
             }
+            Program::External(s) => return s.reference(t),
         }
         r
+    }
+
+    /// Open-loop forces at run time `t`: `Some(τᵢ)` replaces the
+    /// autopilot's command in DOF i (only external schedules have any).
+    pub(crate) fn open_loop(&self, t: f64) -> [Option<f64>; 6] {
+        match self {
+            Program::External(s) => s.open_loop(t),
+            _ => [None; 6],
+        }
     }
 }
 
@@ -66,6 +79,10 @@ pub(crate) struct RunPlan {
     pub switch_time_s: Option<f64>,
     pub speeds: Vec<f64>,
     pub duration_s: f64,
+    /// Unlogged flight before the first log stamp (s).
+    pub preroll_s: f64,
+    /// Initial depth (m) and heading (rad); None: drawn from the run seed.
+    pub start_pose: Option<(f64, f64)>,
     pub program: Program,
 }
 
@@ -102,6 +119,8 @@ pub(crate) fn plan_campaign(spec: &CampaignSpec, rng: &mut Rng) -> Vec<RunPlan> 
             switch_time_s: None,
             speeds: vec![u0],
             duration_s: tenth(rng.range(lo, hi)),
+            preroll_s: spec.preroll_s,
+            start_pose: None,
             program: Program::Hold { u0 },
         });
         for &dof in &spec.dynamic_dofs {
@@ -126,6 +145,8 @@ pub(crate) fn plan_campaign(spec: &CampaignSpec, rng: &mut Rng) -> Vec<RunPlan> 
                 switch_time_s: Some(signal.switch_time_s()),
                 speeds: vec![u0],
                 duration_s: tenth(rng.range(lo, hi)),
+                preroll_s: spec.preroll_s,
+                start_pose: None,
                 program: Program::Excite { u0, dof, signal },
             });
         }
@@ -151,6 +172,8 @@ pub(crate) fn plan_campaign(spec: &CampaignSpec, rng: &mut Rng) -> Vec<RunPlan> 
         switch_time_s: None,
         speeds: levels.clone(),
         duration_s: duration,
+        preroll_s: spec.preroll_s,
+        start_pose: None,
         program: Program::Validation {
             stairs: Staircase {
                 segment_s: duration / levels.len() as f64,
