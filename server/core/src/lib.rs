@@ -26,6 +26,7 @@
 //!   the recordings part, name the left-out physics, model it.
 
 pub mod alignment;
+pub mod design;
 pub mod discrepancy;
 pub mod estimation;
 pub mod identification;

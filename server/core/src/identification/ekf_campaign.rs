@@ -70,7 +70,7 @@ pub fn check_ekf_profile(profile: &VesselProfile) -> Result<(), IdentifyError> {
 
 /// M″ (when the profile gives it), T″ and the Bis scale of a profile, or
 /// the field that lacks them.
-fn known(
+pub(crate) fn known(
     profile: &VesselProfile,
 ) -> Result<(Option<Matrix3<f64>>, Matrix3x6, BisScale), IdentifyError> {
     if profile.kind != VesselKind::Dp3 || profile.dofs != Dof::HORIZONTAL {
@@ -119,7 +119,7 @@ fn known(
 }
 
 /// Default initial guess from the profile's time constants.
-fn default_theta(profile: &VesselProfile, scale: &BisScale) -> [f64; N_THETA] {
+pub(crate) fn default_theta(profile: &VesselProfile, scale: &BisScale) -> [f64; N_THETA] {
     let a = |d: Dof| -scale.time_unit_s / profile.limit(d).time_constant_s;
     [
         a(Dof::Surge),

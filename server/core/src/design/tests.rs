@@ -1,0 +1,120 @@
+//! Predicted precision on the project's own simulators: the mechanics
+//! (every std finite, the weakest named, errors naming fields) and one
+//! analytic property — the Fisher information of independent runs adds, so
+//! flying every experiment twice divides each std by √2.
+
+use super::*;
+use crate::estimation::NoProgress;
+use crate::planning::examples::{
+    supply_vessel, supply_vessel_trial_campaign, surveyor_campaign, surveyor_rov,
+};
+use crate::planning::generate_plan;
+
+fn rov_prediction(repetitions: Option<u32>) -> PrecisionPrediction {
+    let profile = surveyor_rov();
+    let mut spec = surveyor_campaign(7);
+    spec.repetitions = repetitions;
+    let plan = generate_plan(&profile, &spec).unwrap();
+    let prior = Prior::reference(&profile).unwrap();
+    predict_precision(
+        &profile,
+        &plan,
+        &prior,
+        PriorSource::Reference,
+        &PredictSettings::default(),
+        &mut NoProgress,
+    )
+    .unwrap()
+}
+
+#[test]
+fn rov_prediction_is_finite_and_names_the_weakest() {
+    let p = rov_prediction(None);
+    eprintln!(
+        "{} of {} determined, {:.1} h; weakest {:#?}",
+        p.determined, p.total, p.ship_hours, p.weakest
+    );
+    assert_eq!(p.method, "lambda_kf");
+    assert!(p.total > 100, "{} parameters", p.total);
+    for r in &p.parameters {
+        assert!(r.expected_value.is_finite(), "{}", r.symbol);
+        if let Some(sd) = r.predicted_std {
+            assert!(sd.is_finite() && sd >= 0.0, "{}: {sd}", r.symbol);
+        }
+    }
+    // Every inertia diagonal is determined by the thesis plan.
+    for r in p.parameters.iter().filter(|r| r.group == "M") {
+        let diag = ["surge", "sway", "heave", "roll", "pitch", "yaw"]
+            .iter()
+            .any(|d| r.symbol == format!("M[{d},{d}]"));
+        if diag {
+            assert!(
+                r.determined,
+                "{} at {:?}: {:?}",
+                r.symbol, r.grid_speed_mps, r.relative_std
+            );
+        }
+    }
+    assert!(!p.weakest.is_empty() && p.weakest.len() <= WEAKEST_SHOWN);
+    assert!(
+        p.geometric_mean_relative_std
+            .is_some_and(|g| g > 0.0 && g.is_finite())
+    );
+}
+
+fn dp_prediction(repetitions: u32) -> PrecisionPrediction {
+    let profile = supply_vessel();
+    let mut spec = supply_vessel_trial_campaign(3);
+    spec.repetitions = Some(repetitions);
+    let plan = generate_plan(&profile, &spec).unwrap();
+    let prior = Prior::reference(&profile).unwrap();
+    predict_precision(
+        &profile,
+        &plan,
+        &prior,
+        PriorSource::Reference,
+        &PredictSettings::default(),
+        &mut NoProgress,
+    )
+    .unwrap()
+}
+
+/// Independent runs add their Fisher information: twice the runs of every
+/// manoeuvre, √2 smaller stds (within the noise of one realisation).
+#[test]
+fn dp_std_falls_by_root_two_when_every_manoeuvre_is_flown_twice() {
+    let (one, two) = (dp_prediction(2), dp_prediction(4));
+    assert_eq!(one.method, "parallel_ekf");
+    assert_eq!(one.total, 9);
+    for (a, b) in one.parameters.iter().zip(&two.parameters) {
+        let ratio = a.predicted_std.unwrap() / b.predicted_std.unwrap();
+        eprintln!(
+            "{}: {:.3e} → {:.3e}, ratio {ratio:.3}",
+            a.symbol,
+            a.predicted_std.unwrap(),
+            b.predicted_std.unwrap()
+        );
+        assert!(
+            (ratio / 2f64.sqrt() - 1.0).abs() < 0.2,
+            "{}: ratio {ratio}",
+            a.symbol
+        );
+    }
+    assert!(two.ship_hours > one.ship_hours);
+}
+
+#[test]
+fn rough_profile_prior_flies_and_predicts() {
+    for profile in [surveyor_rov(), supply_vessel()] {
+        let prior = Prior::from_profile(&profile).unwrap();
+        match (&prior, profile.kind) {
+            (Prior::Rov(t), crate::planning::vessel::VesselKind::Rov6) => {
+                assert!(t.m.cholesky().is_some());
+            }
+            (Prior::Dp(s), crate::planning::vessel::VesselKind::Dp3) => {
+                assert!(s.theta().iter().all(|v| v.is_finite()));
+            }
+            _ => panic!("prior of the wrong kind"),
+        }
+    }
+}
