@@ -109,6 +109,7 @@ pub mod handler;
 pub mod heartbeat;
 pub mod identify;
 pub mod live;
+pub mod precision;
 pub mod progress;
 pub mod registry;
 pub mod run_inputs;

@@ -19,11 +19,13 @@ impl JobRegistry {
 
     /// The production kinds: `identify` (campaign runs → a validated,
     /// versioned model) and `discover` (a model and its runs → the missing
-    /// physics, and the augmented model as its next version).
+    /// physics, and the augmented model as its next version) and
+    /// `precision` (a plan and a prior → each parameter's predicted std).
     pub fn production() -> Self {
         Self::new()
             .with("identify", super::identify::Identify)
             .with("discover", super::discover::Discover)
+            .with("precision", super::precision::Precision)
     }
 
     /// Adds (or replaces) the handler of `kind`.

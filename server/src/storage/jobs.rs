@@ -64,7 +64,8 @@ impl JobState {
 #[derive(Debug, Clone, Default, Serialize, Deserialize, utoipa::ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JobRequest {
-    /// The job's kind: one of the registered handlers (`identify`, `discover`).
+    /// The job's kind: one of the registered handlers (`identify`,
+    /// `discover`, `precision`).
     #[schema(value_type = JobKind)]
     pub kind: String,
     /// The campaign the runs belong to.
@@ -75,7 +76,7 @@ pub struct JobRequest {
     pub run_ids: Vec<String>,
     /// The method, as the kind defines it. `identify`: `lambda_kf` (default
     /// for ROVs), `parallel_ekf` (default for DP vessels; DP only) or
-    /// `n4sid`; `discover` takes none.
+    /// `n4sid`; `discover` and `precision` take none.
     #[serde(default)]
     #[schema(value_type = Option<IdentifyMethod>)]
     pub method: Option<String>,
@@ -83,7 +84,8 @@ pub struct JobRequest {
     #[serde(default = "empty_object")]
     #[schema(value_type = Object)]
     pub settings: serde_json::Value,
-    /// A model to start from (discovery).
+    /// A model to start from (discovery), or the prior a plan is flown
+    /// with (precision, `settings.prior = model`).
     #[serde(default)]
     pub model_id: Option<String>,
 }
@@ -98,6 +100,10 @@ pub enum JobKind {
     Identify,
     /// Missing-physics discovery on a stored model (`model_id`).
     Discover,
+    /// Predicted precision of the campaign's current plan (settings:
+    /// `PrecisionSettings`; a prior model in `model_id`); the result is a
+    /// `PrecisionResult`.
+    Precision,
 }
 
 /// The methods of an `identify` job (documentation only; an unknown one is a 422).

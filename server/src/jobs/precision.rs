@@ -1,0 +1,237 @@
+//! The `precision` job: a campaign's current plan and a prior model →
+//! the precision each identified parameter is predicted to reach, before
+//! the runs are flown. The numerics are the core's
+//! [`seatrial_core::design`]; this file loads, calls and returns the table
+//! as the job's result (read back by `GET /api/campaigns/{id}/precision`).
+
+use seatrial_core::design::{
+    DesignError, PrecisionPrediction, PredictSettings, Prior, PriorSource, predict_precision,
+};
+use seatrial_core::estimation::Progress;
+use seatrial_core::identification::document::ModelDocument;
+use seatrial_core::planning::{Plan, PlannedExperiment};
+use serde::{Deserialize, Serialize};
+
+use super::handler::{BoxFuture, Compute, JobContext, JobFailure, JobHandler, compute};
+use super::identify::parse_settings;
+use crate::error::ApiError;
+use crate::storage::jobs::{Job, JobRequest};
+use crate::storage::{campaigns, models, plans, vessels};
+
+/// The prior a plan is flown with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, utoipa::ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum PriorChoice {
+    /// The stored model named by the job's `model_id` (its vessel's).
+    Model,
+    /// The vessel profile's limits and time constants (rough).
+    Profile,
+    /// The source documents' vessel: the thesis's Surveyor-like ROV, or the
+    /// supply vessel's identified θ″ (Fossen et al. 1995, eq. 48–49).
+    Reference,
+}
+
+/// Settings of a `precision` job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, utoipa::ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PrecisionSettings {
+    /// The prior; default: `model` when `model_id` is given, else `profile`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prior: Option<PriorChoice>,
+    /// Seed of the simulated sensor noise (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+}
+
+impl PrecisionSettings {
+    fn prior(&self, req: &JobRequest) -> PriorChoice {
+        self.prior.unwrap_or(if req.model_id.is_some() {
+            PriorChoice::Model
+        } else {
+            PriorChoice::Profile
+        })
+    }
+}
+
+/// The job's result: the prediction and the plan version it is for.
+#[derive(Debug, Clone, Serialize, Deserialize, utoipa::ToSchema)]
+pub struct PrecisionResult {
+    /// The plan predicted.
+    pub plan_id: String,
+    /// Its version.
+    pub plan_version: i64,
+    /// The table.
+    pub prediction: PrecisionPrediction,
+}
+
+/// The `precision` handler.
+pub struct Precision;
+
+struct Checked {
+    profile: seatrial_core::planning::VesselProfile,
+    settings: PrecisionSettings,
+    model: Option<(ModelDocument, PriorSource)>,
+}
+
+async fn checked(cx: &JobContext, req: &JobRequest) -> Result<Checked, ApiError> {
+    let Some(cid) = &req.campaign_id else {
+        return Err(ApiError::invalid(
+            "campaign_id",
+            "precision needs the campaign whose plan to predict",
+        ));
+    };
+    if req.method.is_some() {
+        return Err(ApiError::invalid(
+            "method",
+            "precision predicts the vessel's physical identification (lambda_kf for an ROV, parallel_ekf for a DP ship); it takes no method",
+        ));
+    }
+    if !req.run_ids.is_empty() {
+        return Err(ApiError::invalid(
+            "run_ids",
+            "precision flies the plan in simulation; it reads no runs",
+        ));
+    }
+    let settings: PrecisionSettings =
+        parse_settings(&req.settings).map_err(|(f, m)| ApiError::invalid(f, m))?;
+    let campaign = campaigns::get(&cx.db, cid)
+        .await?
+        .ok_or_else(|| ApiError::missing("campaign_id", format!("no campaign with id '{cid}'")))?;
+    let vessel = vessels::get(&cx.db, &campaign.vessel_id)
+        .await?
+        .ok_or_else(|| ApiError::missing("campaign_id", "the campaign's vessel is gone"))?;
+    if plans::latest(&cx.db, cid).await?.is_none() {
+        return Err(ApiError::invalid(
+            "campaign_id",
+            format!(
+                "campaign '{}' has no plan yet; generate one (POST /api/campaigns/{cid}/plan) first",
+                campaign.spec.name
+            ),
+        ));
+    }
+    let model = match (settings.prior(req), &req.model_id) {
+        (PriorChoice::Model, None) => {
+            return Err(ApiError::invalid(
+                "model_id",
+                "settings.prior = model needs the model to fly the plan with (model_id)",
+            ));
+        }
+        (PriorChoice::Model, Some(id)) => {
+            let m = models::get(&cx.db, id)
+                .await?
+                .ok_or_else(|| ApiError::missing("model_id", format!("no model with id '{id}'")))?;
+            if m.summary.vessel_id != vessel.id {
+                return Err(ApiError::invalid(
+                    "model_id",
+                    format!(
+                        "model '{}' v{} is of another vessel; the prior must describe '{}'",
+                        m.summary.name, m.summary.version, vessel.profile.name
+                    ),
+                ));
+            }
+            let doc: ModelDocument = serde_json::from_value(m.document)
+                .map_err(|e| ApiError::invalid("model_id", format!("model unreadable: {e}")))?;
+            Some((
+                doc,
+                PriorSource::Model {
+                    model_id: m.summary.id.clone(),
+                    version: m.summary.version,
+                },
+            ))
+        }
+        (_, Some(_)) => {
+            return Err(ApiError::invalid(
+                "model_id",
+                "a model_id is only used with settings.prior = model",
+            ));
+        }
+        (_, None) => None,
+    };
+    if let Some((doc, _)) = &model {
+        Prior::from_model(doc, &vessel.profile).map_err(design_invalid)?;
+    }
+    Ok(Checked {
+        profile: vessel.profile,
+        settings,
+        model,
+    })
+}
+
+fn design_invalid(e: DesignError) -> ApiError {
+    ApiError::invalid(e.field().to_string(), e.to_string())
+}
+
+impl JobHandler for Precision {
+    fn check<'a>(
+        &'a self,
+        cx: &'a JobContext,
+        req: &'a JobRequest,
+    ) -> BoxFuture<'a, Result<(), ApiError>> {
+        Box::pin(async move { checked(cx, req).await.map(|_| ()) })
+    }
+
+    fn load<'a>(
+        &'a self,
+        cx: &'a JobContext,
+        job: &'a Job,
+    ) -> BoxFuture<'a, Result<Compute, JobFailure>> {
+        Box::pin(async move {
+            let req = &job.request;
+            let c = checked(cx, req)
+                .await
+                .map_err(|e| JobFailure::new(e.to_string()))?;
+            let cid = req.campaign_id.clone().unwrap_or_default();
+            let stored = plans::latest(&cx.db, &cid)
+                .await?
+                .ok_or_else(|| JobFailure::field("campaign_id", "the plan was deleted"))?;
+            let mut experiments = Vec::with_capacity(stored.experiments.len());
+            let mut conn = cx.db.acquire().await?;
+            for e in &stored.experiments {
+                experiments.push(PlannedExperiment {
+                    experiment: e.experiment.clone(),
+                    schedule: plans::schedule(&mut conn, &e.id).await?,
+                });
+            }
+            drop(conn);
+            let plan = Plan {
+                experiments,
+                totals: stored.totals.clone(),
+            };
+            let choice = c.settings.prior(req);
+            let seed = c.settings.seed.unwrap_or(1);
+            let (plan_id, plan_version) = (stored.id.clone(), stored.version);
+            Ok(compute(move |progress: &mut dyn Progress| {
+                let (prior, source) = match (choice, c.model) {
+                    (PriorChoice::Model, Some((doc, source))) => {
+                        (Prior::from_model(&doc, &c.profile), source)
+                    }
+                    (PriorChoice::Reference, _) => {
+                        (Prior::reference(&c.profile), PriorSource::Reference)
+                    }
+                    _ => (Prior::from_profile(&c.profile), PriorSource::Profile),
+                };
+                let prior = prior.map_err(failure)?;
+                let settings = PredictSettings {
+                    seed,
+                    ..PredictSettings::default()
+                };
+                let prediction =
+                    predict_precision(&c.profile, &plan, &prior, source, &settings, progress)
+                        .map_err(failure)?;
+                serde_json::to_value(PrecisionResult {
+                    plan_id,
+                    plan_version,
+                    prediction,
+                })
+                .map_err(|e| JobFailure::new(e.to_string()))
+            }))
+        })
+    }
+}
+
+fn failure(e: DesignError) -> JobFailure {
+    match e {
+        DesignError::Cancelled => JobFailure::Cancelled,
+        e => JobFailure::field(e.field().to_string(), e.to_string()),
+    }
+}

@@ -1,0 +1,160 @@
+//! Predicted precision through REST: the `precision` job flies the
+//! campaign's current plan with a prior and stores the table the core
+//! computes; `GET /api/campaigns/{id}/precision` serves it and says when
+//! the plan has changed since. Requests the job cannot use are 422s naming
+//! the field. Every response is checked against openapi.yaml.
+
+mod common;
+
+use common::TestApp;
+use common::finite::assert_finite_json;
+use common::flights::planned_campaign;
+use seatrial::jobs::{JobRegistry, JobsConfig};
+use seatrial_core::design::{PredictSettings, Prior, PriorSource, predict_precision};
+use seatrial_core::estimation::NoProgress;
+use seatrial_core::planning::examples::{supply_vessel, supply_vessel_trial_campaign};
+use seatrial_core::planning::generate_plan;
+use serde_json::json;
+
+async fn app() -> TestApp {
+    TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_supply_vessels_plan_is_predicted_as_the_core_predicts_it() {
+    let app = app().await;
+    let spec = supply_vessel_trial_campaign(1995);
+    let (cid, _) = planned_campaign(
+        &app,
+        common::dp_profile(),
+        serde_json::to_value(&spec).unwrap(),
+    )
+    .await;
+
+    let none = app
+        .call("GET", "/api/campaigns/{id}/precision", &[&cid], None)
+        .await;
+    assert_eq!(none.status, 404, "{}", none.text);
+    assert!(none.text.contains("precision"), "{}", none.text);
+
+    let job = common::run_job(
+        &app,
+        json!({ "kind": "precision", "campaign_id": cid, "settings": { "prior": "reference", "seed": 4 } }),
+    )
+    .await;
+    assert_eq!(job["result"]["prediction"]["method"], "parallel_ekf");
+
+    let r = app
+        .call("GET", "/api/campaigns/{id}/precision", &[&cid], None)
+        .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_finite_json(&r.json, "precision");
+    assert_eq!(r.json["current"], true);
+    assert_eq!(r.json["plan_version"], 1);
+    assert_eq!(r.json["prediction"]["prior"]["kind"], "reference");
+
+    // The same numbers as the core on the same plan, prior and seed.
+    let profile = supply_vessel();
+    let plan = generate_plan(&profile, &spec).unwrap();
+    let core = predict_precision(
+        &profile,
+        &plan,
+        &Prior::reference(&profile).unwrap(),
+        PriorSource::Reference,
+        &PredictSettings {
+            seed: 4,
+            ..PredictSettings::default()
+        },
+        &mut NoProgress,
+    )
+    .unwrap();
+    let rows = r.json["prediction"]["parameters"].as_array().unwrap();
+    assert_eq!(rows.len(), core.parameters.len());
+    assert_eq!(r.json["prediction"]["determined"], core.determined);
+    for (row, c) in rows.iter().zip(&core.parameters) {
+        assert_eq!(row["symbol"], c.symbol.as_str());
+        let sd = row["predicted_std"].as_f64().unwrap();
+        let want = c.predicted_std.unwrap();
+        assert!(
+            (sd - want).abs() <= 1e-12 * want.abs(),
+            "{}: {sd} vs {want}",
+            c.symbol
+        );
+    }
+
+    // A re-plan that changes the plan makes the stored prediction stale.
+    let re = app
+        .call(
+            "POST",
+            "/api/campaigns/{id}/plan",
+            &[&cid],
+            Some(json!({ "durations": { "setup_s": 90 } })),
+        )
+        .await;
+    assert_eq!(re.status, 201, "{}", re.text);
+    let r = app
+        .call("GET", "/api/campaigns/{id}/precision", &[&cid], None)
+        .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_eq!(r.json["current"], false);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn unusable_precision_requests_are_422_naming_the_field() {
+    let app = app().await;
+    let spec = supply_vessel_trial_campaign(1995);
+    let (cid, _) = planned_campaign(
+        &app,
+        common::dp_profile(),
+        serde_json::to_value(&spec).unwrap(),
+    )
+    .await;
+    for (body, field) in [
+        (
+            json!({ "kind": "precision", "campaign_id": cid, "settings": { "prior": "model" } }),
+            "model_id",
+        ),
+        (
+            json!({ "kind": "precision", "campaign_id": cid, "settings": { "priors": "model" } }),
+            "settings",
+        ),
+        (
+            json!({ "kind": "precision", "campaign_id": cid, "method": "lambda_kf" }),
+            "method",
+        ),
+        (
+            json!({ "kind": "precision", "campaign_id": cid, "settings": { "seed": -1 } }),
+            "settings.seed",
+        ),
+        (json!({ "kind": "precision" }), "campaign_id"),
+    ] {
+        let r = app.call("POST", "/api/jobs", &[], Some(body.clone())).await;
+        assert_eq!(r.status, 422, "{body}: {}", r.text);
+        let got = r.json["field"].as_str().unwrap_or("");
+        assert!(got.starts_with(field), "{body}: field {got}, {}", r.text);
+    }
+    // A prior model of another vessel is refused.
+    let other = planned_campaign(
+        &app,
+        common::rov_profile(),
+        json!({ "name": "rov", "grid": { "unit": "kn", "speeds": [1.0] }, "families": ["dynamic"], "seed": 5 }),
+    )
+    .await
+    .0;
+    let c = app
+        .call("GET", "/api/campaigns/{id}", &[&other], None)
+        .await;
+    let vid = c.json["vessel_id"].as_str().unwrap().to_string();
+    let mid = common::stored_model(&app, &other, &vid, None, &[]).await;
+    let r = app
+        .call(
+            "POST",
+            "/api/jobs",
+            &[],
+            Some(json!({ "kind": "precision", "campaign_id": cid, "model_id": mid })),
+        )
+        .await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    assert_eq!(r.json["field"], "model_id");
+    assert!(r.text.contains("another vessel"), "{}", r.text);
+}
