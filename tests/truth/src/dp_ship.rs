@@ -10,9 +10,12 @@
 //!
 //! with M, T, K the paper's eq. 29, 30, 49 and D = −A_h M from eq. 48;
 //! C(ν) is Fossen's (2011, eq. 6.43–6.44 for a 3-DOF ship with the
-//! sway–yaw coupled inertia) skew-symmetric form from M. Commands are
-//! u = |p|·p (eq. 5) of pitch ratios p held at random levels, slewed at 5 %
-//! per second. Integration: RK4, 10 steps per logged sample, commands held.
+//! sway–yaw coupled inertia) skew-symmetric form from M. Commands are, by
+//! default, u = |p|·p (eq. 5) of pitch ratios p held at random levels,
+//! slewed at 5 % per second ([`DpInputs::Pitch`]); a trial may instead fly
+//! binary commands from a maximum-length shift-register sequence
+//! ([`DpInputs::Prbs`]). Integration: RK4, 10 steps per logged sample,
+//! commands held.
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -99,6 +102,52 @@ pub struct DpTrial {
     pub bias_walk: [f64; 3],
     /// Also log body velocities u, v (m/s), r (rad/s) without noise.
     pub log_velocities: bool,
+    /// How the commands are made.
+    pub inputs: DpInputs,
+    /// Validation runs at the end of the campaign (`VAL`, `VAL-2`, …).
+    pub validation_runs: usize,
+}
+
+/// The commands a trial flies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DpInputs {
+    /// Pitch ratios p held at random levels of alternating sign (|p| and
+    /// hold per manoeuvre as in Fossen et al.'s Fig. 5–7), u = |p|·p, p
+    /// slewed at 5 % per sample, quiet for the first 10 samples; every run
+    /// `samples` long.
+    Pitch,
+    /// Binary commands u = ±`level`: chip c of a maximum-length sequence
+    /// (period 2ⁿ − 1 chips, a random nonzero start state per run) held
+    /// over the samples k with ⌊k / chip_s⌋ = c, u slewed at `slew` per
+    /// sample from u = 0 at k = 0 (no quiet start). SI2's bow tunnel flies
+    /// the aft tunnels' sequence delayed by ⌊m/2⌋ of its m chips; the
+    /// validation run holds independent random signs per chip of
+    /// `validation`. Each manoeuvre has its own run length.
+    Prbs {
+        /// Command magnitude |u|.
+        level: f64,
+        /// Largest change of u per sample.
+        slew: f64,
+        /// SI1 (main propellers).
+        surge: PrbsRun,
+        /// SI2 (aft tunnels against the bow tunnel).
+        sway_yaw: PrbsRun,
+        /// SI3 (bow azimuth).
+        azimuth: PrbsRun,
+        /// Validation (chip and samples; `order` unused).
+        validation: PrbsRun,
+    },
+}
+
+/// Sequence and length of one PRBS manoeuvre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrbsRun {
+    /// Shift-register order n (3 … 10).
+    pub order: u32,
+    /// Chip length (samples, may be fractional).
+    pub chip_s: f64,
+    /// Samples per run (1 Hz).
+    pub samples: usize,
 }
 
 impl Default for DpTrial {
@@ -111,8 +160,56 @@ impl Default for DpTrial {
             bias_initial: [3e-4, 3e-4, 5e-5],
             bias_walk: [3e-6, 3e-6, 6e-7],
             log_velocities: false,
+            inputs: DpInputs::Pitch,
+            validation_runs: 1,
         }
     }
+}
+
+/// Feedback taps (bit positions, 1-based) of a primitive polynomial of
+/// each order 3 … 10 (x³+x²+1, x⁴+x³+1, x⁵+x³+1, x⁶+x⁵+1, x⁷+x⁶+1,
+/// x⁸+x⁶+x⁵+x⁴+1, x⁹+x⁵+1, x¹⁰+x⁷+1).
+fn taps(order: u32) -> &'static [u32] {
+    match order {
+        3 => &[3, 2],
+        4 => &[4, 3],
+        5 => &[5, 3],
+        6 => &[6, 5],
+        7 => &[7, 6],
+        8 => &[8, 6, 5, 4],
+        9 => &[9, 5],
+        10 => &[10, 7],
+        _ => panic!("PRBS order {order} is outside 3 … 10"),
+    }
+}
+
+/// One period (2ⁿ − 1 chips, ±1) of the maximum-length sequence of a
+/// Fibonacci shift register of order n from a random nonzero state.
+fn m_sequence(rng: &mut Rng, order: u32) -> Vec<f64> {
+    let m = (1usize << order) - 1;
+    let mut reg = 1 + rng.below(m as u64) as u32;
+    (0..m)
+        .map(|_| {
+            let out = reg & 1;
+            let fb = taps(order)
+                .iter()
+                .fold(0, |acc, &t| acc ^ ((reg >> (order - t)) & 1));
+            reg = (reg >> 1) | (fb << (order - 1));
+            if out == 1 { 1.0 } else { -1.0 }
+        })
+        .collect()
+}
+
+/// Commands u (n samples) holding `chips[c]`·level over chip c, slewed.
+fn binary(chips: &[f64], chip_s: f64, n: usize, level: f64, slew: f64) -> Vec<f64> {
+    let mut u = 0.0_f64;
+    (0..n)
+        .map(|k| {
+            let c = ((k as f64 + 1e-9) / chip_s).floor() as usize % chips.len();
+            u += (level * chips[c] - u).clamp(-slew, slew);
+            u
+        })
+        .collect()
 }
 
 fn mat(a: &[[f64; 3]; 3]) -> Matrix3<f64> {
@@ -173,8 +270,45 @@ fn pitch(rng: &mut Rng, n: usize, hold: (f64, f64), level: (f64, f64)) -> Vec<f6
         .collect()
 }
 
+/// Samples of a run of `kind`.
+fn run_samples(kind: DpManoeuvre, trial: &DpTrial) -> usize {
+    match trial.inputs {
+        DpInputs::Pitch => trial.samples,
+        DpInputs::Prbs {
+            surge,
+            sway_yaw,
+            azimuth,
+            validation,
+            ..
+        } => match kind {
+            DpManoeuvre::Surge => surge.samples,
+            DpManoeuvre::SwayYaw => sway_yaw.samples,
+            DpManoeuvre::Azimuth => azimuth.samples,
+            DpManoeuvre::Validation => validation.samples,
+        },
+    }
+}
+
 /// Commands (n × 6) of a manoeuvre.
-fn commands(kind: DpManoeuvre, n: usize, rng: &mut Rng) -> Vec<[f64; 6]> {
+fn commands(kind: DpManoeuvre, n: usize, inputs: &DpInputs, rng: &mut Rng) -> Vec<[f64; 6]> {
+    if let DpInputs::Prbs {
+        level,
+        slew,
+        surge,
+        sway_yaw,
+        azimuth,
+        validation,
+    } = *inputs
+    {
+        return prbs_commands(
+            kind,
+            n,
+            level,
+            slew,
+            [surge, sway_yaw, azimuth, validation],
+            rng,
+        );
+    }
     let mut u = vec![[0.0; 6]; n];
     let mut set = |cols: &[usize], p: Vec<f64>| {
         for (row, pk) in u.iter_mut().zip(p) {
@@ -200,6 +334,52 @@ fn commands(kind: DpManoeuvre, n: usize, rng: &mut Rng) -> Vec<[f64; 6]> {
     u
 }
 
+/// Binary commands (n × 6) of a manoeuvre ([`DpInputs::Prbs`]); `runs` is
+/// SI1, SI2, SI3, validation.
+fn prbs_commands(
+    kind: DpManoeuvre,
+    n: usize,
+    level: f64,
+    slew: f64,
+    runs: [PrbsRun; 4],
+    rng: &mut Rng,
+) -> Vec<[f64; 6]> {
+    let mut u = vec![[0.0; 6]; n];
+    let mut set = |cols: &[usize], p: Vec<f64>| {
+        for (row, pk) in u.iter_mut().zip(p) {
+            for &c in cols {
+                row[c] = pk;
+            }
+        }
+    };
+    let [surge, sway_yaw, azimuth, validation] = runs;
+    match kind {
+        DpManoeuvre::Surge => {
+            let s = m_sequence(rng, surge.order);
+            set(&[0, 1], binary(&s, surge.chip_s, n, level, slew));
+        }
+        DpManoeuvre::SwayYaw => {
+            let s = m_sequence(rng, sway_yaw.order);
+            let mut bow = s.clone();
+            bow.rotate_left(s.len() / 2);
+            set(&[2, 3], binary(&s, sway_yaw.chip_s, n, level, slew));
+            set(&[4], binary(&bow, sway_yaw.chip_s, n, level, slew));
+        }
+        DpManoeuvre::Azimuth => {
+            let s = m_sequence(rng, azimuth.order);
+            set(&[5], binary(&s, azimuth.chip_s, n, level, slew));
+        }
+        DpManoeuvre::Validation => {
+            let chips = (n as f64 / validation.chip_s).ceil() as usize + 1;
+            for cols in [&[0, 1][..], &[2, 3], &[4], &[5]] {
+                let s: Vec<f64> = (0..chips).map(|_| rng.sign()).collect();
+                set(cols, binary(&s, validation.chip_s, n, level, slew));
+            }
+        }
+    }
+    u
+}
+
 /// Flies one run and writes its log.
 fn fly(kind: DpManoeuvre, name: String, trial: &DpTrial, seed: u64) -> DpLog {
     let mut rng = Rng::new(seed);
@@ -210,8 +390,8 @@ fn fly(kind: DpManoeuvre, name: String, trial: &DpTrial, seed: u64) -> DpLog {
     let h = 1.0 / time_unit; // 1 s in Bis time
     let steps = 10;
     let dt = h / steps as f64;
-    let n = trial.samples;
-    let u = commands(kind, n, &mut rng);
+    let n = run_samples(kind, trial);
+    let u = commands(kind, n, &trial.inputs, &mut rng);
     let mut b: [f64; 3] = std::array::from_fn(|i| trial.bias_initial[i] * rng.normal());
     let heading0 = rng.range(-std::f64::consts::PI, std::f64::consts::PI);
     let mut s = [0.0, 0.0, 0.0, 0.0, 0.0, heading0];
@@ -269,7 +449,7 @@ fn fly(kind: DpManoeuvre, name: String, trial: &DpTrial, seed: u64) -> DpLog {
 }
 
 /// The campaign of seed `seed`: `repetitions` runs of SI1, SI2, SI3 each,
-/// then one validation run with every thruster.
+/// then `validation_runs` validation runs with every thruster.
 pub fn fly_dp_campaign(trial: &DpTrial, seed: u64) -> Vec<DpLog> {
     let mut out = Vec::new();
     let mut tag = 0;
@@ -288,12 +468,19 @@ pub fn fly_dp_campaign(trial: &DpTrial, seed: u64) -> Vec<DpLog> {
             ));
         }
     }
-    out.push(fly(
-        DpManoeuvre::Validation,
-        "VAL".into(),
-        trial,
-        derive_seed(seed, 1000),
-    ));
+    for r in 1..=trial.validation_runs {
+        let name = if r == 1 {
+            "VAL".to_string()
+        } else {
+            format!("VAL-{r}")
+        };
+        out.push(fly(
+            DpManoeuvre::Validation,
+            name,
+            trial,
+            derive_seed(seed, 999 + r as u64),
+        ));
+    }
     out
 }
 
@@ -337,5 +524,64 @@ mod tests {
         assert!(first.starts_with("t,thr_1,thr_2,thr_3,thr_4,thr_5,thr_6,x,y,psi\n"));
         assert_eq!(first.lines().count(), 601);
         assert_eq!(logs[6].manoeuvre.family(), "validation");
+    }
+
+    /// Every order's register runs through all 2ⁿ − 1 nonzero states: the
+    /// sequence is balanced (one more +1 than −1) and has 2ⁿ⁻¹ runs.
+    #[test]
+    fn shift_register_sequences_are_maximum_length() {
+        let mut rng = Rng::new(3);
+        for order in 3..=10 {
+            let s = m_sequence(&mut rng, order);
+            let m = (1usize << order) - 1;
+            assert_eq!(s.len(), m);
+            assert_eq!(s.iter().sum::<f64>(), 1.0, "order {order}");
+            let runs = (0..m).filter(|&i| s[i] != s[(i + m - 1) % m]).count();
+            assert_eq!(runs, 1 << (order - 1), "order {order}");
+        }
+    }
+
+    #[test]
+    fn prbs_campaign_flies_binary_slewed_commands() {
+        let run = |order, chip_s, samples| PrbsRun {
+            order,
+            chip_s,
+            samples,
+        };
+        let trial = DpTrial {
+            inputs: DpInputs::Prbs {
+                level: 0.5,
+                slew: 0.1,
+                surge: run(3, 87.6, 613),
+                sway_yaw: run(5, 20.0, 620),
+                azimuth: run(5, 20.0, 620),
+                validation: run(0, 20.0, 600),
+            },
+            validation_runs: 2,
+            ..DpTrial::default()
+        };
+        let logs = fly_dp_campaign(&trial, 4);
+        assert_eq!(logs.len(), 8);
+        assert_eq!(logs[7].name, "VAL-2");
+        let col = |log: &DpLog, c: usize| -> Vec<f64> {
+            log.csv
+                .lines()
+                .skip(1)
+                .map(|l| l.split(',').nth(c).unwrap().parse().unwrap())
+                .collect()
+        };
+        assert_eq!(col(&logs[0], 1).len(), 613);
+        let stern = col(&logs[2], 3);
+        let bow = col(&logs[2], 5);
+        assert_eq!(stern.len(), 620);
+        assert!((stern[0].abs() - 0.1).abs() < 1e-9);
+        assert!(stern.iter().all(|u| u.abs() <= 0.5 + 1e-9));
+        assert!(stern.windows(2).all(|w| (w[1] - w[0]).abs() <= 0.1 + 1e-9));
+        // 31 chips of 20 s: 16 holds, each a whole number of chips.
+        let held: Vec<f64> = stern.iter().copied().filter(|u| u.abs() > 0.25).collect();
+        let flips = held.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
+        assert!((14..=16).contains(&flips), "{flips}");
+        assert_ne!(stern, bow);
+        assert!(col(&logs[4], 1).iter().all(|&u| u == 0.0));
     }
 }
