@@ -102,6 +102,8 @@ export const api = {
   // Every channel of a run over a window (`query`: from_s, to_s, points), with the window's statistics.
   runTraces: (rid, query) => request('GET', `/api/runs/${enc(rid)}/traces${query ? `?${query}` : ''}`),
   coverage: (id) => request('GET', `/api/campaigns/${enc(id)}/coverage`),
+  // The newest predicted precision of the campaign's plan (404 before the first `precision` job).
+  precision: (id) => request('GET', `/api/campaigns/${enc(id)}/precision`),
   // Clock offsets of two-file runs (s; null clears the one set by hand).
   campaignClockOffset: (id) => request('GET', `/api/campaigns/${enc(id)}/clock-offset`),
   setCampaignClockOffset: (id, s) => request('PUT', `/api/campaigns/${enc(id)}/clock-offset`, { clock_offset_s: s }),

@@ -14,6 +14,7 @@ export const METHOD_LABEL = {
   parallel_ekf: 'Parallel EKF (DP ship)',
   discovery: 'Missing-physics discovery',
   discover: 'Missing-physics discovery',
+  precision: 'Predicted precision',
 };
 /** What each method fits, shown under the method selector. */
 export const METHOD_HELP = {

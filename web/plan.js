@@ -7,6 +7,7 @@ import { deletedSection } from './trash.js';
 import { campaignTrash } from './parenttrash.js';
 import { deletedBadge } from './manage.js';
 import { sectionNav } from './sectionnav.js';
+import { precisionSection } from './precision.js';
 import {
   FAMILY_LABEL, KIND_LABEL, SIGNAL_LABEL, bandText, describeWaveform, fmt, fmtDate, fmtKn, hms,
   peText, secs, unitLabel,
@@ -114,6 +115,8 @@ export async function campaignPage(view, id) {
   const trash = deletedSection(id, () => reloadPage());
   const runsHost = h('section', { class: 'runs', 'aria-label': 'Runs', 'data-testid': 'runs-section' });
   const identifyHost = h('section', { class: 'identification', 'aria-label': 'Identification', 'data-testid': 'identify-section' });
+  const precisionHost = h('section', { class: 'precision', 'aria-label': 'Predicted precision', 'data-testid': 'precision-section' });
+  let precision = null; // the Predicted precision section's controller
   let runs = null; // the Runs section's controller
   let ident = null; // the Identification section's controller
 
@@ -137,10 +140,11 @@ export async function campaignPage(view, id) {
       h('dt', null, 'Excitation'), h('dd', null, excitationText(c)),
       h('dt', null, 'Durations'), h('dd', null, DURATIONS.filter((d) => durs[d.key] != null).map((d) => `${d.label.toLowerCase()} ${fmt(durs[d.key])} s`).join(' · ') || 'defaults'),
       h('dt', null, 'Seed'), h('dd', { class: 'mono' }, c.seed ?? 'default')),
-    sectionNav([['runs', 'Runs'], ['coverage', 'Coverage'], ['jobs', 'Jobs'], ['models', 'Models'], ['plan', 'Plan'], ['deleted', 'Deleted']]),
+    sectionNav([['runs', 'Runs'], ['coverage', 'Coverage'], ['jobs', 'Jobs'], ['models', 'Models'], ['precision', 'Precision'], ['plan', 'Plan'], ['deleted', 'Deleted']]),
     runsHost,
     campaignOffsetPanel(c.id),
     identifyHost,
+    precisionHost,
     planTitle,
     planHost,
     trash.host);
@@ -161,6 +165,7 @@ export async function campaignPage(view, id) {
       renderPlan();
       if (runs) await runs.setPlan(plan);
       if (ident) ident.setPlan(plan);
+      if (precision) precision.setPlan(plan);
     } catch (err) {
       banner(`${err.status ? `${err.status} · ` : ''}${err.message}${err.field ? ` [${err.field}]` : ''}`);
     } finally {
@@ -367,6 +372,12 @@ export async function campaignPage(view, id) {
     fill(identifyHost, h('h2', { class: 'section-title' }, 'Identification'),
       h('p', { class: 'error-text', role: 'alert', 'data-testid': 'identify-load-error' }, `Could not load jobs and models: ${err.status ? `${err.status} · ` : ''}${err.message}`));
   }
+  try {
+    precision = await precisionSection(precisionHost, { campaign, plan });
+  } catch (err) {
+    fill(precisionHost, h('h2', { class: 'section-title' }, 'Predicted precision'),
+      h('p', { class: 'error-text', role: 'alert' }, `Could not load the prediction: ${err.status ? `${err.status} · ` : ''}${err.message}`));
+  }
 
   return {
     key: `campaign:${id}`,
@@ -375,6 +386,7 @@ export async function campaignPage(view, id) {
       destroyPlots();
       runs.destroy();
       if (ident) ident.destroy();
+      if (precision) precision.destroy();
     },
   };
 }
