@@ -2,15 +2,18 @@
 //! parameter of the identification, predicted before the ship leaves port.
 //!
 //! The prediction flies the plan with a prior model through the project's
-//! own simulators (`simulation::trials` for ROVs, `simulation::dp_ship` for
-//! DP ships), logs it with the stated sensor noise, and identifies the
-//! simulated campaign with the method the campaign will use. The standard
-//! deviations the identification then reports are the prediction: for the
-//! λ-filter method the posterior of its linear regression (the inverse
-//! Fisher information of the λ parameters, carried to M, D̄ by the delta
-//! method; g(η) pooled over the grid), for the parallel EKF the
-//! prediction-error refinement's Cramér–Rao bound √diag J⁻¹ with J the
-//! Fisher information of the Kalman predictor's innovations.
+//! own simulators (`simulation::trials` for ROVs, its controller reading
+//! the noisy sensors; `simulation::dp_ship` for DP ships) over several
+//! noise realisations, logs each with the stated sensor noise, and
+//! identifies each as the campaign will be identified. The spread of the
+//! estimates is the predicted std: the precision the plan buys against the
+//! noise — for the parallel EKF it agrees with the Cramér–Rao bound √diag J⁻¹
+//! of the refinement's Fisher information, for the λ-filter method with the
+//! λ regression's posterior only where the model's structure fits the
+//! prior. Beside it stands the std the identification will *report* (the
+//! median over the realisations), which also carries the structure's misfit:
+//! a parameter whose reported std is several times its spread is limited by
+//! the model, not by the ship time.
 //!
 //! A parameter counts as *determined* when its predicted relative std is at
 //! most [`DETERMINED_RELATIVE_STD`]. The relative std of a matrix entry
@@ -23,7 +26,7 @@ mod predict;
 mod prior;
 mod table;
 
-pub use predict::{PredictSettings, predict_precision};
+pub use predict::{MAX_REALISATIONS, PredictSettings, predict_precision};
 pub use prior::{Prior, PriorSource};
 pub use table::{ParameterPrecision, PrecisionPrediction};
 
@@ -31,6 +34,10 @@ use std::fmt;
 
 /// Largest predicted relative std at which a parameter counts as determined.
 pub const DETERMINED_RELATIVE_STD: f64 = 0.1;
+
+/// Reported std over predicted std beyond which a parameter counts as
+/// limited by the model's structure rather than by the noise.
+pub const STRUCTURE_LIMITED: f64 = 3.0;
 
 /// Parameters named as weakest in a prediction.
 pub const WEAKEST_SHOWN: usize = 5;

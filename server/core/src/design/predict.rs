@@ -5,8 +5,8 @@ use std::collections::HashMap;
 
 use super::table::Scaled;
 use super::{DesignError, PrecisionPrediction, Prior, PriorSource};
-use crate::estimation::{Progress, SubProgress};
-use crate::identification::document::ParameterRow;
+use crate::estimation::{NoProgress, Progress};
+use crate::identification::document::{ModelDocument, ParameterRow};
 use crate::identification::{
     EkfCampaignSettings, IdentifyError, LambdaCampaignSettings, RunInput, identify_ekf_campaign,
     identify_lambda_campaign,
@@ -14,34 +14,136 @@ use crate::identification::{
 use crate::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
 use crate::planning::dof::Dof;
 use crate::planning::{Plan, PlannedExperiment, VesselProfile};
+use crate::rng::mix;
 use crate::simulation::dp_ship::{DpFlightSettings, fly_dp_campaign};
-use crate::simulation::trials::{MeasurementNoise, TrialSettings, fly_campaign};
+use crate::simulation::trials::{Feedback, MeasurementNoise, TrialSettings, fly_campaign};
 
 /// How to fly the plan for a prediction.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PredictSettings {
-    /// Seed of the simulated sensor noise.
+    /// Seed of the simulated sensor noise (realisation r uses mix(seed ⊕ r)).
     pub seed: u64,
+    /// Noise realisations flown and identified: the predicted std is their
+    /// spread (its own relative error ≈ 1/√(2(n − 1)): 16 % at 20). One
+    /// realisation gives the identification's reported std instead.
+    pub realisations: usize,
     /// ROV navigation noise (DVL, gyros, USBL, depth, attitude).
     pub rov_noise: MeasurementNoise,
+    /// What the ROV's controller feeds back (the sensors, as at sea).
+    pub rov_feedback: Feedback,
     /// DP position/heading noise and bias (the supply vessel's trials by
-    /// default); its seed is replaced by `seed`.
+    /// default); its seed is replaced per realisation.
     pub dp_flight: DpFlightSettings,
 }
+
+/// Most noise realisations of one prediction.
+pub const MAX_REALISATIONS: usize = 100;
 
 impl Default for PredictSettings {
     fn default() -> Self {
         PredictSettings {
             seed: 1,
+            realisations: 20,
             rov_noise: MeasurementNoise::default(),
+            rov_feedback: Feedback::Measured,
             dp_flight: DpFlightSettings::supply_vessel(1),
         }
     }
 }
 
+/// One realisation: the plan flown with one noise seed and identified.
+struct Realisation {
+    runs: usize,
+    doc: ModelDocument,
+}
+
+/// Flies `plan` with `prior` under noise seed `seed` and identifies it.
+fn realise(
+    profile: &VesselProfile,
+    plan: &Plan,
+    prior: &Prior,
+    settings: &PredictSettings,
+    seed: u64,
+    progress: &mut dyn Progress,
+) -> Result<Realisation, DesignError> {
+    let flown: Vec<(&PlannedExperiment, String)> = match prior {
+        Prior::Rov(truth) => {
+            let s = TrialSettings {
+                noise: settings.rov_noise,
+                seed,
+                feedback: settings.rov_feedback,
+                ..TrialSettings::default()
+            };
+            let runs = fly_campaign(profile, truth, plan, &s, |_| true).map_err(trial_error)?;
+            pair(plan, runs.into_iter().map(|r| (r.seq, r.csv)))?
+        }
+        Prior::Dp(ship) => {
+            let s = DpFlightSettings {
+                seed,
+                ..settings.dp_flight.clone()
+            };
+            let runs = fly_dp_campaign(profile, ship, plan, &s, |_| true).map_err(trial_error)?;
+            pair(plan, runs.into_iter().map(|r| (r.seq, r.csv)))?
+        }
+    };
+    let runs = flown
+        .iter()
+        .map(|(p, csv)| run_input(profile, p, csv))
+        .collect::<Result<Vec<_>, _>>()?;
+    let inputs = input_columns(profile);
+    let identified = match prior {
+        Prior::Rov(_) => identify_lambda_campaign(
+            profile,
+            &grid_speeds(plan),
+            &inputs,
+            &runs,
+            &LambdaCampaignSettings::default(),
+            progress,
+        ),
+        Prior::Dp(_) => identify_ekf_campaign(
+            profile,
+            &inputs,
+            &runs,
+            &EkfCampaignSettings::default(),
+            progress,
+        ),
+    }
+    .map_err(identify_error)?;
+    Ok(Realisation {
+        runs: runs.len(),
+        doc: identified.document,
+    })
+}
+
+/// Every parameter row of a document: the model's and g(η)'s.
+fn rows(doc: &ModelDocument) -> Vec<ParameterRow> {
+    let mut rows = doc.parameters.clone();
+    if let Some(r) = &doc.restoring {
+        for p in &r.parameters {
+            if !rows
+                .iter()
+                .any(|q| q.symbol == p.symbol && q.group == p.group)
+            {
+                rows.push(p.clone());
+            }
+        }
+    }
+    rows
+}
+
+fn key(r: &ParameterRow) -> (String, String, Option<u64>) {
+    (
+        r.group.clone(),
+        r.symbol.clone(),
+        r.grid_speed_mps.map(f64::to_bits),
+    )
+}
+
 /// Predicts how precisely `plan` determines each parameter of the
 /// identification the vessel gets (λ-filter for ROVs, the parallel EKF
-/// with refinement for DP ships), with `prior` as the vessel.
+/// with refinement for DP ships), with `prior` as the vessel: the spread of
+/// the estimates over `settings.realisations` noise realisations of the
+/// plan, and the std the identification will report.
 pub fn predict_precision(
     profile: &VesselProfile,
     plan: &Plan,
@@ -50,99 +152,133 @@ pub fn predict_precision(
     settings: &PredictSettings,
     progress: &mut dyn Progress,
 ) -> Result<PrecisionPrediction, DesignError> {
-    progress
-        .update(0.0, "flying the plan with the prior")
-        .map_err(|_| cancelled())?;
-    let flown: Vec<(&PlannedExperiment, String)> = match prior {
-        Prior::Rov(truth) => {
-            let s = TrialSettings {
-                noise: settings.rov_noise,
-                seed: settings.seed,
-                ..TrialSettings::default()
-            };
-            let runs = fly_campaign(profile, truth, plan, &s, |_| true).map_err(trial_error)?;
-            pair(plan, runs.into_iter().map(|r| (r.seq, r.csv)))?
-        }
-        Prior::Dp(ship) => {
-            let s = DpFlightSettings {
-                seed: settings.seed,
-                ..settings.dp_flight.clone()
-            };
-            let runs = fly_dp_campaign(profile, ship, plan, &s, |_| true).map_err(trial_error)?;
-            pair(plan, runs.into_iter().map(|r| (r.seq, r.csv)))?
-        }
-    };
-    progress
-        .update(0.15, "reading the simulated logs")
-        .map_err(|_| cancelled())?;
-    let runs = flown
-        .iter()
-        .map(|(p, csv)| run_input(profile, p, csv))
-        .collect::<Result<Vec<_>, _>>()?;
-    let inputs = input_columns(profile);
-    let ship_hours = plan.totals.total_time_s / 3600.0;
-    let mut sub = SubProgress::new(progress, 0.2, 0.98);
-    let (method, identified) = match prior {
-        Prior::Rov(_) => {
-            let grid = grid_speeds(plan);
-            let id = identify_lambda_campaign(
-                profile,
-                &grid,
-                &inputs,
-                &runs,
-                &LambdaCampaignSettings::default(),
-                &mut sub,
-            )
-            .map_err(identify_error)?;
-            ("lambda_kf", id)
-        }
-        Prior::Dp(_) => {
-            let id = identify_ekf_campaign(
-                profile,
-                &inputs,
-                &runs,
-                &EkfCampaignSettings::default(),
-                &mut sub,
-            )
-            .map_err(identify_error)?;
-            ("parallel_ekf", id)
-        }
-    };
-    let doc = &identified.document;
-    let mut rows: Vec<&ParameterRow> = doc.parameters.iter().collect();
-    if let Some(r) = &doc.restoring {
-        for p in &r.parameters {
-            if !rows
-                .iter()
-                .any(|q| q.symbol == p.symbol && q.group == p.group)
-            {
-                rows.push(p);
+    let n = settings.realisations;
+    if n == 0 || n > MAX_REALISATIONS {
+        return Err(DesignError::new(
+            "settings.realisations",
+            format!("must be between 1 and {MAX_REALISATIONS} (got {n})"),
+        ));
+    }
+    let seeds: Vec<u64> = (0..n as u64)
+        .map(|r| {
+            if r == 0 {
+                settings.seed
+            } else {
+                mix(settings.seed ^ mix(r))
             }
+        })
+        .collect();
+    // Realisations are independent: two at a time on scoped threads, the
+    // progress reported between pairs.
+    let mut done: Vec<Realisation> = Vec::with_capacity(n);
+    for (b, batch) in seeds.chunks(2).enumerate() {
+        progress
+            .update(
+                (2 * b) as f64 / n as f64,
+                &format!(
+                    "flying and identifying noise realisation {} of {n}",
+                    2 * b + 1
+                ),
+            )
+            .map_err(|_| cancelled())?;
+        let out: Vec<Result<Realisation, DesignError>> = std::thread::scope(|s| {
+            let handles: Vec<_> = batch
+                .iter()
+                .map(|&seed| {
+                    s.spawn(move || realise(profile, plan, prior, settings, seed, &mut NoProgress))
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| {
+                    h.join()
+                        .unwrap_or_else(|_| Err(DesignError::new("plan", "a realisation panicked")))
+                })
+                .collect()
+        });
+        for r in out {
+            done.push(r?);
         }
     }
-    let scaled = scale_rows(profile, &rows);
-    let mut notes = vec![
-        match prior {
-            Prior::Rov(_) => format!(
-                "the plan's {} experiments flown by the project's ROV simulator with the prior, logged with DVL ±{} m/s, gyro ±{} rad/s, attitude ±{} rad noise (seed {}), and identified by the λ-filter method with its default settings; a std is the posterior of the λ regression (inverse Fisher information), carried to M and D̄ by the delta method",
-                runs.len(),
+    progress
+        .update(0.99, "tabulating")
+        .map_err(|_| cancelled())?;
+    let first = rows(&done[0].doc);
+    let per: Vec<HashMap<_, ParameterRow>> = done
+        .iter()
+        .map(|r| rows(&r.doc).into_iter().map(|p| (key(&p), p)).collect())
+        .collect();
+    // Per parameter: mean value, spread over realisations, median reported std.
+    let mut reported_median = Vec::with_capacity(first.len());
+    let table: Vec<ParameterRow> = first
+        .iter()
+        .map(|p| {
+            let k = key(p);
+            let vals: Vec<f64> = per
+                .iter()
+                .filter_map(|m| m.get(&k).map(|q| q.value))
+                .filter(|v| v.is_finite())
+                .collect();
+            let mut reported: Vec<f64> = per
+                .iter()
+                .filter_map(|m| m.get(&k).and_then(|q| q.std))
+                .filter(|v| v.is_finite())
+                .collect();
+            reported.sort_by(f64::total_cmp);
+            let median = reported.get(reported.len() / 2).copied();
+            reported_median.push(median);
+            let mean = vals.iter().sum::<f64>() / vals.len().max(1) as f64;
+            let spread = (vals.len() > 1).then(|| {
+                (vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (vals.len() - 1) as f64)
+                    .sqrt()
+            });
+            ParameterRow {
+                value: if vals.is_empty() { p.value } else { mean },
+                std: if n > 1 { spread } else { median },
+                ..p.clone()
+            }
+        })
+        .collect();
+    let refs: Vec<&ParameterRow> = table.iter().collect();
+    let mut scaled = scale_rows(profile, &refs);
+    for (s, r) in scaled.iter_mut().zip(reported_median) {
+        s.reported_std = r;
+    }
+    let doc = &done[0].doc;
+    let runs = done[0].runs;
+    let (method, how) = match prior {
+        Prior::Rov(_) => (
+            "lambda_kf",
+            format!(
+                "the plan's {runs} experiments flown {n} times by the project's ROV simulator with the prior, its controller reading sensors with DVL ±{} m/s, gyro ±{} rad/s, attitude ±{} rad noise (seeds from {}), and each flight identified by the λ-filter method with its default settings",
                 settings.rov_noise.nu[0],
                 settings.rov_noise.nu[3],
                 settings.rov_noise.eta[3],
                 settings.seed
             ),
-            Prior::Dp(_) => format!(
-                "the plan's {} experiments flown by the project's DP ship simulator with the prior, logged with ±{} m position and ±{:.2}° heading noise and a slowly varying bias (seed {}), and identified by the staged parallel EKF with refinement; a std is the Cramér–Rao bound √diag J⁻¹ of the refinement's Fisher information",
-                runs.len(),
-                settings.dp_flight.trial.position_noise_std * profile
-                    .dp_prior
-                    .as_ref()
-                    .map_or(1.0, |p| p.length_m),
+        ),
+        Prior::Dp(_) => (
+            "parallel_ekf",
+            format!(
+                "the plan's {runs} experiments flown {n} times by the project's DP ship simulator with the prior, logged with ±{} m position and ±{:.2}° heading noise and a slowly varying bias (seeds from {}), and each flight identified by the staged parallel EKF with refinement",
+                settings.dp_flight.trial.position_noise_std
+                    * profile.dp_prior.as_ref().map_or(1.0, |p| p.length_m),
                 settings.dp_flight.trial.heading_noise_std.to_degrees(),
                 settings.seed
             ),
+        ),
+    };
+    let mut notes = vec![
+        how,
+        if n > 1 {
+            format!(
+                "predicted std: the spread of the {n} estimates (itself uncertain by about {:.0} %); reported std: the median of what the identification reported on them, which also carries the misfit of the model's structure — where it is much larger than the spread, more ship time will not help, a richer model would",
+                100.0 / (2.0 * (n as f64 - 1.0)).sqrt()
+            )
+        } else {
+            "one realisation: the predicted std is the std the identification reported on it".into()
         },
-        "a std assumes the prior is the vessel and the noise is as stated; real runs with waves, current or a mis-logged τ do worse".into(),
+        "a std assumes the prior is the vessel and the noise is as stated; waves, current or a mis-logged τ do worse".into(),
     ];
     notes.extend(
         doc.structure_findings
@@ -152,8 +288,9 @@ pub fn predict_precision(
     Ok(PrecisionPrediction::tabulate(
         method,
         source,
-        ship_hours,
-        runs.len(),
+        plan.totals.total_time_s / 3600.0,
+        runs,
+        n,
         &scaled,
         notes,
     ))
@@ -267,7 +404,11 @@ fn scale_rows<'a>(profile: &VesselProfile, rows: &[&'a ParameterRow]) -> Vec<Sca
                 }
                 _ => own(r.value),
             };
-            Scaled { row: r, reference }
+            Scaled {
+                row: r,
+                reference,
+                reported_std: None,
+            }
         })
         .collect()
 }

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{DETERMINED_RELATIVE_STD, PriorSource, WEAKEST_SHOWN};
+use super::{DETERMINED_RELATIVE_STD, PriorSource, STRUCTURE_LIMITED, WEAKEST_SHOWN};
 use crate::identification::document::ParameterRow;
 
 /// One parameter's predicted precision.
@@ -22,10 +22,20 @@ pub struct ParameterPrecision {
     pub unit: String,
     /// The value the identification returns on the plan flown by the prior.
     pub expected_value: f64,
-    /// Predicted standard deviation; none when the identification could not
-    /// give one (the parameter is then not determined).
+    /// Predicted standard deviation: the spread of the estimates over the
+    /// noise realisations; none when it could not be had (the parameter is
+    /// then not determined).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub predicted_std: Option<f64>,
+    /// The std the identification will report (median over the
+    /// realisations): the noise's share and the misfit of the model's
+    /// structure to the prior.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reported_std: Option<f64>,
+    /// The reported std is more than [`STRUCTURE_LIMITED`] times the
+    /// predicted one: the model's structure, not the noise, limits this
+    /// parameter, and more runs of this plan will not sharpen it.
+    pub structure_limited: bool,
     /// Predicted std relative to `reference` (see the module docs).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub relative_std: Option<f64>,
@@ -47,6 +57,8 @@ pub struct PrecisionPrediction {
     pub ship_hours: f64,
     /// Experiments flown in the prediction.
     pub runs: usize,
+    /// Noise realisations of the plan flown and identified.
+    pub realisations: usize,
     /// Every identified parameter.
     pub parameters: Vec<ParameterPrecision>,
     /// Parameters predicted to be determined (relative std ≤ 10 %).
@@ -70,6 +82,8 @@ pub struct PrecisionPrediction {
 /// A row with the magnitude its std is compared with.
 pub(crate) struct Scaled<'a> {
     pub row: &'a ParameterRow,
+    /// What the identification reports for it (median over realisations).
+    pub reported_std: Option<f64>,
     /// Reference magnitude (> 0) and its description.
     pub reference: Option<(f64, String)>,
 }
@@ -81,6 +95,7 @@ impl PrecisionPrediction {
         prior: PriorSource,
         ship_hours: f64,
         runs: usize,
+        realisations: usize,
         rows: &[Scaled<'_>],
         notes: Vec<String>,
     ) -> Self {
@@ -102,6 +117,8 @@ impl PrecisionPrediction {
                     unit: s.row.unit.clone(),
                     expected_value: finite_or_zero(s.row.value),
                     predicted_std: std,
+                    reported_std: s.reported_std.filter(|v| v.is_finite()),
+                    structure_limited: matches!((std, s.reported_std), (Some(p), Some(r)) if r > STRUCTURE_LIMITED * p),
                     relative_std,
                     relative_to,
                     determined: relative_std.is_some_and(|r| r <= DETERMINED_RELATIVE_STD),
@@ -126,6 +143,7 @@ impl PrecisionPrediction {
             prior,
             ship_hours,
             runs,
+            realisations,
             determined: parameters.iter().filter(|p| p.determined).count(),
             total: parameters.len(),
             parameters,
@@ -147,9 +165,17 @@ fn describe(p: &ParameterPrecision) -> String {
         .grid_speed_mps
         .map(|u| format!(" at {u:.2} m/s"))
         .unwrap_or_default();
+    let limited = match (p.structure_limited, p.reported_std) {
+        (true, Some(r)) => format!(
+            "; limited by the model's structure: reported ±{} {}",
+            crate::numbers::sig3(r),
+            p.unit
+        ),
+        _ => String::new(),
+    };
     match (p.predicted_std, p.relative_std) {
         (Some(sd), Some(r)) => format!(
-            "{}{at}: ±{} {} ({:.0} % of {})",
+            "{}{at}: ±{} {} ({:.0} % of {}){limited}",
             p.symbol,
             crate::numbers::sig3(sd),
             p.unit,

@@ -31,9 +31,15 @@ fn rov_prediction(repetitions: Option<u32>) -> PrecisionPrediction {
 fn rov_prediction_is_finite_and_names_the_weakest() {
     let p = rov_prediction(None);
     eprintln!(
-        "{} of {} determined, {:.1} h; weakest {:#?}",
-        p.determined, p.total, p.ship_hours, p.weakest
+        "{} of {} determined, {} limited by structure, {:.1} h; weakest {:#?}",
+        p.determined,
+        p.total,
+        p.parameters.iter().filter(|r| r.structure_limited).count(),
+        p.ship_hours,
+        p.weakest
     );
+    assert_eq!(p.realisations, 20);
+    assert!(p.parameters.iter().all(|r| r.reported_std.is_some()));
     assert_eq!(p.method, "lambda_kf");
     assert!(p.total > 100, "{} parameters", p.total);
     for r in &p.parameters {
@@ -68,12 +74,17 @@ fn dp_prediction(repetitions: u32) -> PrecisionPrediction {
     spec.repetitions = Some(repetitions);
     let plan = generate_plan(&profile, &spec).unwrap();
     let prior = Prior::reference(&profile).unwrap();
+    // One realisation: the refinement's Cramér–Rao std, free of the spread
+    // estimate's own sampling error.
     predict_precision(
         &profile,
         &plan,
         &prior,
         PriorSource::Reference,
-        &PredictSettings::default(),
+        &PredictSettings {
+            realisations: 1,
+            ..PredictSettings::default()
+        },
         &mut NoProgress,
     )
     .unwrap()

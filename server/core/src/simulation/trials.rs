@@ -21,9 +21,11 @@
 //! [`super::dp_ship::fly`].
 //!
 //! The controller feeds back ν over ground as the navigation filter would
-//! estimate it (taken noise-free); the logger then records τ commanded, ν and
-//! η at the logger rate f_l = f_c / D (D a whole number) with seeded white
-//! measurement noise. Before t = 0 the vessel flies a lead-in holding the
+//! estimate it: noise-free by default ([`Feedback::True`]), or with the
+//! sensors' white noise drawn at every controller sample
+//! ([`Feedback::Measured`]); the logger records τ commanded, ν and η at the
+//! logger rate f_l = f_c / D (D a whole number) with seeded white
+//! measurement noise (with measured feedback: what the controller read). Before t = 0 the vessel flies a lead-in holding the
 //! first references, so a run starts trimmed at its operating point, as after
 //! the set-up time between runs.
 //!
@@ -132,6 +134,19 @@ impl Default for MeasurementNoise {
     }
 }
 
+/// What the vehicle's controller feeds back.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Feedback {
+    /// The true ν and η (the log alone is noisy): the plan's excitation
+    /// exactly as designed.
+    #[default]
+    True,
+    /// The measured ν and η, with the logger's noise drawn at every
+    /// controller sample; the log records what the controller saw. Sensor
+    /// noise then also moves the vehicle through the loop, as at sea.
+    Measured,
+}
+
 /// How to fly and log.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrialSettings {
@@ -146,6 +161,8 @@ pub struct TrialSettings {
     pub lead_in_s: Option<f64>,
     /// RK4 steps per controller interval.
     pub substeps: usize,
+    /// What the controller feeds back.
+    pub feedback: Feedback,
 }
 
 impl Default for TrialSettings {
@@ -156,6 +173,7 @@ impl Default for TrialSettings {
             max_duration_s: None,
             lead_in_s: None,
             substeps: 5,
+            feedback: Feedback::True,
         }
     }
 }
@@ -324,21 +342,38 @@ pub fn fly_experiment(
     let mut tau_cmd = DMatrix::zeros(n, 6);
     let h_int = h / settings.substeps as f64;
     let mut u = [0.0; 9];
+    let measured = settings.feedback == Feedback::Measured;
+    let mut sensor = SplitMix64::new(mix(settings.seed ^ 0x5E45_0F0B));
     for k in 0..n {
         let eta = Vector6::from_column_slice(&x[6..12]);
         let v_ned = current.ned();
         let nu = Vector6::from_column_slice(&x[0..6]) + body_current(&eta, &v_ned);
+        // What the controller reads: the truth, or the sensors.
+        let (nu_m, eta_m) = if measured {
+            let mut nu_m = nu;
+            let mut eta_m = eta;
+            for i in 0..6 {
+                nu_m[i] += settings.noise.nu[i] * sensor.normal();
+            }
+            for i in 0..6 {
+                eta_m[i] += settings.noise.eta[i] * sensor.normal();
+            }
+            eta_m[5] = wrap_pi(eta_m[5]);
+            (nu_m, eta_m)
+        } else {
+            (nu, eta)
+        };
         let mut rate_ref = [0.0; 6];
         for (i, d) in drives.iter().enumerate() {
             rate_ref[i] = match (*d, &attitude[i]) {
                 (Drive::Velocity(c), _) => reference(c, k),
-                (Drive::Attitude(c), Some(a)) => a.rate_reference(reference(c, k), eta[i]),
+                (Drive::Attitude(c), Some(a)) => a.rate_reference(reference(c, k), eta_m[i]),
                 _ => 0.0,
             };
             tau_cmd[(k, i)] = match *d {
                 Drive::Velocity(_) | Drive::Attitude(_) => pis[i]
                     .as_mut()
-                    .map_or(0.0, |pi| pi.step(rate_ref[i], nu[i])),
+                    .map_or(0.0, |pi| pi.step(rate_ref[i], nu_m[i])),
                 Drive::Force(c) => {
                     let l = profile.limit(Dof::ALL[i]).max_force;
                     reference(c, k).clamp(-l, l)
@@ -352,6 +387,8 @@ pub fn fly_experiment(
             for i in 0..6 {
                 rec.nu_true[(j, i)] = nu[i];
                 rec.eta_true[(j, i)] = eta[i];
+                rec.nu[(j, i)] = nu_m[i];
+                rec.eta[(j, i)] = eta_m[i];
                 rec.tau_commanded[(j, i)] = tau_cmd[(k, i)];
                 rec.tau_applied[(j, i)] = if lagged[i] { x[12 + i] } else { shaped[i] };
                 nu_ref[(j, i)] = rate_ref[i];
@@ -384,20 +421,23 @@ pub fn fly_experiment(
         }
     }
 
-    // Measurement noise: 12 draws per logged sample in a fixed order (ν then
-    // η), as RovTruth::simulate draws them; the measured heading is wrapped
-    // to (−π, π] like a compass's.
-    let mut rng = SplitMix64::new(settings.seed);
-    rec.nu.copy_from(&rec.nu_true);
-    rec.eta.copy_from(&rec.eta_true);
-    for k in 0..n_log {
-        for i in 0..6 {
-            rec.nu[(k, i)] += settings.noise.nu[i] * rng.normal();
+    // Measurement noise (with true feedback; with measured feedback the log
+    // already holds what the sensors read): 12 draws per logged sample in a
+    // fixed order (ν then η), as RovTruth::simulate draws them; the measured
+    // heading is wrapped to (−π, π] like a compass's.
+    if !measured {
+        let mut rng = SplitMix64::new(settings.seed);
+        rec.nu.copy_from(&rec.nu_true);
+        rec.eta.copy_from(&rec.eta_true);
+        for k in 0..n_log {
+            for i in 0..6 {
+                rec.nu[(k, i)] += settings.noise.nu[i] * rng.normal();
+            }
+            for i in 0..6 {
+                rec.eta[(k, i)] += settings.noise.eta[i] * rng.normal();
+            }
+            rec.eta[(k, 5)] = wrap_pi(rec.eta[(k, 5)]);
         }
-        for i in 0..6 {
-            rec.eta[(k, i)] += settings.noise.eta[i] * rng.normal();
-        }
-        rec.eta[(k, 5)] = wrap_pi(rec.eta[(k, 5)]);
     }
     let csv = profile_csv(profile, &rec);
     Ok(FlownRun {
