@@ -7,8 +7,9 @@
 //! the project's own simulator flying the plan with the prior. `--retune`
 //! re-tunes the truth's autopilot per seed (nominal inertia and ĝ(η)
 //! drawn anew), so the spread also holds the change of the closed loop.
+//! `--no-recursive` leaves the recursive family (REC runs) out of the plan.
 //!
-//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--grid-kn 0.5,2,3.5]`
+//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--grid-kn 0.5,2,3.5]`
 
 #[path = "../tests/support/precision_truth.rs"]
 mod precision_truth;
@@ -21,15 +22,16 @@ fn main() {
     let mut threads = 2usize;
     let mut own = false;
     let mut retune = false;
-    let mut grid = None;
+    let mut variant = precision_truth::PlanVariant::default();
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--threads" => threads = it.next().and_then(|v| v.parse().ok()).expect("--threads N"),
             "--own" => own = true,
             "--retune" => retune = true,
+            "--no-recursive" => variant.no_recursive = true,
             "--grid-kn" => {
-                grid = Some(
+                variant.grid_kn = Some(
                     it.next()
                         .expect("--grid-kn a,b,c")
                         .split(',')
@@ -41,7 +43,7 @@ fn main() {
         }
     }
     let t0 = Instant::now();
-    let setup = precision_truth::setup(grid);
+    let setup = precision_truth::setup(&variant);
     let pred = precision_truth::predict(&setup);
     eprintln!(
         "predicted {} parameters from {} runs in {:.1} s",

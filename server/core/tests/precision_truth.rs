@@ -7,15 +7,25 @@
 //! `design::predict_precision` predicts with a prior equal to the vessel.
 //!
 //! The issue's goal — empirical spread within 1.5× of the predicted std
-//! for ≥ 90 % of the parameters — is NOT met (≈ 2 %, median ratio ≈ 0.08):
-//! the λ posterior std, and so the prediction, is dominated by the
-//! deterministic equation error of the model class (10 Hz log of a 20 Hz
-//! controller, the λ map's O(h/T), quadratic damping, C(ν)ν), which does
-//! not change from one noise seed to the next; it bounds the error against
-//! the truth (what `open_world` grades), not the noise spread. The goal is
-//! kept as an ignored test; the live test asserts what holds — the
-//! prediction and the reported std are conservative bounds of the spread.
-//! `cargo run --release -p seatrial-core --example precision_table -- 20 --own`
+//! for ≥ 90 % of the parameters — is NOT met: 2 % (median
+//! empirical/predicted 0.075). Not because the posterior is overconfident
+//! (the std the identification reports on the truth's runs is above the
+//! spread for every parameter, median spread/reported 0.014), but because
+//! the λ posterior std — and so the prediction — is set by the pooled
+//! residual variance, which here is deterministic equation error, not
+//! noise: on the project's own simulator the noise-free std equals the
+//! noisy one, and its own noise spread is 0.03× the std (median). Most of
+//! that error comes from the plan's recursive (REC) runs: their roll/pitch
+//! RATE references (PRBS ±0.15 rad/s) integrate to φ ≈ 1.4 rad, θ ≈ 1.2 rad
+//! on the project's simulator and to an inverted vehicle (φ ≈ 3.1 rad) on
+//! the truth. Without the REC family (`--no-recursive` in the example):
+//! 37 % within 1.5×, median 0.90; the rest splits into misfit still in the
+//! std (own-simulator spread/predicted median 0.56) and the truth's larger
+//! noise spread (1.6× the project's simulator's: its autopilot acts on
+//! noisy measurements, the project's on noise-free ν).
+//! The goal is kept as an ignored test; the live test asserts what holds —
+//! neither the prediction nor the reported std understates the spread.
+//! `cargo run --release -p seatrial-core --example precision_table -- 20 --own [--no-recursive]`
 //! prints the full table with the project's own simulator's noise spread.
 
 #[path = "support/precision_truth.rs"]
@@ -24,7 +34,9 @@ mod precision_truth;
 use std::sync::OnceLock;
 use std::time::Instant;
 
-use precision_truth::{Comparison, FACTOR, compare, fly_seeds, predict, print_table, setup};
+use precision_truth::{
+    Comparison, FACTOR, PlanVariant, compare, fly_seeds, predict, print_table, setup,
+};
 
 /// Noise seeds flown.
 const SEEDS: u64 = 20;
@@ -33,7 +45,7 @@ fn comparisons() -> &'static Vec<Comparison> {
     static C: OnceLock<Vec<Comparison>> = OnceLock::new();
     C.get_or_init(|| {
         let t0 = Instant::now();
-        let s = setup(None);
+        let s = setup(&PlanVariant::default());
         let pred = predict(&s);
         let seeds: Vec<u64> = (1..=SEEDS).collect();
         let est = fly_seeds(&s, &seeds, 2);
@@ -79,7 +91,7 @@ fn predicted_and_reported_std_bound_the_truths_noise_spread() {
 /// Issue 15's goal: empirical spread within 1.5× of the predicted std for
 /// ≥ 90 % of the parameters. Not met (see the module docs).
 #[test]
-#[ignore = "issue 15's goal is not met: the λ posterior std is dominated by deterministic model-class misfit, ≈ 13× the noise spread (median)"]
+#[ignore = "issue 15's goal is not met (2 %): the λ posterior std is set by deterministic equation error (mostly the REC runs' large attitudes), ≈ 13× the noise spread (median)"]
 fn empirical_spread_matches_the_predicted_std() {
     let c = comparisons();
     let live: Vec<&Comparison> = c.iter().filter(|c| !c.structural_zero()).collect();

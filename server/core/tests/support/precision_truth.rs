@@ -22,7 +22,9 @@ use seatrial_core::estimation::NoProgress;
 use seatrial_core::identification::document::ParameterRow;
 use seatrial_core::identification::{LambdaCampaignSettings, RunInput, identify_lambda_campaign};
 use seatrial_core::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
-use seatrial_core::planning::{CampaignSpec, Plan, PlannedExperiment, VesselProfile, examples};
+use seatrial_core::planning::{
+    CampaignSpec, ExperimentFamily, Plan, PlannedExperiment, VesselProfile, examples,
+};
 use seatrial_core::simulation::rov::{LinearDamping, Restoring, RovTruth};
 use seatrial_core::simulation::trials::MeasurementNoise;
 use seatrial_truth::controller::ControllerConfig;
@@ -54,13 +56,25 @@ pub struct Setup {
     pub noise: NoiseSpec,
 }
 
-/// The service's rule-based Surveyor plan; `grid_kn` replaces the spec's
-/// grid (knots) when given.
-pub fn plan(grid_kn: Option<Vec<f64>>) -> (VesselProfile, Plan) {
+/// Which plan to fly.
+#[derive(Debug, Clone, Default)]
+pub struct PlanVariant {
+    /// Replaces the spec's grid (knots).
+    pub grid_kn: Option<Vec<f64>>,
+    /// Leaves out the recursive family (the all-DOF REC runs, whose
+    /// roll/pitch rate references integrate to large attitudes).
+    pub no_recursive: bool,
+}
+
+/// The service's rule-based Surveyor plan, as `variant` asks.
+pub fn plan(variant: &PlanVariant) -> (VesselProfile, Plan) {
     let profile = examples::surveyor_rov();
     let mut spec: CampaignSpec = examples::surveyor_campaign(PLAN_SEED);
-    if let Some(g) = grid_kn {
-        spec.grid.speeds = g;
+    if let Some(g) = &variant.grid_kn {
+        spec.grid.speeds = g.clone();
+    }
+    if variant.no_recursive {
+        spec.families.retain(|f| *f != ExperimentFamily::Recursive);
     }
     let plan = seatrial_core::planning::generate_plan(&profile, &spec).expect("the plan");
     (profile, plan)
@@ -68,8 +82,8 @@ pub fn plan(grid_kn: Option<Vec<f64>>) -> (VesselProfile, Plan) {
 
 /// The Surveyor-like truth vessel, the plan as external schedules and one
 /// autopilot tuned for their envelope.
-pub fn setup(grid_kn: Option<Vec<f64>>) -> Setup {
-    let (profile, plan) = plan(grid_kn);
+pub fn setup(variant: &PlanVariant) -> Setup {
+    let (profile, plan) = plan(variant);
     let vessel = Vessel::surveyor_like();
     let runs: Vec<ExternalRun> = plan.experiments.iter().map(to_external).collect();
     let mut rng = Rng::new(derive_seed(TUNE_SEED, 0xCA3B));
