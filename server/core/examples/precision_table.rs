@@ -1,0 +1,87 @@
+//! Issue 15's proof for the ROV as a table: the predicted std of every
+//! λ-filter parameter of the Surveyor plan (`design::predict_precision`,
+//! the vessel as prior) against the empirical spread of the estimates over
+//! noise seeds of the independent truth (`seatrial-truth`) flying the same
+//! plan (one autopilot, noise varied), against the std the identification
+//! reports on those runs, and (`--own`) against the noise-only spread of
+//! the project's own simulator flying the plan with the prior. `--retune`
+//! re-tunes the truth's autopilot per seed (nominal inertia and ĝ(η)
+//! drawn anew), so the spread also holds the change of the closed loop.
+//! `--no-recursive` leaves the recursive family (REC runs) out of the plan.
+//!
+//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--grid-kn 0.5,2,3.5]`
+
+#[path = "../tests/support/precision_truth.rs"]
+mod precision_truth;
+
+use std::time::Instant;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut seeds = 20usize;
+    let mut threads = 2usize;
+    let mut own = false;
+    let mut retune = false;
+    let mut variant = precision_truth::PlanVariant::default();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--threads" => threads = it.next().and_then(|v| v.parse().ok()).expect("--threads N"),
+            "--own" => own = true,
+            "--retune" => retune = true,
+            "--no-recursive" => variant.no_recursive = true,
+            "--grid-kn" => {
+                variant.grid_kn = Some(
+                    it.next()
+                        .expect("--grid-kn a,b,c")
+                        .split(',')
+                        .map(|v| v.parse::<f64>().expect("a speed in knots"))
+                        .collect(),
+                )
+            }
+            n => seeds = n.parse().expect("the number of seeds"),
+        }
+    }
+    let t0 = Instant::now();
+    let setup = precision_truth::setup(&variant);
+    let pred = precision_truth::predict(&setup);
+    eprintln!(
+        "predicted {} parameters from {} runs in {:.1} s",
+        pred.total,
+        pred.runs,
+        t0.elapsed().as_secs_f64()
+    );
+    let t1 = Instant::now();
+    let seed_list: Vec<u64> = (1..=seeds as u64).collect();
+    let est = if retune {
+        precision_truth::fly_seeds_with(
+            &setup,
+            &seed_list,
+            threads,
+            precision_truth::fly_and_identify_retuned,
+        )
+    } else {
+        precision_truth::fly_seeds(&setup, &seed_list, threads)
+    };
+    eprintln!(
+        "{seeds} truth campaigns flown and identified in {:.1} s",
+        t1.elapsed().as_secs_f64()
+    );
+    let (mut cmp, missing) = precision_truth::compare(&pred, &est);
+    if missing > 0 {
+        println!("{missing} predicted parameters missing from some seed's identification");
+    }
+    if own {
+        let t2 = Instant::now();
+        let preds: Vec<_> = seed_list
+            .iter()
+            .map(|&k| precision_truth::predict_seed(&setup, k))
+            .collect();
+        precision_truth::add_self_spread(&mut cmp, &preds);
+        eprintln!(
+            "{seeds} own-simulator predictions in {:.1} s",
+            t2.elapsed().as_secs_f64()
+        );
+    }
+    precision_truth::print_table(&cmp, seeds);
+}

@@ -1,0 +1,602 @@
+//! Issue 15's proof for the ROV: the predicted precision of a plan
+//! (`design::predict_precision`, which flies the plan with a prior through
+//! the project's OWN simulator) against the empirical spread of the
+//! λ-filter estimates when the same plan is flown, seed after seed, by the
+//! INDEPENDENT truth (`seatrial-truth`: its own 6-DOF plant, 20 Hz
+//! autopilot on noisy measurements with a wrong ĝ(η) feed-forward, 10 Hz
+//! logger).
+//!
+//! The bridge is plain numbers: each planned experiment's schedule columns
+//! become the truth's [`Channel`]s, the truth vessel's published parameters
+//! become the prior [`RovTruth`], the truth's [`NoiseSpec`] becomes the
+//! prediction's [`MeasurementNoise`]. The truth's CSV is read through the
+//! service's parser as an upload would be.
+
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+
+use nalgebra::Matrix6;
+use seatrial_core::design::{PrecisionPrediction, PredictSettings, Prior, PriorSource};
+use seatrial_core::estimation::NoProgress;
+use seatrial_core::identification::document::ParameterRow;
+use seatrial_core::identification::{LambdaCampaignSettings, RunInput, identify_lambda_campaign};
+use seatrial_core::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
+use seatrial_core::planning::{
+    CampaignSpec, ExperimentFamily, Plan, PlannedExperiment, VesselProfile, examples,
+};
+use seatrial_core::simulation::rov::{LinearDamping, Restoring, RovTruth};
+use seatrial_core::simulation::trials::MeasurementNoise;
+use seatrial_truth::controller::ControllerConfig;
+use seatrial_truth::rng::{Rng, derive_seed};
+use seatrial_truth::{
+    Channel, ExternalRun, NoiseSpec, Vessel, external_envelope, fly_external_runs,
+};
+
+/// Seed of the plan (its PRBS draws).
+pub const PLAN_SEED: u64 = 7;
+/// Seed of the one autopilot tuning every noise seed flies with.
+pub const TUNE_SEED: u64 = 15;
+/// Largest factor between empirical and predicted std that counts as a
+/// match (the issue's goal).
+pub const FACTOR: f64 = 1.5;
+
+/// Velocity-reference column of DOF i (u_ref … r_ref).
+const VELOCITY: [&str; 6] = ["u_ref", "v_ref", "w_ref", "p_ref", "q_ref", "r_ref"];
+/// Force column of DOF i.
+const FORCE: [&str; 6] = ["tau_X", "tau_Y", "tau_Z", "tau_K", "tau_M", "tau_N"];
+
+/// Everything the comparison needs, built once.
+pub struct Setup {
+    pub profile: VesselProfile,
+    pub plan: Plan,
+    pub vessel: Vessel,
+    pub controller: ControllerConfig,
+    pub runs: Vec<ExternalRun>,
+    pub noise: NoiseSpec,
+}
+
+/// Which plan to fly.
+#[derive(Debug, Clone, Default)]
+pub struct PlanVariant {
+    /// Replaces the spec's grid (knots).
+    pub grid_kn: Option<Vec<f64>>,
+    /// Leaves out the recursive family (the all-DOF REC runs, whose
+    /// roll/pitch rate references integrate to large attitudes).
+    pub no_recursive: bool,
+}
+
+/// The service's rule-based Surveyor plan, as `variant` asks.
+pub fn plan(variant: &PlanVariant) -> (VesselProfile, Plan) {
+    let profile = examples::surveyor_rov();
+    let mut spec: CampaignSpec = examples::surveyor_campaign(PLAN_SEED);
+    if let Some(g) = &variant.grid_kn {
+        spec.grid.speeds = g.clone();
+    }
+    if variant.no_recursive {
+        spec.families.retain(|f| *f != ExperimentFamily::Recursive);
+    }
+    let plan = seatrial_core::planning::generate_plan(&profile, &spec).expect("the plan");
+    (profile, plan)
+}
+
+/// The Surveyor-like truth vessel, the plan as external schedules and one
+/// autopilot tuned for their envelope.
+pub fn setup(variant: &PlanVariant) -> Setup {
+    let (profile, plan) = plan(variant);
+    let vessel = Vessel::surveyor_like();
+    let runs: Vec<ExternalRun> = plan.experiments.iter().map(to_external).collect();
+    let mut rng = Rng::new(derive_seed(TUNE_SEED, 0xCA3B));
+    let controller = ControllerConfig::tune(&vessel, &external_envelope(&runs), &mut rng);
+    Setup {
+        profile,
+        plan,
+        vessel,
+        controller,
+        runs,
+        noise: NoiseSpec::default(),
+    }
+}
+
+/// A planned experiment as the truth's external schedule, column by column
+/// as `simulation::trials` reads it: `u_ref … r_ref` velocity (roll and
+/// pitch: rate) references, `phi_ref`, `theta_ref` attitude references,
+/// `tau_X … tau_N` open-loop forces; a DOF without a column is held.
+pub fn to_external(p: &PlannedExperiment) -> ExternalRun {
+    let s = &p.schedule;
+    let channels: [Channel; 6] = std::array::from_fn(|i| {
+        let col = |name: &str| {
+            s.columns
+                .iter()
+                .position(|c| c == name)
+                .map(|c| s.values[c].clone())
+        };
+        if let Some(x) = col(VELOCITY[i]) {
+            Channel::Velocity(x)
+        } else if let Some(x) = (i == 3).then(|| col("phi_ref")).flatten() {
+            Channel::Attitude(x)
+        } else if let Some(x) = (i == 4).then(|| col("theta_ref")).flatten() {
+            Channel::Attitude(x)
+        } else if let Some(x) = col(FORCE[i]) {
+            Channel::Force(x)
+        } else {
+            Channel::Hold
+        }
+    });
+    ExternalRun::new(p.experiment.code.clone(), s.sample_rate_hz, channels)
+}
+
+/// The prior "equal to the vessel": the truth's published M = M_RB + M_A,
+/// D_l(u) = D_l0 + D_lu·u tabulated over the plan's speeds (exact under
+/// the interpolation; the plan never reverses, u > 0), D_q, C(ν) from M,
+/// W = m g, B = W − (W − B), r_G = (0, 0, z_G), r_B = (0, 0, z_B).
+pub fn prior_of(v: &Vessel) -> RovTruth {
+    let d0 = Matrix6::from_diagonal(&v.damping_linear);
+    let d1 = Matrix6::from_diagonal(&v.damping_linear_per_speed);
+    let speeds: Vec<f64> = (0..=10).map(|k| 0.25 * k as f64).collect();
+    let mut t = RovTruth::new(v.m(), LinearDamping::affine(d0, d1, speeds));
+    t.quadratic_damping = std::array::from_fn(|i| v.damping_quadratic[i]);
+    t.coriolis = true;
+    t.restoring = Restoring {
+        weight: v.weight(),
+        buoyancy: v.buoyancy(),
+        r_g: [0.0, 0.0, v.z_g],
+        r_b: [0.0, 0.0, v.z_b],
+    };
+    t
+}
+
+/// The truth's white noise as the project's simulator states it.
+pub fn measurement_noise(n: &NoiseSpec) -> MeasurementNoise {
+    MeasurementNoise {
+        nu: std::array::from_fn(|i| n.nu_std(i)),
+        eta: std::array::from_fn(|i| n.eta_std(i)),
+    }
+}
+
+/// Key of a parameter row: group, symbol, grid speed.
+pub type Key = (String, String, Option<String>);
+
+fn key(group: &str, symbol: &str, speed: Option<f64>) -> Key {
+    (
+        group.to_string(),
+        symbol.to_string(),
+        speed.map(|u| format!("{u:.4}")),
+    )
+}
+
+/// Rows as the prediction tabulates them: the document's parameters, then
+/// the restoring rows not already among them.
+fn rows(doc: &seatrial_core::identification::document::ModelDocument) -> Vec<&ParameterRow> {
+    let mut rows: Vec<&ParameterRow> = doc.parameters.iter().collect();
+    if let Some(r) = &doc.restoring {
+        for p in &r.parameters {
+            if !rows
+                .iter()
+                .any(|q| q.symbol == p.symbol && q.group == p.group)
+            {
+                rows.push(p);
+            }
+        }
+    }
+    rows
+}
+
+/// The plan's grid speeds, ascending.
+pub fn grid(plan: &Plan) -> Vec<f64> {
+    let mut g: Vec<f64> = plan
+        .experiments
+        .iter()
+        .filter_map(|p| p.experiment.grid_speed_mps)
+        .collect();
+    g.sort_by(f64::total_cmp);
+    g.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    g
+}
+
+/// One seed's estimates: per key the value and the reported std.
+pub type Estimates = BTreeMap<Key, (f64, Option<f64>)>;
+
+/// Flies the plan on the truth with noise seed `seed` (one autopilot for
+/// all seeds) and identifies it as the service would.
+pub fn fly_and_identify(s: &Setup, seed: u64) -> Estimates {
+    let flown = fly_external_runs(&s.vessel, &s.controller, &s.runs, &s.noise, seed);
+    identify_flown(s, &flown)
+}
+
+/// [`fly_and_identify`] with the autopilot re-tuned from `seed` (its
+/// nominal inertia and ĝ(η) drawn anew): the spread then holds the
+/// campaign-to-campaign change of the closed loop, not only the noise.
+pub fn fly_and_identify_retuned(s: &Setup, seed: u64) -> Estimates {
+    let (_, flown) = seatrial_truth::fly_external_campaign(&s.vessel, &s.runs, &s.noise, seed);
+    identify_flown(s, &flown)
+}
+
+fn identify_flown(s: &Setup, flown: &[seatrial_truth::Run]) -> Estimates {
+    let inputs: Vec<RunInput> = s
+        .plan
+        .experiments
+        .iter()
+        .zip(flown)
+        .map(|(p, run)| {
+            assert_eq!(run.meta.name, p.experiment.code);
+            let csv = run.single_csv();
+            let opts = ParseOptions::for_vessel(&s.profile, LogRole::Single, None);
+            let parsed = parse_log(csv.as_bytes(), &opts).expect("the truth's CSV parses");
+            let (record, _) = to_uniform(&parsed.table, None).expect("uniform");
+            let e = &p.experiment;
+            RunInput {
+                run_id: e.code.clone(),
+                name: e.code.clone(),
+                family: Some(e.family),
+                grid_speed_mps: e.grid_speed_mps,
+                excited_dofs: e.dofs.clone(),
+                record,
+            }
+        })
+        .collect();
+    let id = identify_lambda_campaign(
+        &s.profile,
+        &grid(&s.plan),
+        &input_columns(&s.profile),
+        &inputs,
+        &LambdaCampaignSettings::default(),
+        &mut NoProgress,
+    )
+    .expect("the truth's campaign identifies");
+    rows(&id.document)
+        .into_iter()
+        .map(|r| (key(&r.group, &r.symbol, r.grid_speed_mps), (r.value, r.std)))
+        .collect()
+}
+
+/// `fly_and_identify` for `seeds`, on up to `threads` threads.
+pub fn fly_seeds(s: &Setup, seeds: &[u64], threads: usize) -> Vec<Estimates> {
+    fly_seeds_with(s, seeds, threads, fly_and_identify)
+}
+
+/// `f` for `seeds`, on up to `threads` threads, in seed order.
+pub fn fly_seeds_with(
+    s: &Setup,
+    seeds: &[u64],
+    threads: usize,
+    f: fn(&Setup, u64) -> Estimates,
+) -> Vec<Estimates> {
+    let threads = threads.clamp(1, seeds.len().max(1));
+    let chunks: Vec<Vec<u64>> = (0..threads)
+        .map(|t| seeds.iter().copied().skip(t).step_by(threads).collect())
+        .collect();
+    let mut out: Vec<(u64, Estimates)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = chunks
+            .iter()
+            .map(|c| scope.spawn(move || c.iter().map(|&k| (k, f(s, k))).collect::<Vec<_>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("a seed's worker"))
+            .collect()
+    });
+    out.sort_by_key(|(k, _)| *k);
+    out.into_iter().map(|(_, e)| e).collect()
+}
+
+/// The prediction: the plan flown by the project's simulator with the
+/// vessel as prior and the truth's noise.
+pub fn predict(s: &Setup) -> PrecisionPrediction {
+    predict_seed(s, PredictSettings::default().seed)
+}
+
+/// [`predict`] with the simulator's noise seed `seed`.
+pub fn predict_seed(s: &Setup, seed: u64) -> PrecisionPrediction {
+    predict_with(s, prior_of(&s.vessel), seed)
+}
+
+/// [`predict_seed`] with another prior.
+pub fn predict_with(s: &Setup, prior: RovTruth, seed: u64) -> PrecisionPrediction {
+    predict_noise(s, prior, measurement_noise(&s.noise), seed)
+}
+
+/// [`predict_with`] with another noise.
+pub fn predict_noise(
+    s: &Setup,
+    prior: RovTruth,
+    noise: MeasurementNoise,
+    seed: u64,
+) -> PrecisionPrediction {
+    seatrial_core::design::predict_precision(
+        &s.profile,
+        &s.plan,
+        &Prior::Rov(Box::new(prior)),
+        PriorSource::Reference,
+        &PredictSettings {
+            rov_noise: noise,
+            seed,
+            ..PredictSettings::default()
+        },
+        &mut NoProgress,
+    )
+    .expect("the prediction")
+}
+
+/// A prediction's expected values as one seed's estimates.
+pub fn estimates_of_prediction(p: &PrecisionPrediction) -> Estimates {
+    p.parameters
+        .iter()
+        .map(|r| {
+            (
+                key(&r.group, &r.symbol, r.grid_speed_mps),
+                (r.expected_value, r.predicted_std),
+            )
+        })
+        .collect()
+}
+
+/// One parameter: predicted std, empirical std over seeds, mean reported
+/// std on the truth runs.
+#[derive(Debug, Clone)]
+pub struct Comparison {
+    pub key: Key,
+    pub predicted: Option<f64>,
+    pub empirical: f64,
+    pub reported: Option<f64>,
+    /// Mean estimate over the truth's seeds.
+    pub mean: f64,
+    /// The value the prediction's identification returned.
+    pub expected: f64,
+    /// Empirical std over noise seeds of the project's own simulator
+    /// flying the plan with the prior (the noise-only spread the
+    /// prediction's machinery gives), when computed.
+    pub self_spread: Option<f64>,
+}
+
+impl Comparison {
+    /// empirical / predicted (∞ without a prediction).
+    pub fn ratio(&self) -> f64 {
+        match self.predicted {
+            Some(p) if p > 0.0 => self.empirical / p,
+            _ => f64::INFINITY,
+        }
+    }
+
+    /// empirical / mean reported std on the truth runs.
+    pub fn reported_ratio(&self) -> f64 {
+        match self.reported {
+            Some(p) if p > 0.0 => self.empirical / p,
+            _ => f64::INFINITY,
+        }
+    }
+
+    /// Within [1/F, F].
+    pub fn within(&self) -> bool {
+        in_factor(self.ratio())
+    }
+
+    /// mean reported std on the truth runs / predicted std.
+    pub fn reported_over_predicted(&self) -> f64 {
+        match (self.reported, self.predicted) {
+            (Some(r), Some(p)) if p > 0.0 => r / p,
+            _ => f64::INFINITY,
+        }
+    }
+
+    /// empirical std on the truth / empirical std on the project's simulator.
+    pub fn truth_over_self(&self) -> f64 {
+        match self.self_spread {
+            Some(p) if p > 0.0 => self.empirical / p,
+            _ => f64::INFINITY,
+        }
+    }
+
+    /// Structurally zero: no spread and no predicted std.
+    pub fn structural_zero(&self) -> bool {
+        let tiny = 1e-12 * self.mean.abs().max(1e-300);
+        self.empirical <= tiny && self.predicted.is_none_or(|p| p <= tiny)
+    }
+
+    pub fn name(&self) -> String {
+        let (g, s, u) = &self.key;
+        match u {
+            Some(u) => format!("{g} {s} @{u}"),
+            None => format!("{g} {s}"),
+        }
+    }
+}
+
+/// Per parameter of the prediction, the comparison with the seeds'
+/// estimates (parameters missing in any seed are left out and counted).
+pub fn compare(pred: &PrecisionPrediction, seeds: &[Estimates]) -> (Vec<Comparison>, usize) {
+    let mut out = Vec::new();
+    let mut missing = 0;
+    for p in &pred.parameters {
+        let k = key(&p.group, &p.symbol, p.grid_speed_mps);
+        let vals: Vec<(f64, Option<f64>)> =
+            seeds.iter().filter_map(|e| e.get(&k).copied()).collect();
+        if vals.len() != seeds.len() || vals.len() < 2 {
+            missing += 1;
+            continue;
+        }
+        let n = vals.len() as f64;
+        let mean = vals.iter().map(|v| v.0).sum::<f64>() / n;
+        let var = vals.iter().map(|v| (v.0 - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        let rep: Vec<f64> = vals.iter().filter_map(|v| v.1).collect();
+        let reported = (rep.len() == vals.len()).then(|| rep.iter().sum::<f64>() / n);
+        out.push(Comparison {
+            key: k,
+            predicted: p.predicted_std,
+            empirical: var.sqrt(),
+            reported,
+            mean,
+            expected: p.expected_value,
+            self_spread: None,
+        });
+    }
+    (out, missing)
+}
+
+/// Within [1/F, F].
+pub fn in_factor(r: f64) -> bool {
+    (1.0 / FACTOR..=FACTOR).contains(&r)
+}
+
+/// Fills in the noise-only spread over `seeds` of the project's own
+/// simulator (the predictions' expected values).
+pub fn add_self_spread(c: &mut [Comparison], own: &[PrecisionPrediction]) {
+    let est: Vec<Estimates> = own.iter().map(estimates_of_prediction).collect();
+    for x in c.iter_mut() {
+        let vals: Vec<f64> = est
+            .iter()
+            .filter_map(|e| e.get(&x.key).map(|v| v.0))
+            .collect();
+        if vals.len() == est.len() && vals.len() > 1 {
+            let n = vals.len() as f64;
+            let m = vals.iter().sum::<f64>() / n;
+            x.self_spread =
+                Some((vals.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt());
+        }
+    }
+}
+
+/// Summary of a comparison.
+pub struct Summary {
+    pub compared: usize,
+    pub skipped_zero: usize,
+    pub within: usize,
+    pub share: f64,
+    pub median_ratio: f64,
+    pub median_reported_ratio: f64,
+    pub reported_within: usize,
+    /// Parameters whose predicted std bounds the spread: empirical ≤ F × predicted.
+    pub bounded: usize,
+    /// Parameters whose reported std on the truth is within F× of the prediction.
+    pub reported_predicted_within: usize,
+    pub median_reported_over_predicted: f64,
+    /// Parameters whose truth spread is within F× of the project's
+    /// simulator's spread (when computed).
+    pub self_within: usize,
+    pub median_truth_over_self: f64,
+    /// Median over parameters of |truth mean − predicted value| / predicted std.
+    pub median_offset_in_predicted_std: f64,
+}
+
+fn median(mut x: Vec<f64>) -> f64 {
+    x.sort_by(f64::total_cmp);
+    if x.is_empty() {
+        return f64::NAN;
+    }
+    let n = x.len();
+    if n % 2 == 1 {
+        x[n / 2]
+    } else {
+        0.5 * (x[n / 2 - 1] + x[n / 2])
+    }
+}
+
+pub fn summarize(c: &[Comparison]) -> Summary {
+    let live: Vec<&Comparison> = c.iter().filter(|c| !c.structural_zero()).collect();
+    let within = live.iter().filter(|c| c.within()).count();
+    let reported_within = live
+        .iter()
+        .filter(|c| in_factor(c.reported_ratio()))
+        .count();
+    let bounded = live.iter().filter(|c| c.ratio() <= FACTOR).count();
+    let reported_predicted_within = live
+        .iter()
+        .filter(|c| in_factor(c.reported_over_predicted()))
+        .count();
+    let self_within = live
+        .iter()
+        .filter(|c| in_factor(c.truth_over_self()))
+        .count();
+    Summary {
+        compared: live.len(),
+        skipped_zero: c.len() - live.len(),
+        within,
+        share: within as f64 / live.len().max(1) as f64,
+        median_ratio: median(live.iter().map(|c| c.ratio()).collect()),
+        median_reported_ratio: median(live.iter().map(|c| c.reported_ratio()).collect()),
+        reported_within,
+        bounded,
+        reported_predicted_within,
+        median_reported_over_predicted: median(
+            live.iter().map(|c| c.reported_over_predicted()).collect(),
+        ),
+        self_within,
+        median_truth_over_self: median(live.iter().map(|c| c.truth_over_self()).collect()),
+        median_offset_in_predicted_std: median(
+            live.iter()
+                .filter_map(|c| c.predicted.map(|p| (c.mean - c.expected).abs() / p))
+                .collect(),
+        ),
+    }
+}
+
+/// Prints the table (worst ratio first when `sorted`) and the summary.
+pub fn print_table(c: &[Comparison], seeds: usize) -> Summary {
+    let mut live: Vec<&Comparison> = c.iter().filter(|c| !c.structural_zero()).collect();
+    live.sort_by(|a, b| {
+        let d = |c: &Comparison| c.ratio().ln().abs();
+        d(b).total_cmp(&d(a))
+    });
+    println!(
+        "{:<36} {:>11} {:>11} {:>11} {:>11} {:>8} {:>8} {:>8} {:>8}",
+        "parameter",
+        "predicted",
+        "empirical",
+        "reported",
+        "own-sim",
+        "emp/pred",
+        "emp/rep",
+        "rep/pred",
+        "emp/own"
+    );
+    for c in &live {
+        let f = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{v:.3e}"));
+        println!(
+            "{:<36} {:>11} {:>11.3e} {:>11} {:>11} {:>8.3} {:>8.3} {:>8.3} {:>8.3}{}",
+            c.name(),
+            f(c.predicted),
+            c.empirical,
+            f(c.reported),
+            f(c.self_spread),
+            c.ratio(),
+            c.reported_ratio(),
+            c.reported_over_predicted(),
+            c.truth_over_self(),
+            if c.within() { "" } else { "  ✗" }
+        );
+    }
+    let s = summarize(c);
+    println!(
+        "{seeds} seeds: {} of {} parameters within {FACTOR}× ({:.1} %), {} structurally zero skipped; median empirical/predicted {:.3}; empirical/reported(on truth) within {FACTOR}×: {} ({:.1} %), median {:.3}",
+        s.within,
+        s.compared,
+        100.0 * s.share,
+        s.skipped_zero,
+        s.median_ratio,
+        s.reported_within,
+        100.0 * s.reported_within as f64 / s.compared.max(1) as f64,
+        s.median_reported_ratio
+    );
+    let pct = |k: usize| 100.0 * k as f64 / s.compared.max(1) as f64;
+    println!(
+        "predicted std ≥ empirical/{FACTOR} (a bound): {} ({:.1} %); reported std on the truth within {FACTOR}× of the prediction: {} ({:.1} %), median reported/predicted {:.3}",
+        s.bounded,
+        pct(s.bounded),
+        s.reported_predicted_within,
+        pct(s.reported_predicted_within),
+        s.median_reported_over_predicted
+    );
+    println!(
+        "median |truth mean − predicted value| / predicted std: {:.3}",
+        s.median_offset_in_predicted_std
+    );
+    if c.iter().any(|c| c.self_spread.is_some()) {
+        println!(
+            "truth spread within {FACTOR}× of the project's simulator's noise-only spread: {} ({:.1} %), median truth/own {:.3}",
+            s.self_within,
+            pct(s.self_within),
+            s.median_truth_over_self
+        );
+    }
+    s
+}
