@@ -39,7 +39,7 @@ async fn the_supply_vessels_plan_is_predicted_as_the_core_predicts_it() {
 
     let job = common::run_job(
         &app,
-        json!({ "kind": "precision", "campaign_id": cid, "settings": { "prior": "reference", "seed": 4 } }),
+        json!({ "kind": "precision", "campaign_id": cid, "settings": { "prior": "reference", "seed": 4, "realisations": 6 } }),
     )
     .await;
     assert_eq!(job["result"]["prediction"]["method"], "parallel_ekf");
@@ -52,6 +52,7 @@ async fn the_supply_vessels_plan_is_predicted_as_the_core_predicts_it() {
     assert_eq!(r.json["current"], true);
     assert_eq!(r.json["plan_version"], 1);
     assert_eq!(r.json["prediction"]["prior"]["kind"], "reference");
+    assert_eq!(r.json["prediction"]["realisations"], 6);
 
     // The same numbers as the core on the same plan, prior and seed.
     let profile = supply_vessel();
@@ -63,6 +64,7 @@ async fn the_supply_vessels_plan_is_predicted_as_the_core_predicts_it() {
         PriorSource::Reference,
         &PredictSettings {
             seed: 4,
+            realisations: 6,
             ..PredictSettings::default()
         },
         &mut NoProgress,
@@ -125,6 +127,10 @@ async fn unusable_precision_requests_are_422_naming_the_field() {
         (
             json!({ "kind": "precision", "campaign_id": cid, "settings": { "seed": -1 } }),
             "settings.seed",
+        ),
+        (
+            json!({ "kind": "precision", "campaign_id": cid, "settings": { "realisations": 0 } }),
+            "settings.realisations",
         ),
         (json!({ "kind": "precision" }), "campaign_id"),
     ] {

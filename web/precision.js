@@ -39,13 +39,15 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
     h('option', { value: 'reference' }, PRIOR_LABEL.reference),
     models.map((m) => h('option', { value: `model:${m.id}` }, `model ${m.name} v${m.version}`)));
   const seedIn = h('input', { type: 'number', min: '0', step: '1', value: '1', class: 'short', 'data-field': 'settings.seed', 'data-testid': 'precision-seed' });
+  const realIn = h('input', { type: 'number', min: '1', max: '100', step: '1', value: '20', class: 'short', 'data-field': 'settings.realisations', 'data-testid': 'precision-realisations' });
   const startBtn = h('button', { type: 'submit', class: 'btn primary', 'data-testid': 'precision-start' }, 'Predict precision');
   const status = h('div', { class: 'precision-status', 'data-testid': 'precision-status', 'aria-live': 'polite' });
   const result = h('div', { class: 'precision-result', 'data-testid': 'precision-result' });
   const form = h('form', { class: 'card form', novalidate: true, 'data-needs': 'supervisor', 'data-testid': 'precision-form', 'aria-label': 'Predict precision', onSubmit: submit },
     h('div', { class: 'row' },
       labelled('Prior', priorSel, 'the vessel the plan is flown with in simulation'),
-      labelled('Noise seed', seedIn, 'of the simulated sensor noise')),
+      labelled('Noise seed', seedIn, 'of the simulated sensor noise'),
+      labelled('Realisations', realIn, 'flights of the plan in simulation; the predicted std is their spread')),
     h('div', { class: 'form-actions' }, startBtn),
     status);
 
@@ -75,7 +77,7 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
   async function submit(ev) {
     ev.preventDefault();
     const prior = priorSel.value;
-    const body = { kind: 'precision', campaign_id: id, settings: { seed: Number(seedIn.value || 1) } };
+    const body = { kind: 'precision', campaign_id: id, settings: { seed: Number(seedIn.value || 1), realisations: Number(realIn.value || 20) } };
     if (prior.startsWith('model:')) {
       body.settings.prior = 'model';
       body.model_id = prior.slice(6);
@@ -149,6 +151,8 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
         h('td', { class: 'num' }, `${fmtSig(r.expected_value, 4)} ${unitLabel(r.unit)}`),
         h('td', { class: 'num' }, r.predicted_std == null ? '–' : `±${fmtSig(r.predicted_std, 2)} ${unitLabel(r.unit)}`),
         h('td', { class: 'num', title: r.relative_to ? `relative to ${r.relative_to}` : '' }, pct(r.relative_std)),
+        h('td', { class: 'num' }, r.reported_std == null ? '–' : `±${fmtSig(r.reported_std, 2)} ${unitLabel(r.unit)}`,
+          r.structure_limited ? h('span', { class: 'badge status weak', title: 'the model\u2019s structure, not the noise, limits this parameter: more runs of this plan will not sharpen it', 'data-testid': 'precision-limited' }, 'structure') : null),
         h('td', null, r.determined ? 'yes' : h('strong', null, 'no')))));
     }
     renderRows();
@@ -158,9 +162,15 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
       h('p', { 'data-testid': 'precision-summary' },
         h('strong', null, `${p.determined} of ${p.total}`), ' parameters determined (relative std \u2264 10 %) by ',
         `${p.runs} runs in ${fmt(p.ship_hours, 1)} h of ship time`,
+        ` \u00b7 spread of ${p.realisations} simulated flight${p.realisations === 1 ? '' : 's'}`,
         ` \u00b7 ${p.method === 'parallel_ekf' ? 'parallel EKF' : '\u03bb-filter'} \u00b7 prior: ${priorText(p.prior)}`,
         p.geometric_mean_relative_std != null ? ` \u00b7 geometric mean relative std ${pct(p.geometric_mean_relative_std)}` : '',
         h('span', { class: 'muted' }, ` \u00b7 plan v${stored.plan_version}, ${fmtDate(stored.finished_at)}`)),
+      (() => {
+        const limited = p.parameters.filter((r) => r.structure_limited).length;
+        return limited ? h('p', { class: 'hint', 'data-testid': 'precision-structure' },
+          `${limited} parameter${limited === 1 ? ' is' : 's are'} limited by the model\u2019s structure rather than the noise: the identification will report a std over 3\u00d7 the spread; more runs of this plan will not sharpen ${limited === 1 ? 'it' : 'them'}.`) : null;
+      })(),
       h('h3', null, 'Weakest'),
       h('ol', { 'data-testid': 'precision-weakest' }, p.weakest.map((w) => h('li', null, w))),
       h('details', { class: 'sub', open: p.total <= 40 },
@@ -168,7 +178,7 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
         h('div', { class: 'row' }, labelled('Group', groupSel)),
         h('div', { class: 'table-wrap' },
           h('table', { class: 'grid-table', 'data-testid': 'precision-table' },
-            h('thead', null, h('tr', null, ['Parameter', 'Grid speed', 'Expected', 'Predicted std', 'Relative', 'Determined'].map((t) => h('th', null, t)))),
+            h('thead', null, h('tr', null, ['Parameter', 'Grid speed', 'Expected', 'Predicted std', 'Relative', 'Will be reported', 'Determined'].map((t) => h('th', null, t)))),
             tbody))),
       h('details', { class: 'sub' }, h('summary', null, 'How it was predicted'),
         h('ul', null, p.notes.map((n) => h('li', null, n)))));

@@ -30,10 +30,11 @@ test('predict the supply vessel plan\'s precision, then see it go stale after a 
     await form.waitFor();
     await page.locator(tid('precision-none')).waitFor();
     await page.locator(tid('precision-prior')).selectOption('reference');
+    await page.locator(tid('precision-realisations')).fill('4');
     await page.getByRole('button', { name: 'Predict precision' }).click();
     await page.locator(tid('precision-summary')).waitFor({ timeout: 120000 });
     const summary = await page.textContent(tid('precision-summary'));
-    assert.match(summary, /\d of 9 parameters determined \(relative std ≤ 10 %\) by 8 runs in \d+\.\d h of ship time · parallel EKF · prior: the source documents’ vessel/);
+    assert.match(summary, /\d of 9 parameters determined \(relative std ≤ 10 %\) by 8 runs in \d+\.\d h of ship time · spread of 4 simulated flights · parallel EKF · prior: the source documents’ vessel/);
     assert.equal(await page.locator(`${tid('precision-weakest')} li`).count(), 5);
     assert.match(await page.textContent(tid('precision-weakest')), /θ″\d \(\S+\): ±\S+ Bis \(\S+ % of /);
     assert.equal(await page.locator(tid('precision-row')).count(), 9);

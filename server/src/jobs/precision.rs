@@ -5,7 +5,8 @@
 //! as the job's result (read back by `GET /api/campaigns/{id}/precision`).
 
 use seatrial_core::design::{
-    DesignError, PrecisionPrediction, PredictSettings, Prior, PriorSource, predict_precision,
+    DesignError, MAX_REALISATIONS, PrecisionPrediction, PredictSettings, Prior, PriorSource,
+    predict_precision,
 };
 use seatrial_core::estimation::Progress;
 use seatrial_core::identification::document::ModelDocument;
@@ -41,6 +42,11 @@ pub struct PrecisionSettings {
     /// Seed of the simulated sensor noise (default 1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
+    /// Noise realisations flown and identified, 1–100 (default 20): the
+    /// predicted std is their spread, uncertain by ≈ 1/√(2(n − 1)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 1, maximum = 100)]
+    pub realisations: Option<usize>,
 }
 
 impl PrecisionSettings {
@@ -94,6 +100,14 @@ async fn checked(cx: &JobContext, req: &JobRequest) -> Result<Checked, ApiError>
     }
     let settings: PrecisionSettings =
         parse_settings(&req.settings).map_err(|(f, m)| ApiError::invalid(f, m))?;
+    if let Some(n) = settings.realisations
+        && !(1..=MAX_REALISATIONS).contains(&n)
+    {
+        return Err(ApiError::invalid(
+            "settings.realisations",
+            format!("must be between 1 and {MAX_REALISATIONS} (got {n})"),
+        ));
+    }
     let campaign = campaigns::get(&cx.db, cid)
         .await?
         .ok_or_else(|| ApiError::missing("campaign_id", format!("no campaign with id '{cid}'")))?;
@@ -199,6 +213,7 @@ impl JobHandler for Precision {
             };
             let choice = c.settings.prior(req);
             let seed = c.settings.seed.unwrap_or(1);
+            let realisations = c.settings.realisations;
             let (plan_id, plan_version) = (stored.id.clone(), stored.version);
             Ok(compute(move |progress: &mut dyn Progress| {
                 let (prior, source) = match (choice, c.model) {
@@ -211,9 +226,11 @@ impl JobHandler for Precision {
                     _ => (Prior::from_profile(&c.profile), PriorSource::Profile),
                 };
                 let prior = prior.map_err(failure)?;
+                let defaults = PredictSettings::default();
                 let settings = PredictSettings {
                     seed,
-                    ..PredictSettings::default()
+                    realisations: realisations.unwrap_or(defaults.realisations),
+                    ..defaults
                 };
                 let prediction =
                     predict_precision(&c.profile, &plan, &prior, source, &settings, progress)
