@@ -239,6 +239,15 @@ pub fn predict_precision(
             }
         })
         .collect();
+    // An entry the identification fixes in most realisations (reported std
+    // 0: a coupling the structure choice leaves out) is not a parameter of
+    // this plan's model.
+    let fixed = reported_median.iter().filter(|r| **r == Some(0.0)).count();
+    let (table, reported_median): (Vec<ParameterRow>, Vec<Option<f64>>) = table
+        .into_iter()
+        .zip(reported_median)
+        .filter(|(_, r)| *r != Some(0.0))
+        .unzip();
     let refs: Vec<&ParameterRow> = table.iter().collect();
     let mut scaled = scale_rows(profile, &refs);
     for (s, r) in scaled.iter_mut().zip(reported_median) {
@@ -280,6 +289,11 @@ pub fn predict_precision(
         },
         "a std assumes the prior is the vessel and the noise is as stated; waves, current or a mis-logged τ do worse".into(),
     ];
+    if fixed > 0 {
+        notes.push(format!(
+            "{fixed} matrix entries left out: the identification's structure fixes them (at zero or from M) in most realisations"
+        ));
+    }
     notes.extend(
         doc.structure_findings
             .iter()
