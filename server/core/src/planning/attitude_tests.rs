@@ -33,6 +33,31 @@ fn min_eigenvalue(a: &[Vec<f64>]) -> f64 {
 fn surveyor_plan_flown_by_the_simulator_stays_near_level_and_identifies() {
     let profile = surveyor_rov();
     let plan = generate_plan(&profile, &surveyor_campaign(7)).unwrap();
+    for code in ["DYN-2kn-roll-r1", "REC-2kn-r1", "VAL-r1"] {
+        let e = &plan
+            .experiments
+            .iter()
+            .find(|p| p.experiment.code == code)
+            .unwrap()
+            .experiment;
+        eprintln!("{code} ({:.1} s): {}", e.duration_s, e.instruction);
+        for c in e.channels.iter().filter(|c| c.excited) {
+            eprintln!(
+                "  {} ±{:.3} {} {:?} slew {:?}; PE {:?}/{:?}, band {:?}",
+                c.column,
+                c.amplitude,
+                c.unit,
+                c.waveform,
+                c.rate_limit,
+                c.analysis.as_ref().map(|a| a.pe_order),
+                c.analysis.as_ref().map(|a| a.pe_required),
+                c.analysis.as_ref().and_then(|a| a.band_hz),
+            );
+        }
+        for w in &e.warnings {
+            eprintln!("  warning: {w}");
+        }
+    }
     let truth = RovTruth::surveyor_like();
     let settings = TrialSettings {
         seed: 11,
