@@ -319,13 +319,15 @@ async fn bad_input_gets_a_clear_4xx_on_every_route() {
     );
 
     let mut c = rov_campaign(&vid);
+    // Roll is excited by attitude: its amplitude is an angle (rad), at most
+    // the profile's max_angle, 10° without one.
     c["excitation"] = json!({ "per_dof": { "roll": { "amplitude": 0.45 } } });
     let r = app.call("POST", "/api/campaigns", &[], Some(c)).await;
     assert_eq!(
         (r.status.as_u16(), r.json["field"].as_str()),
         (422, Some("excitation.per_dof.roll.amplitude"))
     );
-    assert_eq!(r.json["limit"], 0.3);
+    assert!((r.json["limit"].as_f64().unwrap() - 10f64.to_radians()).abs() < 1e-12);
 
     let mut c = rov_campaign(&vid);
     c["excitation"] = json!({ "per_dof": { "sway": { "clock_period_s": 500.0 } } });

@@ -5,7 +5,7 @@
 
 use seatrial_core::planning::{CampaignSpec, generate_plan};
 use seatrial_core::simulation::rov::RovTruth;
-use seatrial_core::simulation::trials::{TrialSettings, fly_experiment};
+use seatrial_core::simulation::trials::{MeasurementNoise, TrialSettings, fly_experiment};
 use serde_json::{Value, json};
 
 use super::{TestApp, rov_profile};
@@ -88,9 +88,17 @@ pub async fn flown_logs(
     let profile = seatrial_core::planning::examples::surveyor_rov();
     let core_spec: CampaignSpec = serde_json::from_value(spec).unwrap();
     let core_plan = generate_plan(&profile, &core_spec).unwrap();
+    // A fibre-optic gyro (±0.001 rad/s): roll and pitch are excited by
+    // attitude (±10° about level), so p and q move ≈ 0.03 rad/s (std) on a
+    // validation run, and a MEMS gyro's ±0.005 rad/s would put their
+    // held-out fits at the noise ceiling (≈ 0.75–0.8), where discovery's
+    // absolute tolerance of 0.005 in fit is below the fit's own noise.
+    let mut noise = MeasurementNoise::default();
+    noise.nu[3..6].fill(0.001);
     let settings = TrialSettings {
         max_duration_s: Some(240.0),
         seed: 3,
+        noise,
         ..TrialSettings::default()
     };
     let logs = core_plan

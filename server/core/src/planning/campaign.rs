@@ -128,7 +128,10 @@ pub enum SignalKind {
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 #[serde(rename_all = "snake_case")]
 pub enum Quantity {
-    /// Velocity references ν_ref flown with the vessel's controllers (the thesis).
+    /// Velocity references ν_ref flown with the vessel's controllers (the
+    /// thesis); roll and pitch are excited by attitude references φ_ref,
+    /// θ_ref about level (a rate reference would integrate to large angles
+    /// on a metacentrically stable vehicle).
     #[default]
     Velocity,
     /// Open-loop generalized forces τ (N, N·m).
@@ -143,7 +146,10 @@ pub struct DofExcitation {
     /// Signal shape for this DOF.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub signal: Option<SignalKind>,
-    /// Amplitude about the operating point (SI: m/s, rad/s, N or N·m).
+    /// Amplitude about the operating point (SI: m/s, rad/s, N or N·m). Roll
+    /// and pitch under velocity references are excited by attitude: an
+    /// angle about level (rad), at most the profile's `max_angle` (10°
+    /// without one); default 10° or `max_angle` when smaller.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub amplitude: Option<f64>,
     /// PRBS / random-binary clock period (s); square-wave half period.

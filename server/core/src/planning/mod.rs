@@ -22,4 +22,6 @@ pub use plan::{Experiment, Plan, PlanTotals, PlannedExperiment, Schedule, genera
 pub use vessel::VesselProfile;
 
 #[cfg(test)]
+mod attitude_tests;
+#[cfg(test)]
 mod tests;

@@ -10,6 +10,9 @@ use super::campaign::{CampaignSpec, ExperimentFamily, Quantity, SignalKind, Spee
 use super::design::{ChannelRequest, MAX_SEED, SQUARE_HOLD_TIME_CONSTANTS, design_channel};
 use super::dof::{Dof, KNOT};
 use super::error::PlanError;
+use super::statics::{
+    ATTITUDE_LOOP_TIME_CONSTANTS, attitude_column, attitude_limit, holds_attitude, static_angle,
+};
 use super::vessel::{ThrusterKind, VesselKind, VesselProfile};
 use super::waveform::Waveform;
 use crate::rng::mix;
@@ -24,7 +27,8 @@ pub const NYQUIST_WARNING_FRACTION: f64 = 0.05;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 pub struct ChannelPlan {
-    /// CSV column: `u_ref`…`r_ref` (velocity), `tau_Y`… (force), `thr_1`… (thrusters).
+    /// CSV column: `u_ref`…`r_ref` (velocity), `phi_ref`, `theta_ref`
+    /// (roll and pitch attitude), `tau_Y`… (force), `thr_1`… (thrusters).
     pub column: String,
     /// SI unit of the column.
     pub unit: String,
@@ -212,9 +216,53 @@ impl Ctx<'_> {
         }
     }
 
-    /// Amplitude of a non-surge DOF, checked against its limit.
+    /// True when `d` is excited by an attitude reference (`phi_ref`,
+    /// `theta_ref`) in dynamic, recursive and validation runs: roll and
+    /// pitch under velocity references. A rate reference p_ref, q_ref on a
+    /// metacentrically stable vehicle integrates to a random walk of
+    /// attitude (25–45° on the Surveyor), far outside the linear model; an
+    /// attitude square wave or PRBS about level stays within ±A while the
+    /// attitude loop moves the rate at every switch.
+    pub(super) fn excites_attitude(&self, d: Dof) -> bool {
+        holds_attitude(d) && self.quantity() == Quantity::Velocity
+    }
+
+    /// Column, unit, clip limit, slew limit (and its field) of `d`'s
+    /// excited channel: an attitude for roll and pitch under velocity
+    /// references (slewed at no more than the DOF's rate limit), else the
+    /// DOF's velocity or force channel.
+    pub(super) fn excitation_channel(&self, d: Dof) -> (String, String, f64, Option<f64>, String) {
+        if self.excites_attitude(d) {
+            (
+                attitude_column(d).to_string(),
+                "rad".to_string(),
+                attitude_limit(self.vessel, d),
+                Some(self.vessel.limit(d).max_velocity),
+                format!("limits.{}.max_velocity", d.name()),
+            )
+        } else {
+            self.dof_channel(d)
+        }
+    }
+
+    /// Time constant of the response an excited channel of `d` drives: the
+    /// attitude loop's ([`ATTITUDE_LOOP_TIME_CONSTANTS`] · T) for an
+    /// attitude reference, else the DOF's T.
+    pub(super) fn excitation_time_constant(&self, d: Dof) -> f64 {
+        let t = self.vessel.limit(d).time_constant_s;
+        if self.excites_attitude(d) {
+            ATTITUDE_LOOP_TIME_CONSTANTS * t
+        } else {
+            t
+        }
+    }
+
+    /// Amplitude of a non-surge DOF's excitation, checked against its
+    /// limit: for an attitude, ±10° or the profile's `max_angle` when
+    /// smaller (as static holds), at most `max_angle` (10° without one);
+    /// else `amplitude_fraction` of the DOF's limit.
     pub(super) fn amplitude(&self, d: Dof) -> Result<f64, PlanError> {
-        let (_, unit, limit, _, _) = self.dof_channel(d);
+        let (_, unit, limit, _, _) = self.excitation_channel(d);
         match self.override_of(d).and_then(|o| o.amplitude) {
             Some(a) => check_amplitude(
                 &format!("excitation.per_dof.{}.amplitude", d.name()),
@@ -222,6 +270,7 @@ impl Ctx<'_> {
                 limit,
                 &unit,
             ),
+            None if self.excites_attitude(d) => Ok(static_angle(self.vessel, d)),
             None => Ok(self.spec.excitation.amplitude_fraction * limit),
         }
     }
@@ -280,7 +329,7 @@ impl Ctx<'_> {
         seed: u64,
         channel: (usize, usize),
     ) -> Result<ChannelSpec, PlanError> {
-        let (column, unit, limit, rate, rate_field) = self.dof_channel(d);
+        let (column, unit, limit, rate, rate_field) = self.excitation_channel(d);
         let (amplitude, offset) = if d == Dof::Surge {
             self.surge_excursion(u0)?
         } else {
@@ -291,7 +340,7 @@ impl Ctx<'_> {
         let design = design_channel(&ChannelRequest {
             field: &field,
             signal,
-            time_constant_s: self.vessel.limit(d).time_constant_s,
+            time_constant_s: self.excitation_time_constant(d),
             amplitude,
             rate_limit: rate,
             rate_field: &rate_field,
@@ -512,11 +561,22 @@ pub(super) fn assemble(
                 ));
             }
             if let (Some(d), Some([_, hi])) = (p.dof, a.band_hz) {
-                let corner =
-                    1.0 / (2.0 * std::f64::consts::PI * ctx.vessel.limit(d).time_constant_s);
+                // An attitude reference drives the attitude loop, whose
+                // corner lies below the DOF's.
+                let attitude = p.column == attitude_column(d) && holds_attitude(d);
+                let t = ctx.vessel.limit(d).time_constant_s;
+                let (t, what) = if attitude {
+                    (
+                        ATTITUDE_LOOP_TIME_CONSTANTS * t,
+                        "attitude-loop corner frequency 1/(2π·2T)",
+                    )
+                } else {
+                    (t, "corner frequency 1/(2πT)")
+                };
+                let corner = 1.0 / (2.0 * std::f64::consts::PI * t);
                 if p.waveform.is_dynamic() && hi < corner {
                     warnings.push(format!(
-                        "{}: usable band ends at {hi:.3} Hz, below the {} corner frequency 1/(2πT) = {corner:.3} Hz; a shorter clock would excite the dynamics better",
+                        "{}: usable band ends at {hi:.3} Hz, below the {} {what} = {corner:.3} Hz; a shorter clock would excite the dynamics better",
                         p.column,
                         d.name()
                     ));
@@ -563,6 +623,50 @@ pub(super) fn fmt_speed(ctx: &Ctx<'_>, gi: usize) -> String {
     )
 }
 
+/// What the pilot does in a dynamic roll or pitch run excited by attitude:
+/// hold +A, then −A, switching as the schedule says.
+fn attitude_words(d: Dof, p: &ChannelPlan) -> String {
+    let (name, col, a) = (d.name(), &p.column, p.amplitude);
+    let deg = a.to_degrees();
+    let switching = match &p.waveform {
+        Waveform::Square { period_s } => format!("switching every {:.0} s", period_s / 2.0),
+        Waveform::Prbs { clock_period_s, .. } => format!(
+            "switching as the {col} schedule says (a PRBS: each level held a whole number of {clock_period_s:.0} s chips)"
+        ),
+        Waveform::RandomBinary { clock_period_s, .. } => format!(
+            "switching as the {col} schedule says (random levels, each held a whole number of {clock_period_s:.0} s chips)"
+        ),
+        _ => format!("moving between them as the {col} schedule says"),
+    };
+    let slew = p.rate_limit.map_or(String::new(), |r| {
+        format!(", bringing it over at no more than {r:.2} rad/s")
+    });
+    format!(
+        "hold {name} at +{deg:.0}°, then −{deg:.0}° (±{a:.3} rad about level) by attitude control, {switching}{slew}: the {name} rate moves at every switch, the attitude never leaves ±{deg:.0}°"
+    )
+}
+
+/// The run sheet's note on roll and pitch in runs that excite every DOF.
+fn attitude_note(ctx: &Ctx<'_>) -> String {
+    let parts: Vec<String> = ctx
+        .vessel
+        .dofs
+        .iter()
+        .filter(|&&d| ctx.excites_attitude(d))
+        .map(|&d| {
+            let deg = ctx.amplitude(d).unwrap_or(0.0).to_degrees();
+            format!("{} between +{deg:.0}° and −{deg:.0}°", d.name())
+        })
+        .collect();
+    if parts.is_empty() {
+        return String::new();
+    }
+    format!(
+        " Roll and pitch references are attitudes ({}): hold them there by attitude control, never as a rate.",
+        parts.join(", ")
+    )
+}
+
 /// Dynamic runs (Tables 3.4–3.5): one DOF excited about the grid speed.
 fn rov_dynamic(
     ctx: &Ctx<'_>,
@@ -582,6 +686,12 @@ fn rov_dynamic(
                     "Alternate the forward speed about {} following the u_ref schedule (±{:.3} m/s); no other motion.",
                     fmt_speed(ctx, gi),
                     ex.plan.amplitude
+                )
+            } else if ctx.excites_attitude(d) {
+                format!(
+                    "At a constant {}, {}; no other motion.",
+                    fmt_speed(ctx, gi),
+                    attitude_words(d, &ex.plan)
                 )
             } else {
                 format!(
@@ -657,8 +767,9 @@ fn rov_recursive(
                 sign: None,
                 repetition: rep,
                 instruction: format!(
-                    "Fly about {} and follow the references on all DOFs at once (Table 3.1).",
-                    fmt_speed(ctx, gi)
+                    "Fly about {} and follow the references on all DOFs at once (Table 3.1).{}",
+                    fmt_speed(ctx, gi),
+                    attitude_note(ctx)
                 ),
                 pe_required: pe_required(ExperimentFamily::Recursive, dofs.len()),
                 field: "excitation".into(),
@@ -912,6 +1023,12 @@ fn validation(ctx: &Ctx<'_>, reps: u32, out: &mut Vec<PlannedExperiment>) -> Res
                 for (i, &d) in dofs.iter().enumerate() {
                     let mut p = ctx.held(d, ctx.speeds[0]);
                     p.excited = true;
+                    let mut clock = ctx.vessel.limit(d).time_constant_s;
+                    if ctx.excites_attitude(d) {
+                        let (column, unit, limit, rate, _) = ctx.excitation_channel(d);
+                        (p.column, p.unit, p.limit, p.rate_limit) = (column, unit, limit, rate);
+                        clock = ctx.excitation_time_constant(d);
+                    }
                     if d == Dof::Surge {
                         p.waveform = Waveform::Staircase {
                             levels: ctx.speeds.clone(),
@@ -923,7 +1040,7 @@ fn validation(ctx: &Ctx<'_>, reps: u32, out: &mut Vec<PlannedExperiment>) -> Res
                         p.waveform = Waveform::ConstantThenRandom {
                             segment_s: segment,
                             constant_fraction: 0.4,
-                            clock_period_s: ctx.vessel.limit(d).time_constant_s,
+                            clock_period_s: clock,
                             seed: mix(seed ^ i as u64) & MAX_SEED,
                         };
                     }
@@ -937,9 +1054,10 @@ fn validation(ctx: &Ctx<'_>, reps: u32, out: &mut Vec<PlannedExperiment>) -> Res
         };
         let instruction = match ctx.vessel.kind {
             VesselKind::Rov6 => format!(
-                "Validation (never used for fitting): step the forward speed through every grid speed; in each step hold all other DOFs still for the first 40 %, then follow their changing references. Covers {:.3}–{:.3} m/s.",
+                "Validation (never used for fitting): step the forward speed through every grid speed; in each step hold all other DOFs still for the first 40 %, then follow their changing references. Covers {:.3}–{:.3} m/s.{}",
                 ctx.speeds[0],
-                ctx.speeds[n_grid - 1]
+                ctx.speeds[n_grid - 1],
+                attitude_note(ctx)
             ),
             VesselKind::Dp3 => "Validation (never used for fitting): drive all thruster groups together with independent random-binary schedules.".to_string(),
         };

@@ -33,11 +33,17 @@ use super::waveform::Waveform;
 /// almost as upright.
 pub const STATIC_ATTITUDE_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
 
+/// Time constant of the attitude loop (the pilot's or autopilot's), in
+/// time constants T of the DOF: taken twice as slow as the rate response
+/// below it. It sets the clock of dynamic attitude excitation (a PRBS chip
+/// lasts one attitude time constant, a square-wave level five) as T sets a
+/// rate or speed channel's.
+pub const ATTITUDE_LOOP_TIME_CONSTANTS: f64 = 2.0;
+
 /// Settling allowance of an attitude hold, in time constants of the DOF:
-/// the pilot's (or autopilot's) attitude loop is taken twice as slow as
-/// the rate response below it, so a hold settles within twice the 5·T of a
-/// rate hold.
-pub const ATTITUDE_SETTLE_TIME_CONSTANTS: f64 = 2.0 * SQUARE_HOLD_TIME_CONSTANTS;
+/// 5 time constants of the attitude loop, twice the 5·T of a rate hold.
+pub const ATTITUDE_SETTLE_TIME_CONSTANTS: f64 =
+    ATTITUDE_LOOP_TIME_CONSTANTS * SQUARE_HOLD_TIME_CONSTANTS;
 
 /// True for the DOFs whose static runs hold an attitude.
 pub fn holds_attitude(d: Dof) -> bool {
@@ -59,6 +65,14 @@ pub fn static_angle(vessel: &VesselProfile, d: Dof) -> f64 {
         .limit(d)
         .max_angle
         .map_or(STATIC_ATTITUDE_RAD, |m| m.min(STATIC_ATTITUDE_RAD))
+}
+
+/// Largest attitude amplitude of roll or pitch (rad): the profile's
+/// `max_angle`, or 10° when it sets none. Dynamic runs excite roll and
+/// pitch between ±[`static_angle`] by default; a per-DOF amplitude may go
+/// up to this.
+pub fn attitude_limit(vessel: &VesselProfile, d: Dof) -> f64 {
+    vessel.limit(d).max_angle.unwrap_or(STATIC_ATTITUDE_RAD)
 }
 
 fn signed(sign: i8) -> &'static str {

@@ -242,9 +242,11 @@ fn impossible_requests_name_the_field_and_limit() {
             ..Default::default()
         },
     );
+    // Roll is excited by attitude: its amplitude is an angle, at most the
+    // profile's max_angle (10° without one), not the 0.3 rad/s rate limit.
     let e = generate_plan(&rov, &c).unwrap_err();
     assert_eq!(e.field, "excitation.per_dof.roll.amplitude");
-    assert_eq!(e.limit, Some(0.3));
+    assert_eq!(e.limit, Some(super::statics::STATIC_ATTITUDE_RAD));
 
     let mut c = rov_campaign();
     c.excitation.per_dof.insert(

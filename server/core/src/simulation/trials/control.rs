@@ -13,8 +13,10 @@ pub const BANDWIDTH_PER_TIME_CONSTANT: f64 = 2.0;
 /// Time constant of the attitude loop in units of the DOF's T̂: twice as
 /// slow as T̂, four times slower than the rate loop below it, so a hold
 /// settles (1 %) within ≈ 9·T̂ — inside the planner's allowance of 10·T̂
-/// ([`crate::planning::statics::ATTITUDE_SETTLE_TIME_CONSTANTS`]).
-pub const ATTITUDE_TIME_CONSTANTS: f64 = 2.0;
+/// ([`crate::planning::statics::ATTITUDE_SETTLE_TIME_CONSTANTS`]). The
+/// planner's assumption, which sets the clock of dynamic attitude
+/// excitation ([`crate::planning::statics::ATTITUDE_LOOP_TIME_CONSTANTS`]).
+pub const ATTITUDE_TIME_CONSTANTS: f64 = crate::planning::statics::ATTITUDE_LOOP_TIME_CONSTANTS;
 
 /// The velocity controller of one DOF: a discrete PI designed on the nominal
 /// first-order model m̂ ν̇ + d̂ ν = τ taken from the profile's limits alone

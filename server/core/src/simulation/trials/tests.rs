@@ -150,7 +150,12 @@ fn replaying_the_commanded_tau_through_the_truth_simulator_gives_the_same_flight
         ..quiet()
     };
     let run = fly_experiment(&profile, &truth, planned, &s).unwrap();
-    let nu0: [f64; 6] = std::array::from_fn(|i| run.nu_ref[(0, i)]);
+    // The flight starts at the first velocity references; roll and pitch,
+    // flown by attitude (whose loop asks for a rate at once), start at rest.
+    let nu0: [f64; 6] = std::array::from_fn(|i| match run.drives[i] {
+        Drive::Velocity(_) => run.nu_ref[(0, i)],
+        _ => 0.0,
+    });
     let cfg = SimConfig {
         h: 1.0 / profile.controller_rate_hz,
         substeps: s.substeps,
