@@ -6,27 +6,24 @@
 //! empirical spread of every parameter against the std
 //! `design::predict_precision` predicts with a prior equal to the vessel.
 //!
-//! The issue's goal — empirical spread within 1.5× of the predicted std
-//! for ≥ 90 % of the parameters — is NOT met: 2 % (median
-//! empirical/predicted 0.075). Not because the posterior is overconfident
-//! (the std the identification reports on the truth's runs is above the
-//! spread for every parameter, median spread/reported 0.014), but because
-//! the λ posterior std — and so the prediction — is set by the pooled
-//! residual variance, which here is deterministic equation error, not
-//! noise: on the project's own simulator the noise-free std equals the
-//! noisy one, and its own noise spread is 0.03× the std (median). Most of
-//! that error comes from the plan's recursive (REC) runs: their roll/pitch
-//! RATE references (PRBS ±0.15 rad/s) integrate to φ ≈ 1.4 rad, θ ≈ 1.2 rad
-//! on the project's simulator and to an inverted vehicle (φ ≈ 3.1 rad) on
-//! the truth. Without the REC family (`--no-recursive` in the example):
-//! 37 % within 1.5×, median 0.90; the rest splits into misfit still in the
-//! std (own-simulator spread/predicted median 0.56) and the truth's larger
-//! noise spread (1.6× the project's simulator's: its autopilot acts on
-//! noisy measurements, the project's on noise-free ν).
-//! The goal is kept as an ignored test; the live test asserts what holds —
-//! neither the prediction nor the reported std understates the spread.
-//! `cargo run --release -p seatrial-core --example precision_table -- 20 --own [--no-recursive]`
-//! prints the full table with the project's own simulator's noise spread.
+//! Measured (20 seeds): the prediction is the spread of 20 flights of the
+//! plan by the project's own simulator, its controller reading noisy
+//! sensors. 50 % of the 296 parameters have an empirical spread within 1.5×
+//! of it (median empirical/predicted 0.72), and for 94 % the spread is at
+//! most 1.5× the prediction: the prediction rarely promises more precision
+//! than the truth delivers. The issue's goal (≥ 90 % within 1.5× either
+//! way) is not met. The two closed loops differ: the truth's 20 Hz
+//! autopilot (PI on u, v, w, r; PD on φ, θ without an integral and with a
+//! nominal ĝ 20–40 % off; commands logged every second sample) is not the
+//! project's PI/attitude loop, and the noise that feeds back through each
+//! moves the vehicle differently — most of the parameters under-predicted
+//! are the pitch row (D̄[pitch,·], b[pitch]) that the truth's pitch loop
+//! holds least stiffly. The std the identification reports on the truth's
+//! runs is 8× the prediction (median): the linear LPV model's misfit to the
+//! truth's nonlinear plant, which the prediction shows as the *reported*
+//! std beside its spread.
+//! `cargo run --release -p seatrial-core --example precision_table -- 20 [--own] [--no-recursive]`
+//! prints the table.
 
 #[path = "support/precision_truth.rs"]
 mod precision_truth;
@@ -65,13 +62,23 @@ fn comparisons() -> &'static Vec<Comparison> {
     })
 }
 
-/// What holds: neither the prediction nor the std the identification
-/// reports on the truth's runs understates the spread over noise seeds.
+/// What holds: the prediction is centred on the truth's spread (median
+/// empirical/predicted within [1/1.5, 1.5]) and rarely promises more
+/// precision than the truth gives (spread ≤ 1.5× the prediction for ≥ 90 %
+/// of the parameters); the std the identification reports on the truth's
+/// runs never understates the spread.
 #[test]
-fn predicted_and_reported_std_bound_the_truths_noise_spread() {
+fn prediction_is_centred_and_does_not_overstate_the_truths_precision() {
     let c = comparisons();
     let live: Vec<&Comparison> = c.iter().filter(|c| !c.structural_zero()).collect();
     assert!(live.len() > 250, "{} parameters compared", live.len());
+    let mut ratios: Vec<f64> = live.iter().map(|c| c.ratio()).collect();
+    ratios.sort_by(f64::total_cmp);
+    let median = ratios[ratios.len() / 2];
+    assert!(
+        (1.0 / FACTOR..=FACTOR).contains(&median),
+        "median empirical/predicted {median}"
+    );
     let bounded = live.iter().filter(|c| c.ratio() <= FACTOR).count();
     assert!(
         bounded as f64 >= 0.9 * live.len() as f64,
@@ -91,7 +98,7 @@ fn predicted_and_reported_std_bound_the_truths_noise_spread() {
 /// Issue 15's goal: empirical spread within 1.5× of the predicted std for
 /// ≥ 90 % of the parameters. Not met (see the module docs).
 #[test]
-#[ignore = "issue 15's goal is not met (2 %): the λ posterior std is set by deterministic equation error (mostly the REC runs' large attitudes), ≈ 13× the noise spread (median)"]
+#[ignore = "issue 15's goal is not met (50 % within 1.5×): the truth's autopilot and the project's controller pass the sensor noise through differently (see the module docs)"]
 fn empirical_spread_matches_the_predicted_std() {
     let c = comparisons();
     let live: Vec<&Comparison> = c.iter().filter(|c| !c.structural_zero()).collect();
