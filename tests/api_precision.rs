@@ -139,6 +139,24 @@ async fn unusable_precision_requests_are_422_naming_the_field() {
         let got = r.json["field"].as_str().unwrap_or("");
         assert!(got.starts_with(field), "{body}: field {got}, {}", r.text);
     }
+    // A plan without a validation run cannot be identified, so not predicted.
+    let (bare, _) = planned_campaign(
+        &app,
+        common::rov_profile(),
+        json!({ "name": "no validation", "grid": { "unit": "kn", "speeds": [1.0] }, "families": ["dynamic"], "seed": 5 }),
+    )
+    .await;
+    let r = app
+        .call(
+            "POST",
+            "/api/jobs",
+            &[],
+            Some(json!({ "kind": "precision", "campaign_id": bare })),
+        )
+        .await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    assert_eq!(r.json["field"], "campaign_id");
+    assert!(r.text.contains("no validation run"), "{}", r.text);
     // A prior model of another vessel is refused.
     let other = planned_campaign(
         &app,

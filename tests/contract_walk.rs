@@ -51,7 +51,8 @@ async fn stored_discrepancy(app: &TestApp, cid: &str, mid: &str) -> String {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn every_documented_operation_is_exercised_and_answers() {
-    let app = TestApp::with_jobs(common::jobs::registry(), common::jobs::config(1)).await;
+    let registry = common::jobs::registry().with("precision", seatrial::jobs::precision::Precision);
+    let app = TestApp::with_jobs(registry, common::jobs::config(1)).await;
     let r = app
         .call("POST", "/api/vessels", &[], Some(rov_profile()))
         .await;
@@ -59,7 +60,7 @@ async fn every_documented_operation_is_exercised_and_answers() {
     let campaign = json!({
         "vessel_id": vid, "name": "walk", "seed": 3,
         "grid": { "unit": "kn", "speeds": [1.0, 2.0] },
-        "families": ["static", "dynamic"]
+        "families": ["static", "dynamic", "validation"]
     });
     let r = app
         .call("POST", "/api/campaigns", &[], Some(campaign.clone()))
@@ -230,6 +231,15 @@ async fn every_documented_operation_is_exercised_and_answers() {
                     app.call("POST", "/api/jobs/{id}/cancel", &[&id], None)
                         .await;
                     r
+                }
+                // A prediction exists once a precision job has run.
+                ("get", "/api/campaigns/{id}/precision") => {
+                    let body = json!({ "kind": "precision", "campaign_id": cid, "settings": { "prior": "reference", "realisations": 1 } });
+                    let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
+                    assert_eq!(r.status, 202, "{}", r.text);
+                    let done = common::wait_for_job(&app, r.json["id"].as_str().unwrap(), 120).await;
+                    assert_eq!(done["state"], "succeeded", "{done}");
+                    app.call("GET", template, &args, None).await
                 }
                 ("get", "/api/models/compare") => {
                     app.call(

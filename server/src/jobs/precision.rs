@@ -10,7 +10,7 @@ use seatrial_core::design::{
 };
 use seatrial_core::estimation::Progress;
 use seatrial_core::identification::document::ModelDocument;
-use seatrial_core::planning::{Plan, PlannedExperiment};
+use seatrial_core::planning::{ExperimentFamily, Plan, PlannedExperiment};
 use serde::{Deserialize, Serialize};
 
 use super::handler::{BoxFuture, Compute, JobContext, JobFailure, JobHandler, compute};
@@ -114,12 +114,25 @@ async fn checked(cx: &JobContext, req: &JobRequest) -> Result<Checked, ApiError>
     let vessel = vessels::get(&cx.db, &campaign.vessel_id)
         .await?
         .ok_or_else(|| ApiError::missing("campaign_id", "the campaign's vessel is gone"))?;
-    if plans::latest(&cx.db, cid).await?.is_none() {
+    let Some(plan) = plans::latest(&cx.db, cid).await? else {
         return Err(ApiError::invalid(
             "campaign_id",
             format!(
                 "campaign '{}' has no plan yet; generate one (POST /api/campaigns/{cid}/plan) first",
                 campaign.spec.name
+            ),
+        ));
+    };
+    if !plan
+        .experiments
+        .iter()
+        .any(|e| e.experiment.family == ExperimentFamily::Validation)
+    {
+        return Err(ApiError::invalid(
+            "campaign_id",
+            format!(
+                "plan v{} of campaign '{}' has no validation run, and the identification holds one out; add the validation family (re-plan) to predict its precision",
+                plan.version, campaign.spec.name
             ),
         ));
     }

@@ -13,7 +13,7 @@ use crate::identification::{
 };
 use crate::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
 use crate::planning::dof::Dof;
-use crate::planning::{Plan, PlannedExperiment, VesselProfile};
+use crate::planning::{ExperimentFamily, Plan, PlannedExperiment, VesselProfile};
 use crate::rng::mix;
 use crate::simulation::dp_ship::{DpFlightSettings, fly_dp_campaign};
 use crate::simulation::trials::{Feedback, MeasurementNoise, TrialSettings, fly_campaign};
@@ -157,6 +157,16 @@ pub fn predict_precision(
         return Err(DesignError::new(
             "settings.realisations",
             format!("must be between 1 and {MAX_REALISATIONS} (got {n})"),
+        ));
+    }
+    if !plan
+        .experiments
+        .iter()
+        .any(|p| p.experiment.family == ExperimentFamily::Validation)
+    {
+        return Err(DesignError::new(
+            "plan",
+            "the plan has no validation run, and the identification holds one out; add the validation family (re-plan) to predict it",
         ));
     }
     let seeds: Vec<u64> = (0..n as u64)
