@@ -642,7 +642,7 @@ fn attitude_words(d: Dof, p: &ChannelPlan) -> String {
         format!(", bringing it over at no more than {r:.2} rad/s")
     });
     format!(
-        "hold {name} at +{deg:.0}°, then −{deg:.0}° (±{a:.3} rad about level) by attitude control, {switching}{slew}: the {name} rate moves at every switch, the attitude never leaves ±{deg:.0}°"
+        "hold {name} at +{deg:.0}°, then −{deg:.0}° (±{a:.3} rad about level) by attitude control, {switching}{slew}: the {name} rate moves at every switch, the attitude stays within about ±{deg:.0}°"
     )
 }
 
