@@ -181,6 +181,7 @@ pub fn predict_precision(
     // Realisations are independent: two at a time on scoped threads, the
     // progress reported between pairs.
     let mut done: Vec<Realisation> = Vec::with_capacity(n);
+    let mut failed: Vec<DesignError> = Vec::new();
     for (b, batch) in seeds.chunks(2).enumerate() {
         progress
             .update(
@@ -207,8 +208,20 @@ pub fn predict_precision(
                 .collect()
         });
         for r in out {
-            done.push(r?);
+            match r {
+                Ok(r) => done.push(r),
+                Err(DesignError::Cancelled) => return Err(DesignError::Cancelled),
+                Err(e) => failed.push(e),
+            }
         }
+    }
+    // One unlucky realisation does not sink the prediction; most failing
+    // means the plan or the prior is at fault.
+    if done.is_empty() || done.len() * 2 < n {
+        return Err(failed
+            .into_iter()
+            .next()
+            .unwrap_or_else(|| DesignError::new("plan", "no realisation could be identified")));
     }
     progress
         .update(0.99, "tabulating")
@@ -244,7 +257,7 @@ pub fn predict_precision(
             });
             ParameterRow {
                 value: if vals.is_empty() { p.value } else { mean },
-                std: if n > 1 { spread } else { median },
+                std: if done.len() > 1 { spread } else { median },
                 ..p.clone()
             }
         })
@@ -299,6 +312,12 @@ pub fn predict_precision(
         },
         "a std assumes the prior is the vessel and the noise is as stated; waves, current or a mis-logged τ do worse".into(),
     ];
+    if let Some(e) = failed.first() {
+        notes.push(format!(
+            "{} of {n} realisations could not be identified and were left out (first: {e})",
+            failed.len()
+        ));
+    }
     if fixed > 0 {
         notes.push(format!(
             "{fixed} matrix entries left out: the identification's structure fixes them (at zero or from M) in most realisations"
@@ -314,7 +333,7 @@ pub fn predict_precision(
         source,
         plan.totals.total_time_s / 3600.0,
         runs,
-        n,
+        done.len(),
         &scaled,
         notes,
     ))
