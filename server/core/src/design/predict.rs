@@ -94,7 +94,7 @@ fn realise(
     let identified = match prior {
         Prior::Rov(_) => identify_lambda_campaign(
             profile,
-            &grid_speeds(plan),
+            &plan.grid_speeds(),
             &inputs,
             &runs,
             &LambdaCampaignSettings::default(),
@@ -377,18 +377,6 @@ fn run_input(
         excited_dofs: e.dofs.clone(),
         record,
     })
-}
-
-/// The plan's grid speeds, ascending.
-fn grid_speeds(plan: &Plan) -> Vec<f64> {
-    let mut g: Vec<f64> = plan
-        .experiments
-        .iter()
-        .filter_map(|p| p.experiment.grid_speed_mps)
-        .collect();
-    g.sort_by(f64::total_cmp);
-    g.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
-    g
 }
 
 /// Each row with the magnitude its std is measured against (module docs

@@ -117,13 +117,7 @@ fn surveyor_plan_flown_by_the_simulator_stays_near_level_and_identifies() {
         })
         .collect();
     let inputs = input_columns(&profile);
-    let mut grid: Vec<f64> = plan
-        .experiments
-        .iter()
-        .filter_map(|p| p.experiment.grid_speed_mps)
-        .collect();
-    grid.sort_by(f64::total_cmp);
-    grid.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    let grid = plan.grid_speeds();
     // A dynamic attitude excitation switches many times: the data read it
     // as a dynamic roll or pitch run, not as a static hold (one step).
     for r in runs.iter().filter(|r| {

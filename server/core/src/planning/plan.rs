@@ -148,6 +148,20 @@ pub struct Plan {
     pub totals: PlanTotals,
 }
 
+impl Plan {
+    /// The grid speeds its experiments are flown at (m/s), ascending, each once.
+    pub fn grid_speeds(&self) -> Vec<f64> {
+        let mut g: Vec<f64> = self
+            .experiments
+            .iter()
+            .filter_map(|p| p.experiment.grid_speed_mps)
+            .collect();
+        g.sort_by(f64::total_cmp);
+        g.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        g
+    }
+}
+
 fn run_seed(seed: u64, family: ExperimentFamily, grid: usize, dof: usize, rep: u32) -> u64 {
     let mut h = mix(seed);
     for v in [family as u64, grid as u64, dof as u64, u64::from(rep)] {

@@ -184,14 +184,7 @@ fn rows(doc: &seatrial_core::identification::document::ModelDocument) -> Vec<&Pa
 
 /// The plan's grid speeds, ascending.
 pub fn grid(plan: &Plan) -> Vec<f64> {
-    let mut g: Vec<f64> = plan
-        .experiments
-        .iter()
-        .filter_map(|p| p.experiment.grid_speed_mps)
-        .collect();
-    g.sort_by(f64::total_cmp);
-    g.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
-    g
+    plan.grid_speeds()
 }
 
 /// One seed's estimates: per key the value and the reported std.
