@@ -355,7 +355,7 @@ fn pair(
         .collect()
 }
 
-fn run_input(
+pub(super) fn run_input(
     profile: &VesselProfile,
     planned: &PlannedExperiment,
     csv: &str,
@@ -461,6 +461,6 @@ fn identify_error(e: IdentifyError) -> DesignError {
     )
 }
 
-fn cancelled() -> DesignError {
+pub(super) fn cancelled() -> DesignError {
     DesignError::Cancelled
 }

@@ -129,3 +129,37 @@ fn rough_profile_prior_flies_and_predicts() {
         }
     }
 }
+
+/// The information of independent runs adds: flying every experiment twice
+/// lowers the D criterion by ln 2 (the same schedules flown again give
+/// exactly twice the Gram matrices; the planner's repetitions differ only
+/// in their PRBS seeds, so within a few per cent).
+#[test]
+fn repeating_the_plan_lowers_the_d_criterion_by_ln_2() {
+    use super::information::{InformationCache, Scaling, d_criterion, plan_information};
+    let profile = surveyor_rov();
+    let spec = surveyor_campaign(7);
+    let plan = generate_plan(&profile, &spec).unwrap();
+    let Prior::Rov(truth) = Prior::reference(&profile).unwrap() else {
+        panic!("the Surveyor's prior is an ROV")
+    };
+    let mut cache = InformationCache::default();
+    let info = plan_information(&profile, &plan, &truth, &mut cache).unwrap();
+    let flown = cache.flown;
+    let scaling = Scaling::of(&info, &plan.grid_speeds()).unwrap();
+    let d1 = d_criterion(&profile, &info, &scaling).unwrap();
+    // Flying the same plan again is served from the cache.
+    let again = plan_information(&profile, &plan, &truth, &mut cache).unwrap();
+    assert_eq!(cache.flown, flown);
+    assert_eq!(d_criterion(&profile, &again, &scaling).unwrap(), d1);
+    let mut twice = spec.clone();
+    twice.repetitions = Some(2);
+    let plan2 = generate_plan(&profile, &twice).unwrap();
+    let info2 = plan_information(&profile, &plan2, &truth, &mut cache).unwrap();
+    let d2 = d_criterion(&profile, &info2, &scaling).unwrap();
+    let drop = d1 - d2;
+    assert!(
+        (drop - std::f64::consts::LN_2).abs() < 0.03 * std::f64::consts::LN_2,
+        "D fell by {drop}, expected ln 2"
+    );
+}

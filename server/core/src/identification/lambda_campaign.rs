@@ -16,7 +16,8 @@ use super::intersample::{correct_estimates, logged_equivalent};
 use super::joint_restoring::{Functions, PooledRestoring, load, specification};
 use super::lambda_consistency::inflate_inertia_std;
 use super::lambda_coriolis::fit_points;
-use super::lambda_data::{experiment, per_point, static_holds};
+use super::lambda_data::{experiment, per_point, regression_columns, static_holds};
+use super::lambda_information::default_t_lambda;
 use super::lambda_physical::enforce;
 use super::lambda_structure::choose_structure;
 use super::outcome::{Identified, RunValidation};
@@ -24,7 +25,6 @@ use super::roles::assign_roles;
 use crate::estimation::lambda::{Experiment, LambdaEstimate, LambdaSettings, MIN_T_OVER_H, Prior};
 use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
 use crate::estimation::{Progress, SubProgress};
-use crate::logs::schema::pose_column;
 use crate::models::{LinearVesselModel, LpvModel, Scheduling};
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
@@ -235,15 +235,7 @@ pub fn identify_lambda_campaign(
 
     // Columns: τ, then η when g(η) is part of the model.
     let with_restoring = settings.estimate_restoring && six_dof;
-    let cols: Vec<String> = if with_restoring {
-        inputs
-            .iter()
-            .cloned()
-            .chain(Dof::ALL.iter().map(|d| pose_column(*d).to_string()))
-            .collect()
-    } else {
-        inputs.to_vec()
-    };
+    let cols = regression_columns(inputs, with_restoring);
     if !six_dof && settings.estimate_restoring {
         notes.push("g(η) needs all six DOFs and the attitude; γ = τ".into());
     }
@@ -264,13 +256,9 @@ pub fn identify_lambda_campaign(
     }
 
     // λ filter time constant: well below the vessel's dynamics, ≥ 5 samples.
-    let t_min = dofs
-        .iter()
-        .map(|d| profile.limit(*d).time_constant_s)
-        .fold(f64::INFINITY, f64::min);
     let t_lambda = settings
         .t_lambda_s
-        .unwrap_or_else(|| (0.5 * t_min).max(MIN_T_OVER_H * h));
+        .unwrap_or_else(|| default_t_lambda(profile, h));
     if !(t_lambda.is_finite() && t_lambda >= MIN_T_OVER_H * h) {
         return Err(IdentifyError::invalid(
             "settings.t_lambda_s",

@@ -14,7 +14,17 @@ use crate::estimation::lambda::Experiment;
 use crate::estimation::restoring::{
     RestoringEstimate, RestoringParams, RestoringSettings, StaticRecord, estimate_restoring,
 };
+use crate::logs::schema::pose_column;
 use crate::planning::dof::Dof;
+
+/// The columns a segment carries: τ, then η when g(η) is part of the model.
+pub(crate) fn regression_columns(inputs: &[String], with_attitude: bool) -> Vec<String> {
+    let mut cols = inputs.to_vec();
+    if with_attitude {
+        cols.extend(Dof::ALL.iter().map(|d| pose_column(*d).to_string()));
+    }
+    cols
+}
 
 /// A static run whose mean forward speed is below this (m/s) is a
 /// station-keeping attitude hold; above, steady flight at a grid speed.
