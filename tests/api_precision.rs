@@ -134,10 +134,7 @@ async fn unusable_precision_requests_are_422_naming_the_field() {
         ),
         (json!({ "kind": "precision" }), "campaign_id"),
     ] {
-        let r = app.call("POST", "/api/jobs", &[], Some(body.clone())).await;
-        assert_eq!(r.status, 422, "{body}: {}", r.text);
-        let got = r.json["field"].as_str().unwrap_or("");
-        assert!(got.starts_with(field), "{body}: field {got}, {}", r.text);
+        common::assert_job_refused(&app, body, field).await;
     }
     // A plan without a validation run cannot be identified, so not predicted.
     let (bare, _) = planned_campaign(

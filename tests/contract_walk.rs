@@ -51,7 +51,9 @@ async fn stored_discrepancy(app: &TestApp, cid: &str, mid: &str) -> String {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn every_documented_operation_is_exercised_and_answers() {
-    let registry = common::jobs::registry().with("precision", seatrial::jobs::precision::Precision);
+    let registry = common::jobs::registry()
+        .with("precision", seatrial::jobs::precision::Precision)
+        .with("design", seatrial::jobs::design::Design);
     let app = TestApp::with_jobs(registry, common::jobs::config(1)).await;
     let r = app
         .call("POST", "/api/vessels", &[], Some(rov_profile()))
@@ -235,6 +237,15 @@ async fn every_documented_operation_is_exercised_and_answers() {
                 // A prediction exists once a precision job has run.
                 ("get", "/api/campaigns/{id}/precision") => {
                     let body = json!({ "kind": "precision", "campaign_id": cid, "settings": { "prior": "reference", "realisations": 1 } });
+                    let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
+                    assert_eq!(r.status, 202, "{}", r.text);
+                    let done = common::wait_for_job(&app, r.json["id"].as_str().unwrap(), 120).await;
+                    assert_eq!(done["state"], "succeeded", "{done}");
+                    app.call("GET", template, &args, None).await
+                }
+                // A design exists once a design job has run.
+                ("get", "/api/campaigns/{id}/design") => {
+                    let body = json!({ "kind": "design", "campaign_id": cid, "settings": { "prior": "reference" } });
                     let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
                     assert_eq!(r.status, 202, "{}", r.text);
                     let done = common::wait_for_job(&app, r.json["id"].as_str().unwrap(), 120).await;

@@ -310,6 +310,14 @@ pub async fn run_job(app: &TestApp, body: Value) -> Value {
     job
 }
 
+/// Submits the job `body` and expects a 422 whose field starts with `field`.
+pub async fn assert_job_refused(app: &TestApp, body: Value, field: &str) {
+    let r = app.call("POST", "/api/jobs", &[], Some(body.clone())).await;
+    assert_eq!(r.status, 422, "{body}: {}", r.text);
+    let got = r.json["field"].as_str().unwrap_or("");
+    assert!(got.starts_with(field), "{body}: field {got}, {}", r.text);
+}
+
 /// Identifies campaign `cid` by `method`; the stored model's id.
 pub async fn identified(app: &TestApp, cid: &str, method: &str) -> String {
     let job = run_job(

@@ -6,6 +6,7 @@
 pub mod auth;
 pub mod campaigns;
 pub mod clock_offsets;
+pub mod design;
 pub mod discrepancies;
 pub mod export;
 pub mod exposure;
@@ -114,13 +115,13 @@ impl AppState {
         description = "Sea-trial system identification of ROVs and dynamically positioned ships: plan trial campaigns, score runs, identify and validate models.",
         license(name = "MIT")
     ),
-    components(schemas(ErrorBody, JobEvent, model_export::ExportFormat, crate::storage::jobs::JobKind, crate::storage::jobs::IdentifyMethod, crate::jobs::precision::PrecisionSettings, crate::jobs::precision::PriorChoice)),
+    components(schemas(ErrorBody, JobEvent, model_export::ExportFormat, crate::storage::jobs::JobKind, crate::storage::jobs::IdentifyMethod, crate::jobs::precision::PrecisionSettings, crate::jobs::precision::PriorChoice, crate::jobs::design::DesignSettings)),
     tags(
         (name = "service", description = "Service health"),
         (name = "accounts", description = "Sign-in, personal API tokens, users and roles, the audit trail"),
         (name = "planning", description = "Vessels, campaigns, excitation plans and their exports"),
         (name = "runs", description = "Uploaded logs, their alignment and data-quality reports"),
-        (name = "jobs", description = "Background jobs (identification, discovery, predicted precision): submit, follow by polling or Server-Sent Events, cancel, retry"),
+        (name = "jobs", description = "Background jobs (identification, discovery, predicted precision, experiment design): submit, follow by polling or Server-Sent Events, cancel, retry"),
         (name = "models", description = "Identified models: versions with provenance, matrices and parameters with uncertainties, validation, exports"),
         (name = "discovery", description = "Missing-physics discovery: where a model and the recordings part, the physics left out, the augmented model and the before/after proof")
     )
@@ -176,6 +177,7 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(run_traces::run_traces))
         .routes(routes!(runs::coverage))
         .routes(routes!(precision::get_precision))
+        .routes(routes!(design::get_design))
         .routes(routes!(
             clock_offsets::get_campaign_clock_offset,
             clock_offsets::put_campaign_clock_offset

@@ -103,6 +103,7 @@
 //! unwind, and queues their jobs again at once with the attempt given back
 //! and no lease, so the next start claims them without waiting.
 
+pub mod design;
 pub mod discover;
 pub mod events;
 pub mod handler;

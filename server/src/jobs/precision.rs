@@ -50,7 +50,7 @@ pub struct PrecisionSettings {
 }
 
 impl PrecisionSettings {
-    fn prior(&self, req: &JobRequest) -> PriorChoice {
+    pub(super) fn prior(&self, req: &JobRequest) -> PriorChoice {
         self.prior.unwrap_or(if req.model_id.is_some() {
             PriorChoice::Model
         } else {
@@ -80,24 +80,6 @@ struct Checked {
 }
 
 async fn checked(cx: &JobContext, req: &JobRequest) -> Result<Checked, ApiError> {
-    let Some(cid) = &req.campaign_id else {
-        return Err(ApiError::invalid(
-            "campaign_id",
-            "precision needs the campaign whose plan to predict",
-        ));
-    };
-    if req.method.is_some() {
-        return Err(ApiError::invalid(
-            "method",
-            "precision predicts the vessel's physical identification (lambda_kf for an ROV, parallel_ekf for a DP ship); it takes no method",
-        ));
-    }
-    if !req.run_ids.is_empty() {
-        return Err(ApiError::invalid(
-            "run_ids",
-            "precision flies the plan in simulation; it reads no runs",
-        ));
-    }
     let settings: PrecisionSettings =
         parse_settings(&req.settings).map_err(|(f, m)| ApiError::invalid(f, m))?;
     if let Some(n) = settings.realisations
@@ -108,20 +90,9 @@ async fn checked(cx: &JobContext, req: &JobRequest) -> Result<Checked, ApiError>
             format!("must be between 1 and {MAX_REALISATIONS} (got {n})"),
         ));
     }
-    let campaign = campaigns::get(&cx.db, cid)
-        .await?
-        .ok_or_else(|| ApiError::missing("campaign_id", format!("no campaign with id '{cid}'")))?;
-    let vessel = vessels::get(&cx.db, &campaign.vessel_id)
-        .await?
-        .ok_or_else(|| ApiError::missing("campaign_id", "the campaign's vessel is gone"))?;
-    let Some(plan) = plans::latest(&cx.db, cid).await? else {
-        return Err(ApiError::invalid(
-            "campaign_id",
-            format!(
-                "campaign '{}' has no plan yet; generate one (POST /api/campaigns/{cid}/plan) first",
-                campaign.spec.name
-            ),
-        ));
+    let found = campaign_and_prior(cx, req, "precision", settings.prior(req)).await?;
+    let Some(plan) = plans::latest(&cx.db, &found.campaign.id).await? else {
+        return Err(no_plan(&found.campaign));
     };
     if !plan
         .experiments
@@ -132,11 +103,72 @@ async fn checked(cx: &JobContext, req: &JobRequest) -> Result<Checked, ApiError>
             "campaign_id",
             format!(
                 "plan v{} of campaign '{}' has no validation run, and the identification holds one out; add the validation family (re-plan) to predict its precision",
-                plan.version, campaign.spec.name
+                plan.version, found.campaign.spec.name
             ),
         ));
     }
-    let model = match (settings.prior(req), &req.model_id) {
+    Ok(Checked {
+        profile: found.profile,
+        settings,
+        model: found.model,
+    })
+}
+
+/// The 422 of a campaign without a plan.
+pub(super) fn no_plan(campaign: &campaigns::Campaign) -> ApiError {
+    ApiError::invalid(
+        "campaign_id",
+        format!(
+            "campaign '{}' has no plan yet; generate one (POST /api/campaigns/{}/plan) first",
+            campaign.spec.name, campaign.id
+        ),
+    )
+}
+
+/// A planning job's campaign, its vessel's profile and the stored model
+/// the prior comes from (when `choice` is `model`), checked.
+pub(super) struct CampaignPrior {
+    pub campaign: campaigns::Campaign,
+    pub profile: seatrial_core::planning::VesselProfile,
+    pub model: Option<(ModelDocument, PriorSource)>,
+}
+
+/// Checks a planning job's request (`kind` names it in messages): a
+/// campaign, no method or runs, and a model of the campaign's vessel when
+/// the prior is a stored model.
+pub(super) async fn campaign_and_prior(
+    cx: &JobContext,
+    req: &JobRequest,
+    kind: &str,
+    choice: PriorChoice,
+) -> Result<CampaignPrior, ApiError> {
+    let Some(cid) = &req.campaign_id else {
+        return Err(ApiError::invalid(
+            "campaign_id",
+            format!("{kind} needs the campaign whose plan to predict"),
+        ));
+    };
+    if req.method.is_some() {
+        return Err(ApiError::invalid(
+            "method",
+            format!(
+                "{kind} flies the vessel's physical identification (lambda_kf for an ROV, parallel_ekf for a DP ship); it takes no method"
+            ),
+        ));
+    }
+    if !req.run_ids.is_empty() {
+        return Err(ApiError::invalid(
+            "run_ids",
+            format!("{kind} flies the plan in simulation; it reads no runs"),
+        ));
+    }
+    let campaign = campaigns::get(&cx.db, cid)
+        .await?
+        .ok_or_else(|| ApiError::missing("campaign_id", format!("no campaign with id '{cid}'")))?;
+    let vessel = vessels::get(&cx.db, &campaign.vessel_id)
+        .await?
+        .ok_or_else(|| ApiError::missing("campaign_id", "the campaign's vessel is gone"))?;
+    let model = match (choice, &req.model_id) {
         (PriorChoice::Model, None) => {
             return Err(ApiError::invalid(
                 "model_id",
@@ -177,14 +209,28 @@ async fn checked(cx: &JobContext, req: &JobRequest) -> Result<Checked, ApiError>
     if let Some((doc, _)) = &model {
         Prior::from_model(doc, &vessel.profile).map_err(design_invalid)?;
     }
-    Ok(Checked {
+    Ok(CampaignPrior {
+        campaign,
         profile: vessel.profile,
-        settings,
         model,
     })
 }
 
-fn design_invalid(e: DesignError) -> ApiError {
+/// The prior `choice` names, built in the worker.
+pub(super) fn build_prior(
+    choice: PriorChoice,
+    model: Option<(ModelDocument, PriorSource)>,
+    profile: &seatrial_core::planning::VesselProfile,
+) -> Result<(Prior, PriorSource), JobFailure> {
+    let (prior, source) = match (choice, model) {
+        (PriorChoice::Model, Some((doc, source))) => (Prior::from_model(&doc, profile), source),
+        (PriorChoice::Reference, _) => (Prior::reference(profile), PriorSource::Reference),
+        _ => (Prior::from_profile(profile), PriorSource::Profile),
+    };
+    Ok((prior.map_err(failure)?, source))
+}
+
+pub(super) fn design_invalid(e: DesignError) -> ApiError {
     ApiError::invalid(e.field().to_string(), e.to_string())
 }
 
@@ -229,16 +275,7 @@ impl JobHandler for Precision {
             let realisations = c.settings.realisations;
             let (plan_id, plan_version) = (stored.id.clone(), stored.version);
             Ok(compute(move |progress: &mut dyn Progress| {
-                let (prior, source) = match (choice, c.model) {
-                    (PriorChoice::Model, Some((doc, source))) => {
-                        (Prior::from_model(&doc, &c.profile), source)
-                    }
-                    (PriorChoice::Reference, _) => {
-                        (Prior::reference(&c.profile), PriorSource::Reference)
-                    }
-                    _ => (Prior::from_profile(&c.profile), PriorSource::Profile),
-                };
-                let prior = prior.map_err(failure)?;
+                let (prior, source) = build_prior(choice, c.model, &c.profile)?;
                 let defaults = PredictSettings::default();
                 let settings = PredictSettings {
                     seed,
@@ -259,7 +296,7 @@ impl JobHandler for Precision {
     }
 }
 
-fn failure(e: DesignError) -> JobFailure {
+pub(super) fn failure(e: DesignError) -> JobFailure {
     match e {
         DesignError::Cancelled => JobFailure::Cancelled,
         e => JobFailure::field(e.field().to_string(), e.to_string()),

@@ -20,12 +20,15 @@ impl JobRegistry {
     /// The production kinds: `identify` (campaign runs → a validated,
     /// versioned model) and `discover` (a model and its runs → the missing
     /// physics, and the augmented model as its next version) and
-    /// `precision` (a plan and a prior → each parameter's predicted std).
+    /// `precision` (a plan and a prior → each parameter's predicted std) and
+    /// `design` (a campaign, a prior and a budget → the plan that buys the
+    /// most precision in those hours).
     pub fn production() -> Self {
         Self::new()
             .with("identify", super::identify::Identify)
             .with("discover", super::discover::Discover)
             .with("precision", super::precision::Precision)
+            .with("design", super::design::Design)
     }
 
     /// Adds (or replaces) the handler of `kind`.

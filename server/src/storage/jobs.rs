@@ -65,7 +65,7 @@ impl JobState {
 #[serde(deny_unknown_fields)]
 pub struct JobRequest {
     /// The job's kind: one of the registered handlers (`identify`,
-    /// `discover`, `precision`).
+    /// `discover`, `precision`, `design`).
     #[schema(value_type = JobKind)]
     pub kind: String,
     /// The campaign the runs belong to.
@@ -76,7 +76,7 @@ pub struct JobRequest {
     pub run_ids: Vec<String>,
     /// The method, as the kind defines it. `identify`: `lambda_kf` (default
     /// for ROVs), `parallel_ekf` (default for DP vessels; DP only) or
-    /// `n4sid`; `discover` and `precision` take none.
+    /// `n4sid`; `discover`, `precision` and `design` take none.
     #[serde(default)]
     #[schema(value_type = Option<IdentifyMethod>)]
     pub method: Option<String>,
@@ -85,7 +85,7 @@ pub struct JobRequest {
     #[schema(value_type = Object)]
     pub settings: serde_json::Value,
     /// A model to start from (discovery), or the prior a plan is flown
-    /// with (precision, `settings.prior = model`).
+    /// with (precision and design, `settings.prior = model`).
     #[serde(default)]
     pub model_id: Option<String>,
 }
@@ -104,6 +104,10 @@ pub enum JobKind {
     /// `PrecisionSettings`; a prior model in `model_id`); the result is a
     /// `PrecisionResult`.
     Precision,
+    /// The campaign designed for precision per ship-hour (settings:
+    /// `DesignSettings`; a prior model in `model_id`; ROVs); the result is
+    /// a `DesignResult`.
+    Design,
 }
 
 /// The methods of an `identify` job (documentation only; an unknown one is a 422).

@@ -366,8 +366,11 @@ pub fn design_campaign(
                 .map(move |f| (dy, rc, n, f))
         })
         .collect();
-    let mut designed = Vec::new();
-    let mut best_design: Option<(CampaignSpec, TradePoint)> = None;
+    // The current plan stays a candidate: a budget of its hours always has
+    // an answer, even where the shapes chosen lengthen the runs.
+    let mut designed = vec![current.clone()];
+    let mut best_design: Option<(CampaignSpec, TradePoint)> =
+        (current_hours <= budget + 1e-9).then(|| (base.clone(), current.clone()));
     for (i, (dy, rc, n, fams)) in combos.iter().enumerate() {
         progress
             .update(
@@ -426,7 +429,11 @@ pub fn design_campaign(
                     Quantity::Force => d.force_unit().to_string(),
                 },
                 clock_period_s: o.and_then(|o| o.clock_period_s),
-                gain: gains.get(d).copied().unwrap_or(1.0),
+                gain: if o == base.excitation.per_dof.get(d) {
+                    1.0
+                } else {
+                    gains.get(d).copied().unwrap_or(1.0)
+                },
             }
         })
         .collect();
