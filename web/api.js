@@ -79,6 +79,8 @@ export const api = {
   createCampaign: (body, raw) => request('POST', '/api/campaigns', body, raw).then(flatCampaign),
   plan: (id) => request('GET', `/api/campaigns/${enc(id)}/plan`),
   generatePlan: (id) => request('POST', `/api/campaigns/${enc(id)}/plan`),
+  // Re-plan with changed campaign settings (families, repetitions, excitation, durations, …).
+  replan: (id, changes) => request('POST', `/api/campaigns/${enc(id)}/plan`, changes),
   experiment: (id, eid) => request('GET', urls.experimentJson(id, eid)),
   runs: (id) => request('GET', `/api/campaigns/${enc(id)}/runs`),
   run: (rid) => request('GET', `/api/runs/${enc(rid)}`),
@@ -104,6 +106,8 @@ export const api = {
   coverage: (id) => request('GET', `/api/campaigns/${enc(id)}/coverage`),
   // The newest predicted precision of the campaign's plan (404 before the first `precision` job).
   precision: (id) => request('GET', `/api/campaigns/${enc(id)}/precision`),
+  // The newest experiment design of the campaign (404 before the first `design` job).
+  design: (id) => request('GET', `/api/campaigns/${enc(id)}/design`),
   // Clock offsets of two-file runs (s; null clears the one set by hand).
   campaignClockOffset: (id) => request('GET', `/api/campaigns/${enc(id)}/clock-offset`),
   setCampaignClockOffset: (id, s) => request('PUT', `/api/campaigns/${enc(id)}/clock-offset`, { clock_offset_s: s }),

@@ -8,6 +8,7 @@ import { campaignTrash } from './parenttrash.js';
 import { deletedBadge } from './manage.js';
 import { sectionNav } from './sectionnav.js';
 import { precisionSection } from './precision.js';
+import { designSection } from './design.js';
 import {
   FAMILY_LABEL, KIND_LABEL, SIGNAL_LABEL, bandText, describeWaveform, fmt, fmtDate, fmtKn, hms,
   peText, secs, unitLabel,
@@ -117,6 +118,8 @@ export async function campaignPage(view, id) {
   const identifyHost = h('section', { class: 'identification', 'aria-label': 'Identification', 'data-testid': 'identify-section' });
   const precisionHost = h('section', { class: 'precision', 'aria-label': 'Predicted precision', 'data-testid': 'precision-section' });
   let precision = null; // the Predicted precision section's controller
+  const designHost = h('section', { class: 'design', 'aria-label': 'Experiment design', 'data-testid': 'design-section' });
+  let design = null; // the Experiment design section's controller
   let runs = null; // the Runs section's controller
   let ident = null; // the Identification section's controller
 
@@ -140,14 +143,26 @@ export async function campaignPage(view, id) {
       h('dt', null, 'Excitation'), h('dd', null, excitationText(c)),
       h('dt', null, 'Durations'), h('dd', null, DURATIONS.filter((d) => durs[d.key] != null).map((d) => `${d.label.toLowerCase()} ${fmt(durs[d.key])} s`).join(' · ') || 'defaults'),
       h('dt', null, 'Seed'), h('dd', { class: 'mono' }, c.seed ?? 'default')),
-    sectionNav([['runs', 'Runs'], ['coverage', 'Coverage'], ['jobs', 'Jobs'], ['models', 'Models'], ['precision', 'Precision'], ['plan', 'Plan'], ['deleted', 'Deleted']]),
+    sectionNav([['runs', 'Runs'], ['coverage', 'Coverage'], ['jobs', 'Jobs'], ['models', 'Models'], ['precision', 'Precision'], ['design', 'Design'], ['plan', 'Plan'], ['deleted', 'Deleted']]),
     runsHost,
     campaignOffsetPanel(c.id),
     identifyHost,
     precisionHost,
+    designHost,
     planTitle,
     planHost,
     trash.host);
+
+  // Every section that shows the plan follows a new version.
+  async function planChanged() {
+    selected = null;
+    if (location.hash !== `#/campaigns/${id}`) history.replaceState(null, '', `#/campaigns/${id}`);
+    renderPlan();
+    if (runs) await runs.setPlan(plan);
+    if (ident) ident.setPlan(plan);
+    if (precision) precision.setPlan(plan);
+    if (design) design.setPlan(plan);
+  }
 
   async function generate() {
     genBtn.disabled = true;
@@ -160,12 +175,7 @@ export async function campaignPage(view, id) {
       if (plan.created === false) banner(`Plan v${plan.version} unchanged: the inputs give the same plan, nothing stored (${took}).`, 'ok');
       else if (plan.changes) banner(`Plan v${plan.version} generated: ${changeWords(plan.changes)} (${took}).`, 'ok');
       else banner(`Plan v${plan.version} generated: ${plan.totals.experiments} experiments in ${took}.`, 'ok');
-      selected = null;
-      if (location.hash !== `#/campaigns/${id}`) history.replaceState(null, '', `#/campaigns/${id}`);
-      renderPlan();
-      if (runs) await runs.setPlan(plan);
-      if (ident) ident.setPlan(plan);
-      if (precision) precision.setPlan(plan);
+      await planChanged();
     } catch (err) {
       banner(`${err.status ? `${err.status} · ` : ''}${err.message}${err.field ? ` [${err.field}]` : ''}`);
     } finally {
@@ -373,6 +383,17 @@ export async function campaignPage(view, id) {
       h('p', { class: 'error-text', role: 'alert', 'data-testid': 'identify-load-error' }, `Could not load jobs and models: ${err.status ? `${err.status} · ` : ''}${err.message}`));
   }
   try {
+    design = await designSection(designHost, {
+      campaign,
+      plan,
+      // The campaign's settings changed too: the whole page is redrawn.
+      onAdopt: () => reloadPage(),
+    });
+  } catch (err) {
+    fill(designHost, h('h2', { class: 'section-title' }, 'Experiment design'),
+      h('p', { class: 'error-text', role: 'alert' }, `Could not load the design: ${err.status ? `${err.status} · ` : ''}${err.message}`));
+  }
+  try {
     precision = await precisionSection(precisionHost, { campaign, plan });
   } catch (err) {
     fill(precisionHost, h('h2', { class: 'section-title' }, 'Predicted precision'),
@@ -387,6 +408,7 @@ export async function campaignPage(view, id) {
       runs.destroy();
       if (ident) ident.destroy();
       if (precision) precision.destroy();
+      if (design) design.destroy();
     },
   };
 }

@@ -6,7 +6,7 @@
 import { api } from './api.js';
 import { fmt, fmtSig, fmtDate, unitLabel } from './format.js';
 import { h, fill, labelled } from './forms.js';
-import { errLine, jobStateBadge } from './identify.js';
+import { newestResult, planJobRunner, priorSelect, withPrior } from './planjob.js';
 
 const PRIOR_LABEL = {
   profile: 'the vessel profile\u2019s rough numbers',
@@ -29,15 +29,8 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
   const id = campaign.id;
   let plan = plan0;
   let stored = null;
-  let destroyed = false;
-  let timer = null;
-  let shown = 0; // progress shown: never goes backwards within a job
 
-  const models = (await api.models(id).catch(() => [])).filter((m) => m.kind !== 'state_space' && !m.deleted_at);
-  const priorSel = h('select', { 'data-field': 'settings.prior', 'data-testid': 'precision-prior' },
-    h('option', { value: 'profile' }, PRIOR_LABEL.profile),
-    h('option', { value: 'reference' }, PRIOR_LABEL.reference),
-    models.map((m) => h('option', { value: `model:${m.id}` }, `model ${m.name} v${m.version}`)));
+  const priorSel = await priorSelect(id, 'precision-prior', (m) => m.kind !== 'state_space');
   const seedIn = h('input', { type: 'number', min: '0', step: '1', value: '1', class: 'short', 'data-field': 'settings.seed', 'data-testid': 'precision-seed' });
   const realIn = h('input', { type: 'number', min: '1', max: '100', step: '1', value: '20', class: 'short', 'data-field': 'settings.realisations', 'data-testid': 'precision-realisations' });
   const startBtn = h('button', { type: 'submit', class: 'btn primary', 'data-testid': 'precision-start' }, 'Predict precision');
@@ -51,6 +44,8 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
     h('div', { class: 'form-actions' }, startBtn),
     status);
 
+  const runner = planJobRunner({ testid: 'precision', status, startBtn, onDone: () => load() });
+
   fill(host,
     h('h2', { class: 'section-title', 'data-section': 'precision' }, 'Predicted precision ',
       h('span', { class: 'hint' }, 'before the ship leaves port: how precisely this plan will determine each parameter')),
@@ -58,72 +53,14 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
     result);
 
   async function load() {
-    // Ask for the table only when a prediction exists (no 404 on every page view).
-    const jobs = await api.jobs(id).catch(() => []);
-    if (!jobs.some((j) => j.kind === 'precision' && j.state === 'succeeded')) {
-      stored = null;
-      render();
-      return;
-    }
-    try {
-      stored = await api.precision(id);
-    } catch (e) {
-      if (e.status !== 404) throw e;
-      stored = null;
-    }
+    stored = await newestResult(id, 'precision', api.precision);
     render();
   }
 
   async function submit(ev) {
     ev.preventDefault();
-    const prior = priorSel.value;
     const body = { kind: 'precision', campaign_id: id, settings: { seed: Number(seedIn.value || 1), realisations: Number(realIn.value || 20) } };
-    if (prior.startsWith('model:')) {
-      body.settings.prior = 'model';
-      body.model_id = prior.slice(6);
-    } else {
-      body.settings.prior = prior;
-    }
-    startBtn.disabled = true;
-    shown = 0;
-    try {
-      const job = await api.submitJob(body);
-      follow(job.id);
-    } catch (err) {
-      fill(status, h('p', { class: 'error-text', role: 'alert', 'data-testid': 'precision-error' }, errLine(err)));
-      startBtn.disabled = false;
-    }
-  }
-
-  function follow(jid) {
-    const tick = async () => {
-      if (destroyed) return;
-      let job;
-      try {
-        job = await api.job(jid);
-      } catch (err) {
-        fill(status, h('p', { class: 'error-text', role: 'alert' }, errLine(err)));
-        startBtn.disabled = false;
-        return;
-      }
-      shown = Math.max(shown, job.progress || 0);
-      fill(status, h('p', null, jobStateBadge(job.state), ' ',
-        h('progress', { max: '1', value: String(shown), 'data-testid': 'precision-progress' }), ' ',
-        h('span', { class: 'muted' }, job.stage || '')));
-      if (job.state === 'succeeded') {
-        startBtn.disabled = false;
-        fill(status);
-        await load();
-      } else if (['failed', 'cancelled', 'interrupted'].includes(job.state)) {
-        startBtn.disabled = false;
-        const e = job.error || {};
-        fill(status, h('p', { class: 'error-text', role: 'alert', 'data-testid': 'precision-error' },
-          `${job.state}: ${e.message || ''}${e.field ? ` [${e.field}]` : ''}`));
-      } else {
-        timer = setTimeout(tick, 400);
-      }
-    };
-    tick();
+    await runner.submit(withPrior(body, priorSel.value));
   }
 
   function render() {
@@ -188,6 +125,6 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
 
   return {
     setPlan(p) { plan = p; render(); load().catch(() => {}); },
-    destroy() { destroyed = true; if (timer) clearTimeout(timer); },
+    destroy() { runner.destroy(); },
   };
 }
