@@ -56,7 +56,9 @@ export function tradeOffPlot(d) {
     s('circle', { class: 'chosen', cx: X(d.design.hours), cy: Y(d.design.relative_std), r: 6, 'data-testid': 'design-plot-chosen' }, s('title', null, 'design within the budget')),
     s('g', { class: 'legend' },
       s('line', { class: 'designed', x1: W - 190, x2: W - 170, y1: T + 8, y2: T + 8 }), s('text', { x: W - 164, y: T + 12 }, 'designed'),
-      s('line', { class: 'rule', x1: W - 190, x2: W - 170, y1: T + 26, y2: T + 26 }), s('text', { x: W - 164, y: T + 30 }, 'today\u2019s rules, repeated')));
+      s('line', { class: 'rule', x1: W - 190, x2: W - 170, y1: T + 26, y2: T + 26 }), s('text', { x: W - 164, y: T + 30 }, 'today\u2019s rules, repeated'),
+      s('circle', { class: 'current', cx: W - 180, cy: T + 44, r: 5 }), s('text', { x: W - 164, y: T + 48 }, 'current plan'),
+      s('circle', { class: 'chosen', cx: W - 180, cy: T + 62, r: 5 }), s('text', { x: W - 164, y: T + 66 }, 'design within the budget')));
 }
 
 /** The Experiment design section. `setPlan` refreshes it after a re-plan. */
