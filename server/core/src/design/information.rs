@@ -67,6 +67,41 @@ fn content_key(p: &PlannedExperiment) -> u64 {
     h.finish()
 }
 
+/// The information one planned experiment gives per grid point of `grid`
+/// (flown once, then kept by its content).
+///
+/// # Errors
+/// The simulator or the identification's data path refuses it (named by
+/// its code).
+pub fn experiment_information<'c>(
+    profile: &VesselProfile,
+    grid: &[f64],
+    planned: &PlannedExperiment,
+    truth: &RovTruth,
+    cache: &'c mut InformationCache,
+) -> Result<&'c [(usize, DMatrix<f64>)], DesignError> {
+    let key = content_key(planned);
+    if !cache.by_content.contains_key(&key) {
+        let field = || format!("plan.experiments[{}]", planned.experiment.code);
+        let settings = TrialSettings {
+            noise: MeasurementNoise::NONE,
+            feedback: Feedback::True,
+            ..TrialSettings::default()
+        };
+        let flown = fly_experiment(profile, truth, planned, &settings)
+            .map_err(|e| DesignError::new(field(), e.to_string()))?;
+        let run = run_input(profile, planned, &flown.csv)?;
+        let info = lambda_information(profile, grid, &input_columns(profile), &[run])
+            .map_err(|e| DesignError::new(field(), e.to_string()))?;
+        cache.flown += 1;
+        cache.by_content.insert(
+            key,
+            info.into_iter().map(|i| (i.grid_index, i.gram)).collect(),
+        );
+    }
+    Ok(&cache.by_content[&key])
+}
+
 /// Flies every estimation experiment of `plan` (validation runs are held
 /// out by the identification and add nothing) and sums its information.
 ///
@@ -80,39 +115,28 @@ pub fn plan_information(
     cache: &mut InformationCache,
 ) -> Result<PlanInformation, DesignError> {
     let grid = plan.grid_speeds();
-    let inputs = input_columns(profile);
-    let settings = TrialSettings {
-        noise: MeasurementNoise::NONE,
-        feedback: Feedback::True,
-        ..TrialSettings::default()
+    let mut info = PlanInformation {
+        grams: vec![None; grid.len()],
     };
-    let mut grams: Vec<Option<DMatrix<f64>>> = vec![None; grid.len()];
     for p in &plan.experiments {
         if p.experiment.family == ExperimentFamily::Validation {
             continue;
         }
-        let key = content_key(p);
-        if !cache.by_content.contains_key(&key) {
-            let field = || format!("plan.experiments[{}]", p.experiment.code);
-            let flown = fly_experiment(profile, truth, p, &settings)
-                .map_err(|e| DesignError::new(field(), e.to_string()))?;
-            let run = run_input(profile, p, &flown.csv)?;
-            let info = lambda_information(profile, &grid, &inputs, &[run])
-                .map_err(|e| DesignError::new(field(), e.to_string()))?;
-            cache.flown += 1;
-            cache.by_content.insert(
-                key,
-                info.into_iter().map(|i| (i.grid_index, i.gram)).collect(),
-            );
-        }
-        for (g, gram) in &cache.by_content[&key] {
-            match &mut grams[*g] {
-                Some(acc) => *acc += gram,
-                slot => *slot = Some(gram.clone()),
-            }
+        for (g, gram) in experiment_information(profile, &grid, p, truth, cache)? {
+            info.add(*g, gram);
         }
     }
-    Ok(PlanInformation { grams })
+    Ok(info)
+}
+
+impl PlanInformation {
+    /// Adds `gram` at grid point `g`.
+    pub fn add(&mut self, g: usize, gram: &DMatrix<f64>) {
+        match &mut self.grams[g] {
+            Some(acc) => *acc += gram,
+            slot => *slot = Some(gram.clone()),
+        }
+    }
 }
 
 /// The diagonal scaling S of a reference plan's information, per grid

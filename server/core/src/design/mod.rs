@@ -29,11 +29,13 @@
 //! chosen design.
 
 pub mod information;
+mod next_dive;
 mod predict;
 mod prior;
 mod search;
 mod table;
 
+pub use next_dive::{NextDive, ProposedRun, propose_next_dive};
 pub use predict::{MAX_REALISATIONS, PredictSettings, predict_precision};
 pub use prior::{Prior, PriorSource};
 pub use search::{DofChoice, ExperimentDesign, TradePoint, design_campaign};

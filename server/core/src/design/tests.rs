@@ -5,10 +5,13 @@
 
 use super::*;
 use crate::estimation::NoProgress;
+use crate::identification::RunInput;
 use crate::planning::examples::{
     supply_vessel, supply_vessel_trial_campaign, surveyor_campaign, surveyor_rov,
 };
 use crate::planning::generate_plan;
+use crate::planning::{ExperimentFamily, Plan, VesselProfile};
+use crate::simulation::rov::RovTruth;
 
 fn rov_prediction(repetitions: Option<u32>) -> PrecisionPrediction {
     let profile = surveyor_rov();
@@ -162,4 +165,92 @@ fn repeating_the_plan_lowers_the_d_criterion_by_ln_2() {
         (drop - std::f64::consts::LN_2).abs() < 0.03 * std::f64::consts::LN_2,
         "D fell by {drop}, expected ln 2"
     );
+}
+
+/// A two-speed Surveyor campaign: its plan, the reference prior, and the
+/// plan's runs flown with sensor noise as the campaign's logs.
+fn two_speed_campaign() -> (VesselProfile, Plan, Box<RovTruth>, Vec<RunInput>) {
+    use crate::simulation::trials::{TrialSettings, fly_campaign};
+    let profile = surveyor_rov();
+    let mut spec = surveyor_campaign(3);
+    spec.grid.speeds = vec![0.0, 1.5];
+    let plan = generate_plan(&profile, &spec).unwrap();
+    let Prior::Rov(truth) = Prior::reference(&profile).unwrap() else {
+        panic!("an ROV prior")
+    };
+    let settings = TrialSettings {
+        seed: 5,
+        ..TrialSettings::default()
+    };
+    let runs = fly_campaign(&profile, &truth, &plan, &settings, |_| true).unwrap();
+    let inputs = runs
+        .iter()
+        .map(|r| {
+            let pe = plan
+                .experiments
+                .iter()
+                .find(|p| p.experiment.seq == r.seq)
+                .unwrap();
+            super::predict::run_input(&profile, pe, &r.csv).unwrap()
+        })
+        .collect();
+    (profile, plan, truth, inputs)
+}
+
+#[test]
+fn the_first_dive_flies_validation_then_covers_every_grid_speed() {
+    let (profile, plan, truth, _) = two_speed_campaign();
+    let dive = propose_next_dive(&profile, &plan, &[], &[], &truth, 3.0, &mut NoProgress).unwrap();
+    eprintln!("{dive:#?}");
+    assert_eq!(dive.relative_std_now, None);
+    assert_eq!(dive.proposed[0].family, ExperimentFamily::Validation);
+    assert!(dive.uncovered_speeds_mps.is_empty());
+    assert!(dive.hours <= 3.0 + 1e-9);
+    let firsts = dive
+        .proposed
+        .iter()
+        .filter(|p| p.reason.starts_with("the first data"))
+        .count();
+    assert_eq!(firsts, 2, "one run opens each grid speed");
+    // After the dive the campaign is within reach of the whole plan.
+    let after = dive.relative_std_after.unwrap();
+    assert!(after >= 1.0 && after.is_finite(), "{after}");
+    // The precision only improves along the proposal.
+    for w in dive.proposed[1..].windows(2) {
+        if w[0].relative_std_after > 0.0 {
+            assert!(w[1].relative_std_after <= w[0].relative_std_after + 1e-12);
+        }
+    }
+}
+
+#[test]
+fn after_a_dive_the_flown_runs_count_and_are_not_proposed_again() {
+    let (profile, plan, truth, runs) = two_speed_campaign();
+    // The first half of the plan was flown (the validation run among them
+    // or not, as the plan orders it).
+    let half = runs.len() / 2;
+    let flown = &runs[..half];
+    let done: Vec<String> = flown.iter().map(|r| r.run_id.clone()).collect();
+    let dive =
+        propose_next_dive(&profile, &plan, flown, &done, &truth, 2.0, &mut NoProgress).unwrap();
+    assert_eq!(dive.flown_runs, half);
+    assert!(dive.proposed.iter().all(|p| !done.contains(&p.code)));
+    assert!(!dive.proposed.is_empty());
+    let (now, after) = (dive.relative_std_now, dive.relative_std_after.unwrap());
+    if let Some(now) = now {
+        assert!(after < now, "{after} vs {now}");
+    }
+    // Everything flown: nothing left to propose, and the campaign's own
+    // data reach the plan's precision (noise aside: within 10 %).
+    let all: Vec<String> = runs.iter().map(|r| r.run_id.clone()).collect();
+    let done_all =
+        propose_next_dive(&profile, &plan, &runs, &all, &truth, 2.0, &mut NoProgress).unwrap();
+    assert!(done_all.proposed.is_empty());
+    let now = done_all.relative_std_now.unwrap();
+    assert!(
+        (now - 1.0).abs() < 0.1,
+        "flown data against the plan's: {now}"
+    );
+    // No hours, no dive.
+    assert!(propose_next_dive(&profile, &plan, &[], &[], &truth, 0.0, &mut NoProgress).is_err());
 }
