@@ -53,7 +53,8 @@ async fn stored_discrepancy(app: &TestApp, cid: &str, mid: &str) -> String {
 async fn every_documented_operation_is_exercised_and_answers() {
     let registry = common::jobs::registry()
         .with("precision", seatrial::jobs::precision::Precision)
-        .with("design", seatrial::jobs::design::Design);
+        .with("design", seatrial::jobs::design::Design)
+        .with("next_dive", seatrial::jobs::next_dive::NextDiveJob);
     let app = TestApp::with_jobs(registry, common::jobs::config(1)).await;
     let r = app
         .call("POST", "/api/vessels", &[], Some(rov_profile()))
@@ -246,6 +247,16 @@ async fn every_documented_operation_is_exercised_and_answers() {
                 // A design exists once a design job has run.
                 ("get", "/api/campaigns/{id}/design") => {
                     let body = json!({ "kind": "design", "campaign_id": cid, "settings": { "prior": "reference" } });
+                    let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
+                    assert_eq!(r.status, 202, "{}", r.text);
+                    let done = common::wait_for_job(&app, r.json["id"].as_str().unwrap(), 120).await;
+                    assert_eq!(done["state"], "succeeded", "{done}");
+                    app.call("GET", template, &args, None).await
+                }
+                // A next-dive proposal (and its run sheet) exists once a
+                // next_dive job has run.
+                ("get", "/api/campaigns/{id}/next-dive" | "/api/campaigns/{id}/next-dive/runsheet") => {
+                    let body = json!({ "kind": "next_dive", "campaign_id": cid, "settings": { "prior": "reference", "dive_hours": 1 } });
                     let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
                     assert_eq!(r.status, 202, "{}", r.text);
                     let done = common::wait_for_job(&app, r.json["id"].as_str().unwrap(), 120).await;

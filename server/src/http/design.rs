@@ -5,11 +5,10 @@ use axum::Json;
 use axum::extract::{Path, State};
 use serde::Serialize;
 
-use super::{AppState, found};
-use crate::error::{ApiError, ApiResult, ErrorBody};
+use super::AppState;
+use super::planning_jobs::newest_result;
+use crate::error::{ApiResult, ErrorBody};
 use crate::jobs::design::DesignResult;
-use crate::storage::jobs::{self as stored, JobState};
-use crate::storage::{campaigns, plans};
 
 /// A stored design.
 #[derive(Debug, Serialize, utoipa::ToSchema)]
@@ -39,20 +38,18 @@ pub async fn get_design(
     State(s): State<AppState>,
     Path(id): Path<String>,
 ) -> ApiResult<Json<CampaignDesign>> {
-    found(campaigns::get(&s.db, &id).await?, "campaign", &id)?;
-    let jobs = stored::list(&s.db, Some(&id), Some(JobState::Succeeded)).await?;
-    let Some(job) = jobs.into_iter().find(|j| j.kind == "design") else {
-        return Err(ApiError::NotFound(format!(
-            "campaign '{id}' has no experiment design yet; submit POST /api/jobs {{\"kind\": \"design\", \"campaign_id\": \"{id}\"}}"
-        )));
-    };
-    let result: DesignResult = serde_json::from_value(job.result.clone().unwrap_or_default())
-        .map_err(|e| ApiError::Internal(anyhow::anyhow!("stored design unreadable: {e}")))?;
-    let newest = plans::latest(&s.db, &id).await?.map(|p| p.id);
+    let (job, result, current) = newest_result(
+        &s,
+        &id,
+        "design",
+        "experiment design",
+        |r: &DesignResult| &r.plan_id,
+    )
+    .await?;
     Ok(Json(CampaignDesign {
         job_id: job.id,
         finished_at: job.finished_at,
-        current: newest.as_deref() == Some(result.plan_id.as_str()),
+        current,
         result,
     }))
 }

@@ -82,11 +82,21 @@ pub fn describe(w: &Waveform) -> String {
 
 /// Printable HTML run sheet of a plan.
 pub fn run_sheet(vessel: &Vessel, campaign: &Campaign, plan: &StoredPlan) -> String {
+    run_sheet_titled(vessel, campaign, plan, "Run sheet")
+}
+
+/// [`run_sheet`] under another title (e.g. the next dive's selection).
+pub fn run_sheet_titled(
+    vessel: &Vessel,
+    campaign: &Campaign,
+    plan: &StoredPlan,
+    title: &str,
+) -> String {
     let t = &plan.totals;
     let mut h = String::new();
     let _ = write!(
         h,
-        r#"<!doctype html><html lang="en"><head><meta charset="utf-8"><title>Run sheet – {name}</title>
+        r#"<!doctype html><html lang="en"><head><meta charset="utf-8"><title>{title} – {name}</title>
 <style>
 body {{ font: 11pt system-ui, sans-serif; margin: 1.5cm; }}
 table {{ border-collapse: collapse; width: 100%; }}
@@ -95,12 +105,13 @@ th {{ background: #eee; }} tr {{ page-break-inside: avoid; }}
 .warn {{ color: #a40; }} .box {{ width: 1.2em; height: 1.2em; border: 1px solid #000; display: inline-block; }}
 @media print {{ body {{ margin: 0.8cm; }} }}
 </style></head><body>
-<h1>Run sheet: {name}</h1>
+<h1>{title}: {name}</h1>
 <p><b>Vessel:</b> {vessel} · <b>Plan version</b> {ver} ({created}) · <b>Grid:</b> {grid} {unit} · <b>Seed:</b> {seed}</p>
 <p><b>{n}</b> experiments · run time {run} · set-up {setup} · <b>total trial time {total}</b></p>
 <table><thead><tr><th>#</th><th>Code</th><th>Speed</th><th>Instruction</th><th>References</th><th>Duration</th><th>PE / band</th><th>Flown</th><th>Log file / notes</th></tr></thead><tbody>
 "#,
         name = esc(&campaign.spec.name),
+        title = esc(title),
         vessel = esc(&vessel.profile.name),
         ver = plan.version,
         created = esc(&plan.created_at),

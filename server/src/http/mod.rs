@@ -20,7 +20,9 @@ pub mod model_cache;
 pub mod model_export;
 pub mod model_views;
 pub mod models;
+pub mod next_dive;
 pub mod offload;
+mod planning_jobs;
 pub mod plans;
 pub mod precision;
 pub mod query;
@@ -115,7 +117,7 @@ impl AppState {
         description = "Sea-trial system identification of ROVs and dynamically positioned ships: plan trial campaigns, score runs, identify and validate models.",
         license(name = "MIT")
     ),
-    components(schemas(ErrorBody, JobEvent, model_export::ExportFormat, crate::storage::jobs::JobKind, crate::storage::jobs::IdentifyMethod, crate::jobs::precision::PrecisionSettings, crate::jobs::precision::PriorChoice, crate::jobs::design::DesignSettings)),
+    components(schemas(ErrorBody, JobEvent, model_export::ExportFormat, crate::storage::jobs::JobKind, crate::storage::jobs::IdentifyMethod, crate::jobs::precision::PrecisionSettings, crate::jobs::precision::PriorChoice, crate::jobs::design::DesignSettings, crate::jobs::next_dive::NextDiveSettings)),
     tags(
         (name = "service", description = "Service health"),
         (name = "accounts", description = "Sign-in, personal API tokens, users and roles, the audit trail"),
@@ -178,6 +180,8 @@ pub fn api() -> OpenApiRouter<AppState> {
         .routes(routes!(runs::coverage))
         .routes(routes!(precision::get_precision))
         .routes(routes!(design::get_design))
+        .routes(routes!(next_dive::get_next_dive))
+        .routes(routes!(next_dive::next_dive_run_sheet))
         .routes(routes!(
             clock_offsets::get_campaign_clock_offset,
             clock_offsets::put_campaign_clock_offset

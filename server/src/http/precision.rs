@@ -5,11 +5,10 @@ use axum::Json;
 use axum::extract::{Path, State};
 use serde::Serialize;
 
-use super::{AppState, found};
-use crate::error::{ApiError, ApiResult, ErrorBody};
+use super::AppState;
+use super::planning_jobs::newest_result;
+use crate::error::{ApiResult, ErrorBody};
 use crate::jobs::precision::PrecisionResult;
-use crate::storage::jobs::{self as stored, JobState};
-use crate::storage::{campaigns, plans};
 
 /// A stored prediction.
 #[derive(Debug, Serialize, utoipa::ToSchema)]
@@ -36,20 +35,18 @@ pub async fn get_precision(
     State(s): State<AppState>,
     Path(id): Path<String>,
 ) -> ApiResult<Json<CampaignPrecision>> {
-    found(campaigns::get(&s.db, &id).await?, "campaign", &id)?;
-    let jobs = stored::list(&s.db, Some(&id), Some(JobState::Succeeded)).await?;
-    let Some(job) = jobs.into_iter().find(|j| j.kind == "precision") else {
-        return Err(ApiError::NotFound(format!(
-            "campaign '{id}' has no predicted precision yet; submit POST /api/jobs {{\"kind\": \"precision\", \"campaign_id\": \"{id}\"}}"
-        )));
-    };
-    let result: PrecisionResult = serde_json::from_value(job.result.clone().unwrap_or_default())
-        .map_err(|e| ApiError::Internal(anyhow::anyhow!("stored prediction unreadable: {e}")))?;
-    let newest = plans::latest(&s.db, &id).await?.map(|p| p.id);
+    let (job, result, current) = newest_result(
+        &s,
+        &id,
+        "precision",
+        "predicted precision",
+        |r: &PrecisionResult| &r.plan_id,
+    )
+    .await?;
     Ok(Json(CampaignPrecision {
         job_id: job.id,
         finished_at: job.finished_at,
-        current: newest.as_deref() == Some(result.plan_id.as_str()),
+        current,
         result,
     }))
 }

@@ -12,7 +12,9 @@ use serde::{Deserialize, Serialize};
 
 use super::handler::{BoxFuture, Compute, JobContext, JobFailure, JobHandler, compute};
 use super::identify::parse_settings;
-use super::precision::{PriorChoice, build_prior, campaign_and_prior, failure, no_plan};
+use super::precision::{
+    PriorChoice, build_prior, campaign_and_prior, failure, no_plan, prior_or_default,
+};
 use crate::error::ApiError;
 use crate::storage::jobs::{Job, JobRequest};
 use crate::storage::plans;
@@ -50,14 +52,6 @@ pub struct DesignResult {
 /// The `design` handler.
 pub struct Design;
 
-fn prior_of(settings: &DesignSettings, req: &JobRequest) -> PriorChoice {
-    settings.prior.unwrap_or(if req.model_id.is_some() {
-        PriorChoice::Model
-    } else {
-        PriorChoice::Profile
-    })
-}
-
 async fn checked(
     cx: &JobContext,
     req: &JobRequest,
@@ -79,7 +73,8 @@ async fn checked(
             format!("must be a number of hours in (0, {MAX_BUDGET_HOURS}] (got {b})"),
         ));
     }
-    let found = campaign_and_prior(cx, req, "design", prior_of(&settings, req)).await?;
+    let found =
+        campaign_and_prior(cx, req, "design", prior_or_default(settings.prior, req)).await?;
     if found.profile.kind != VesselKind::Rov6 {
         return Err(ApiError::invalid(
             "campaign_id",
@@ -111,7 +106,7 @@ impl JobHandler for Design {
             let (settings, found, head) = checked(cx, req)
                 .await
                 .map_err(|e| JobFailure::new(e.to_string()))?;
-            let choice = prior_of(&settings, req);
+            let choice = prior_or_default(settings.prior, req);
             Ok(compute(move |progress: &mut dyn Progress| {
                 let (prior, source) = build_prior(choice, found.model, &found.profile)?;
                 let Prior::Rov(truth) = prior else {

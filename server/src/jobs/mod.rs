@@ -110,6 +110,7 @@ pub mod handler;
 pub mod heartbeat;
 pub mod identify;
 pub mod live;
+pub mod next_dive;
 pub mod precision;
 pub mod progress;
 pub mod registry;

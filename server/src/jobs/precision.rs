@@ -51,12 +51,18 @@ pub struct PrecisionSettings {
 
 impl PrecisionSettings {
     pub(super) fn prior(&self, req: &JobRequest) -> PriorChoice {
-        self.prior.unwrap_or(if req.model_id.is_some() {
-            PriorChoice::Model
-        } else {
-            PriorChoice::Profile
-        })
+        prior_or_default(self.prior, req)
     }
+}
+
+/// A planning job's prior: the one asked for, else `model` when the job
+/// names a `model_id`, else the vessel profile's rough numbers.
+pub(super) fn prior_or_default(prior: Option<PriorChoice>, req: &JobRequest) -> PriorChoice {
+    prior.unwrap_or(if req.model_id.is_some() {
+        PriorChoice::Model
+    } else {
+        PriorChoice::Profile
+    })
 }
 
 /// The job's result: the prediction and the plan version it is for.
@@ -112,6 +118,31 @@ async fn checked(cx: &JobContext, req: &JobRequest) -> Result<Checked, ApiError>
         settings,
         model: found.model,
     })
+}
+
+/// The campaign's newest plan as stored and as the core's [`Plan`] (its
+/// schedules read back).
+pub(super) async fn core_plan(
+    cx: &JobContext,
+    cid: &str,
+) -> Result<(plans::StoredPlan, Plan), JobFailure> {
+    let stored = plans::latest(&cx.db, cid)
+        .await?
+        .ok_or_else(|| JobFailure::field("campaign_id", "the plan was deleted"))?;
+    let mut experiments = Vec::with_capacity(stored.experiments.len());
+    let mut conn = cx.db.acquire().await?;
+    for e in &stored.experiments {
+        experiments.push(PlannedExperiment {
+            experiment: e.experiment.clone(),
+            schedule: plans::schedule(&mut conn, &e.id).await?,
+        });
+    }
+    drop(conn);
+    let plan = Plan {
+        experiments,
+        totals: stored.totals.clone(),
+    };
+    Ok((stored, plan))
 }
 
 /// The 422 of a campaign without a plan.
@@ -254,22 +285,7 @@ impl JobHandler for Precision {
                 .await
                 .map_err(|e| JobFailure::new(e.to_string()))?;
             let cid = req.campaign_id.clone().unwrap_or_default();
-            let stored = plans::latest(&cx.db, &cid)
-                .await?
-                .ok_or_else(|| JobFailure::field("campaign_id", "the plan was deleted"))?;
-            let mut experiments = Vec::with_capacity(stored.experiments.len());
-            let mut conn = cx.db.acquire().await?;
-            for e in &stored.experiments {
-                experiments.push(PlannedExperiment {
-                    experiment: e.experiment.clone(),
-                    schedule: plans::schedule(&mut conn, &e.id).await?,
-                });
-            }
-            drop(conn);
-            let plan = Plan {
-                experiments,
-                totals: stored.totals.clone(),
-            };
+            let (stored, plan) = core_plan(cx, &cid).await?;
             let choice = c.settings.prior(req);
             let seed = c.settings.seed.unwrap_or(1);
             let realisations = c.settings.realisations;

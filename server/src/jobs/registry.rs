@@ -22,13 +22,15 @@ impl JobRegistry {
     /// physics, and the augmented model as its next version) and
     /// `precision` (a plan and a prior → each parameter's predicted std) and
     /// `design` (a campaign, a prior and a budget → the plan that buys the
-    /// most precision in those hours).
+    /// most precision in those hours) and `next_dive` (the flown runs and
+    /// a dive's hours → the planned runs to fly next).
     pub fn production() -> Self {
         Self::new()
             .with("identify", super::identify::Identify)
             .with("discover", super::discover::Discover)
             .with("precision", super::precision::Precision)
             .with("design", super::design::Design)
+            .with("next_dive", super::next_dive::NextDiveJob)
     }
 
     /// Adds (or replaces) the handler of `kind`.

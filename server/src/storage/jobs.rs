@@ -65,7 +65,7 @@ impl JobState {
 #[serde(deny_unknown_fields)]
 pub struct JobRequest {
     /// The job's kind: one of the registered handlers (`identify`,
-    /// `discover`, `precision`, `design`).
+    /// `discover`, `precision`, `design`, `next_dive`).
     #[schema(value_type = JobKind)]
     pub kind: String,
     /// The campaign the runs belong to.
@@ -76,7 +76,7 @@ pub struct JobRequest {
     pub run_ids: Vec<String>,
     /// The method, as the kind defines it. `identify`: `lambda_kf` (default
     /// for ROVs), `parallel_ekf` (default for DP vessels; DP only) or
-    /// `n4sid`; `discover`, `precision` and `design` take none.
+    /// `n4sid`; the other kinds take none.
     #[serde(default)]
     #[schema(value_type = Option<IdentifyMethod>)]
     pub method: Option<String>,
@@ -85,7 +85,7 @@ pub struct JobRequest {
     #[schema(value_type = Object)]
     pub settings: serde_json::Value,
     /// A model to start from (discovery), or the prior a plan is flown
-    /// with (precision and design, `settings.prior = model`).
+    /// with (precision, design, next_dive: `settings.prior = model`).
     #[serde(default)]
     pub model_id: Option<String>,
 }
@@ -108,6 +108,10 @@ pub enum JobKind {
     /// `DesignSettings`; a prior model in `model_id`; ROVs); the result is
     /// a `DesignResult`.
     Design,
+    /// The next dive's runs from what was flown (settings:
+    /// `NextDiveSettings`; a prior model in `model_id`; ROVs); the result
+    /// is a `NextDiveResult`.
+    NextDive,
 }
 
 /// The methods of an `identify` job (documentation only; an unknown one is a 422).

@@ -75,8 +75,9 @@ pub struct NextDive {
 /// (`done`, not proposed again); candidates are flown with `truth`.
 ///
 /// # Errors
-/// A dive of no hours; a flown run or a planned experiment the
-/// identification's data path refuses (named); cancellation.
+/// A dive of no hours; a planned experiment the identification's data path
+/// refuses (named); cancellation. A flown run it refuses is left out and
+/// named in the notes.
 pub fn propose_next_dive(
     profile: &VesselProfile,
     plan: &Plan,
@@ -113,14 +114,21 @@ pub fn propose_next_dive(
         grams: vec![None; grid.len()],
     };
     let inputs = input_columns(profile);
+    let mut notes = Vec::new();
     for run in flown
         .iter()
         .filter(|r| r.family != Some(ExperimentFamily::Validation))
     {
-        let info = lambda_information(profile, &grid, &inputs, std::slice::from_ref(run))
-            .map_err(|e| DesignError::new(format!("runs[{}]", run.run_id), e.to_string()))?;
-        for i in info {
-            now.add(i.grid_index, &i.gram);
+        match lambda_information(profile, &grid, &inputs, std::slice::from_ref(run)) {
+            Ok(info) => {
+                for i in info {
+                    now.add(i.grid_index, &i.gram);
+                }
+            }
+            Err(e) => notes.push(format!(
+                "run '{}' left out: the identification could not use it ({e})",
+                run.name
+            )),
         }
     }
     let score = |info: &PlanInformation| -> f64 {
@@ -231,11 +239,14 @@ pub fn propose_next_dive(
         hours: used_s / 3600.0,
         left_for_later: candidates.len(),
         proposed,
-        notes: vec![
+        notes: [
             "the flown runs count with their own logged data; runs with rejected or insufficient excitation are left out".into(),
             "candidates are the plan's experiments not yet covered by a good run, each flown noise-free with the prior; the λ regression's information (port–starboard structure, constant loads and g(η)'s shapes) ranks them per hour of run and set-up".into(),
             "stds are geometric means over the parameters, relative to the whole plan flown".into(),
-        ],
+        ]
+        .into_iter()
+        .chain(notes)
+        .collect(),
     })
 }
 
