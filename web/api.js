@@ -108,6 +108,9 @@ export const api = {
   precision: (id) => request('GET', `/api/campaigns/${enc(id)}/precision`),
   // The newest experiment design of the campaign (404 before the first `design` job).
   design: (id) => request('GET', `/api/campaigns/${enc(id)}/design`),
+  // The newest next-dive proposal (404 before the first `next_dive` job).
+  nextDive: (id) => request('GET', `/api/campaigns/${enc(id)}/next-dive`),
+  nextDiveSheetUrl: (id) => `/api/campaigns/${enc(id)}/next-dive/runsheet`,
   // Clock offsets of two-file runs (s; null clears the one set by hand).
   campaignClockOffset: (id) => request('GET', `/api/campaigns/${enc(id)}/clock-offset`),
   setCampaignClockOffset: (id, s) => request('PUT', `/api/campaigns/${enc(id)}/clock-offset`, { clock_offset_s: s }),

@@ -9,6 +9,7 @@ import { deletedBadge } from './manage.js';
 import { sectionNav } from './sectionnav.js';
 import { precisionSection } from './precision.js';
 import { designSection } from './design.js';
+import { nextDiveSection } from './nextdive.js';
 import {
   FAMILY_LABEL, KIND_LABEL, SIGNAL_LABEL, bandText, describeWaveform, fmt, fmtDate, fmtKn, hms,
   peText, secs, unitLabel,
@@ -120,6 +121,8 @@ export async function campaignPage(view, id) {
   let precision = null; // the Predicted precision section's controller
   const designHost = h('section', { class: 'design', 'aria-label': 'Experiment design', 'data-testid': 'design-section' });
   let design = null; // the Experiment design section's controller
+  const nextDiveHost = h('section', { class: 'next-dive', 'aria-label': 'Next dive', 'data-testid': 'next-dive-section' });
+  let nextDive = null; // the Next dive section's controller
   let runs = null; // the Runs section's controller
   let ident = null; // the Identification section's controller
 
@@ -143,12 +146,13 @@ export async function campaignPage(view, id) {
       h('dt', null, 'Excitation'), h('dd', null, excitationText(c)),
       h('dt', null, 'Durations'), h('dd', null, DURATIONS.filter((d) => durs[d.key] != null).map((d) => `${d.label.toLowerCase()} ${fmt(durs[d.key])} s`).join(' · ') || 'defaults'),
       h('dt', null, 'Seed'), h('dd', { class: 'mono' }, c.seed ?? 'default')),
-    sectionNav([['runs', 'Runs'], ['coverage', 'Coverage'], ['jobs', 'Jobs'], ['models', 'Models'], ['precision', 'Precision'], ['design', 'Design'], ['plan', 'Plan'], ['deleted', 'Deleted']]),
+    sectionNav([['runs', 'Runs'], ['coverage', 'Coverage'], ['jobs', 'Jobs'], ['models', 'Models'], ['precision', 'Precision'], ['design', 'Design'], ['next-dive', 'Next dive'], ['plan', 'Plan'], ['deleted', 'Deleted']]),
     runsHost,
     campaignOffsetPanel(c.id),
     identifyHost,
     precisionHost,
     designHost,
+    nextDiveHost,
     planTitle,
     planHost,
     trash.host);
@@ -162,6 +166,7 @@ export async function campaignPage(view, id) {
     if (ident) ident.setPlan(plan);
     if (precision) precision.setPlan(plan);
     if (design) design.setPlan(plan);
+    if (nextDive) nextDive.setPlan(plan);
   }
 
   async function generate() {
@@ -394,6 +399,12 @@ export async function campaignPage(view, id) {
       h('p', { class: 'error-text', role: 'alert' }, `Could not load the design: ${err.status ? `${err.status} · ` : ''}${err.message}`));
   }
   try {
+    nextDive = await nextDiveSection(nextDiveHost, { campaign, plan });
+  } catch (err) {
+    fill(nextDiveHost, h('h2', { class: 'section-title' }, 'Next dive'),
+      h('p', { class: 'error-text', role: 'alert' }, `Could not load the proposal: ${err.status ? `${err.status} · ` : ''}${err.message}`));
+  }
+  try {
     precision = await precisionSection(precisionHost, { campaign, plan });
   } catch (err) {
     fill(precisionHost, h('h2', { class: 'section-title' }, 'Predicted precision'),
@@ -409,6 +420,7 @@ export async function campaignPage(view, id) {
       if (ident) ident.destroy();
       if (precision) precision.destroy();
       if (design) design.destroy();
+      if (nextDive) nextDive.destroy();
     },
   };
 }

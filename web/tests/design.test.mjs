@@ -62,3 +62,33 @@ test('design the campaign for its ship hours, read the trade-off, adopt it', asy
     assert.ok(Math.abs(plan.json.totals.total_time_s / 3600 - d.json.design.design.hours) < 1e-9);
   });
 });
+
+test('propose the next dive before any run is flown, and open its run sheet', async () => {
+  await H.withPage([], async (page) => {
+    await page.goto(`${H.base}/#/campaigns/${cid}`);
+    await page.getByRole('form', { name: 'Propose next dive' }).waitFor();
+    await page.locator(tid('next-dive-none')).waitFor();
+    await page.locator(tid('next-dive-prior')).selectOption('reference');
+    await page.locator(tid('next-dive-hours')).fill('1.5');
+    await page.getByRole('button', { name: 'Propose next dive' }).click();
+    await page.locator(tid('next-dive-summary')).waitFor({ timeout: 120000 });
+    assert.match(await page.textContent(tid('next-dive-summary')),
+      /^0 flown runs counted: stds not yet identifiable the whole plan’s now; \d+ runs? in \d\.\d\d h of the 1\.5 h dive bring them to ×\d\.\d+/);
+    const codes = await page.locator(`${tid('next-dive-row')} td:nth-child(2)`).allTextContents();
+    assert.ok(codes.length >= 2, codes.join());
+    assert.match(codes[0], /^VAL-/);
+    assert.match(await page.locator(`${tid('next-dive-row')} td:nth-child(5)`).first().textContent(), /no validation run has been flown/);
+    // The run sheet lists the proposal in its order.
+    const href = await page.locator(tid('next-dive-sheet')).getAttribute('href');
+    const sheet = await page.request.get(`${H.base}${href}`);
+    assert.equal(sheet.status(), 200);
+    const html = await sheet.text();
+    assert.match(html, /<h1>Next dive: Designed trial<\/h1>/);
+    let at = 0;
+    for (const c of codes) {
+      const i = html.indexOf(c, at);
+      assert.ok(i >= 0, `${c} in order on the run sheet`);
+      at = i;
+    }
+  });
+});
