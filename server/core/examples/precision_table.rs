@@ -7,9 +7,11 @@
 //! the project's own simulator flying the plan with the prior. `--retune`
 //! re-tunes the truth's autopilot per seed (nominal inertia and ĝ(η)
 //! drawn anew), so the spread also holds the change of the closed loop.
-//! `--no-recursive` leaves the recursive family (REC runs) out of the plan.
+//! `--no-recursive` leaves the recursive family (REC runs) out of the plan;
+//! `--designed` flies the campaign as `design::design_campaign` designs it
+//! within the rule-based plan's hours.
 //!
-//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--grid-kn 0.5,2,3.5]`
+//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--designed] [--grid-kn 0.5,2,3.5]`
 
 #[path = "../tests/support/precision_truth.rs"]
 mod precision_truth;
@@ -30,6 +32,7 @@ fn main() {
             "--own" => own = true,
             "--retune" => retune = true,
             "--no-recursive" => variant.no_recursive = true,
+            "--designed" => variant.designed = true,
             "--grid-kn" => {
                 variant.grid_kn = Some(
                     it.next()

@@ -64,6 +64,10 @@ pub struct PlanVariant {
     /// Leaves out the recursive family (the all-DOF REC runs, whose
     /// roll/pitch rate references integrate to large attitudes).
     pub no_recursive: bool,
+    /// Flies the campaign as `design::design_campaign` designs it within
+    /// the rule-based plan's hours (prior: the source documents' vessel,
+    /// as a supervisor would have; the truth flies it).
+    pub designed: bool,
 }
 
 /// The service's rule-based Surveyor plan, as `variant` asks.
@@ -75,6 +79,15 @@ pub fn plan(variant: &PlanVariant) -> (VesselProfile, Plan) {
     }
     if variant.no_recursive {
         spec.families.retain(|f| *f != ExperimentFamily::Recursive);
+    }
+    if variant.designed {
+        let Prior::Rov(prior) = Prior::reference(&profile).expect("the reference prior") else {
+            panic!("the Surveyor's prior is an ROV")
+        };
+        spec =
+            seatrial_core::design::design_campaign(&profile, &spec, &prior, None, &mut NoProgress)
+                .expect("the design")
+                .spec;
     }
     let plan = seatrial_core::planning::generate_plan(&profile, &spec).expect("the plan");
     (profile, plan)
