@@ -557,17 +557,26 @@ pub fn print_table(c: &[Comparison], seeds: usize) -> Summary {
     );
     for c in &live {
         let f = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{v:.3e}"));
+        // A ratio without its denominator (no own-simulator spread asked
+        // for, or a zero std) is shown as "—", never as inf.
+        let r = |v: f64| {
+            if v.is_finite() {
+                format!("{v:.3}")
+            } else {
+                "—".to_string()
+            }
+        };
         println!(
-            "{:<36} {:>11} {:>11.3e} {:>11} {:>11} {:>8.3} {:>8.3} {:>8.3} {:>8.3}{}",
+            "{:<36} {:>11} {:>11.3e} {:>11} {:>11} {:>8} {:>8} {:>8} {:>8}{}",
             c.name(),
             f(c.predicted),
             c.empirical,
             f(c.reported),
             f(c.self_spread),
-            c.ratio(),
-            c.reported_ratio(),
-            c.reported_over_predicted(),
-            c.truth_over_self(),
+            r(c.ratio()),
+            r(c.reported_ratio()),
+            r(c.reported_over_predicted()),
+            r(c.truth_over_self()),
             if c.within() { "" } else { "  ✗" }
         );
     }
