@@ -38,7 +38,8 @@ pub struct ProposedRun {
     /// Run length (s).
     pub duration_s: f64,
     /// Geometric-mean std of the campaign after this run, relative to the
-    /// whole plan flown: 1.2 means 20 % above what the plan promises.
+    /// whole plan flown: 1.2 means 20 % above what the plan promises; 0
+    /// while a grid point still has no data (not yet identifiable).
     pub relative_std_after: f64,
     /// Why it was chosen, in words.
     pub reason: String,
@@ -171,7 +172,7 @@ pub fn propose_next_dive(
             proposed.push(proposal(
                 plan,
                 i,
-                rel(&now).unwrap_or(f64::NAN),
+                rel(&now).unwrap_or(0.0),
                 "no validation run has been flown, and the identification holds one out".into(),
             ));
         }
@@ -217,12 +218,7 @@ pub fn propose_next_dive(
         } else {
             "the most precision per hour among the runs not yet flown".into()
         };
-        proposed.push(proposal(plan, i, rel(&now).unwrap_or(f64::NAN), reason));
-    }
-    for p in &mut proposed {
-        if !p.relative_std_after.is_finite() {
-            p.relative_std_after = 0.0;
-        }
+        proposed.push(proposal(plan, i, rel(&now).unwrap_or(0.0), reason));
     }
     let uncovered_speeds_mps = grid
         .iter()
