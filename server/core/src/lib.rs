@@ -34,6 +34,7 @@ pub mod kernels;
 pub mod logs;
 pub mod models;
 pub mod numbers;
+mod par;
 pub mod planning;
 pub mod quality;
 pub mod responses;

@@ -133,6 +133,20 @@ impl Accumulators {
         }
     }
 
+    /// Adds the sums of `other` (same channels, pairs and bins) to these,
+    /// and keeps its buffers for the next call on this thread.
+    pub(super) fn absorb(&mut self, other: Accumulators) {
+        for (a, b) in self.auto.iter_mut().zip(&other.auto) {
+            *a += b;
+        }
+        for (a, b) in self.cross.iter_mut().zip(&other.cross) {
+            *a += b;
+        }
+        for buffer in [other.planes, other.auto, other.cross] {
+            scratch::give_back(buffer);
+        }
+    }
+
     /// The spectra: sums times the density `factors`.
     pub(super) fn finish(
         self,

@@ -13,7 +13,9 @@ use crate::kernels::has_avx2_fma;
 /// Windowed, detrended real FFTs of the successive segments of a signal.
 ///
 /// Built once per estimate; [`SegmentFft::transform`] reuses the plan and the
-/// internal buffers, so nothing is allocated per segment.
+/// internal buffers, so nothing is allocated per segment. A clone shares the
+/// plan (for a second thread) and has buffers of its own.
+#[derive(Clone)]
 pub(crate) struct SegmentFft {
     fft: Arc<dyn RealToComplex<f64>>,
     window: Vec<f64>,

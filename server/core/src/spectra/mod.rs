@@ -29,6 +29,7 @@
 //! segments: no allocation per segment.
 
 mod accumulators;
+mod batches;
 mod config;
 mod cross;
 mod detrend;

@@ -21,7 +21,8 @@ use std::ops::Range;
 
 use realfft::num_complex::Complex;
 
-use super::accumulators::{Accumulators, BATCH};
+use super::accumulators::Accumulators;
+use super::batches::{batches, run_batches, split_point};
 use super::engine::SegmentFft;
 use super::{Detrend, SpectraError, WelchConfig};
 
@@ -170,6 +171,12 @@ pub(crate) fn multi_welch_finite(
 /// The estimate on validated inputs, over `n_segments ≥ 1` segments; with
 /// `check_finite` (constant detrend only), a non-finite sample inside a
 /// segment is a [`SpectraError::NonFinite`].
+///
+/// Large estimates are split at a batch boundary near the middle of the
+/// segments: each half is summed on its own thread (see [`crate::par`])
+/// and the two sums are then added. The split depends on the input sizes
+/// only, so the result is the same with one core or two; it differs from
+/// one running sum over all segments by rounding (≤ a few ulp of the sums).
 fn compute(
     channels: &[&[f64]],
     blocks: &[Range<usize>],
@@ -194,49 +201,65 @@ fn compute(
     } else {
         cfg.clone()
     };
-    let mut engine = SegmentFft::new(&engine_cfg, virtual_len);
+    let engine = SegmentFft::new(&engine_cfg, virtual_len);
     debug_assert_eq!(engine.n_segments(), n_segments);
 
-    let mut acc = Accumulators::new(channels.len(), pairs, cfg.n_freqs());
-    let mut spec = engine.make_output();
-    for block in blocks {
-        let n_block = cfg.n_segments(block.len());
-        // Up to BATCH consecutive segments of one channel after another:
-        // the samples they share are read while still in cache.
-        for first in (0..n_block).step_by(BATCH) {
-            let count = BATCH.min(n_block - first);
-            for (c, channel) in channels.iter().enumerate() {
-                // The channel's last segment mean: the next segment's shift.
-                let mut mean = f64::NAN;
-                for slot in 0..count {
-                    let m = first + slot;
-                    let start = block.start + m * step;
-                    let end = start + cfg.nperseg;
-                    if own_mean {
-                        let samples = &channel[start..end];
-                        let shift = if mean.is_finite() { mean } else { samples[0] };
-                        // The samples the next segment adds (within the block).
-                        let ahead = end.min(block.end)..(end + step).min(block.end);
-                        let offset =
-                            engine.transform_centred(samples, shift, &channel[ahead], &mut spec)?;
-                        if check_finite && !offset.is_finite() {
-                            require_finite_channel(
-                                c,
-                                channel,
-                                std::slice::from_ref(&(start..end)),
-                            )?;
-                        }
-                        mean = shift + offset;
-                    } else {
-                        engine.transform(&channel[block.clone()], m, &mut spec)?;
-                    }
-                    acc.add_channel(slot, c, &spec);
-                }
-            }
-            acc.add_segments(count);
-        }
-    }
+    let batches = batches(blocks, cfg);
+    let work = n_segments
+        .saturating_mul(channels.len())
+        .saturating_mul(cfg.nperseg);
+    let split = split_point(&batches, n_segments, work);
+    let (head, tail) = batches.split_at(split);
+    let nf = cfg.n_freqs();
+    let mut acc = Accumulators::new(channels.len(), pairs, nf);
     let factors = engine.density_factors(cfg.fs);
+    if tail.is_empty() {
+        let mut engine = engine;
+        run_batches(
+            &mut engine,
+            &mut acc,
+            head,
+            channels,
+            cfg,
+            own_mean,
+            check_finite,
+        )?;
+    } else {
+        // Both sets of sums are taken here, so that their buffers are this
+        // thread's kept ones (see `Accumulators::new`).
+        let mut second = Accumulators::new(channels.len(), pairs, nf);
+        let mut other_engine = engine.clone();
+        let mut engine = engine;
+        let (a, b) = crate::par::join(
+            true,
+            || {
+                run_batches(
+                    &mut engine,
+                    &mut acc,
+                    head,
+                    channels,
+                    cfg,
+                    own_mean,
+                    check_finite,
+                )
+            },
+            || {
+                run_batches(
+                    &mut other_engine,
+                    &mut second,
+                    tail,
+                    channels,
+                    cfg,
+                    own_mean,
+                    check_finite,
+                )
+            },
+        );
+        // The first half's error first: a serial run would meet it first.
+        a?;
+        b?;
+        acc.absorb(second);
+    }
     Ok(acc.finish(pairs, &factors, cfg.frequencies(), n_segments))
 }
 
@@ -329,7 +352,7 @@ fn require_finite(channels: &[&[f64]], blocks: &[Range<usize>]) -> Result<(), Sp
 }
 
 /// Checks that every sample of channel `i` inside the blocks is finite.
-fn require_finite_channel(
+pub(super) fn require_finite_channel(
     i: usize,
     c: &[f64],
     blocks: &[Range<usize>],
