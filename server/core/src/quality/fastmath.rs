@@ -14,6 +14,7 @@
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, LOG10_E, PI};
 
+#[cfg(test)]
 use crate::spectra::Complex;
 
 /// fdlibm `atan` coefficients for |x| ≤ 7/16.
@@ -54,7 +55,9 @@ const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-01;
 const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
 
 /// `out[k] = arg(c[k]) = atan2(c[k].im, c[k].re)`, through the split
-/// planes `re`, `im` (scratch, resized) so the main loop vectorises.
+/// planes `re`, `im` (scratch, resized) so the main loop vectorises. (The
+/// report's cross spectra come in planes already: a test reference.)
+#[cfg(test)]
 pub(crate) fn arg_into(c: &[Complex<f64>], re: &mut Vec<f64>, im: &mut Vec<f64>, out: &mut [f64]) {
     re.clear();
     im.clear();

@@ -34,14 +34,32 @@ pub(super) struct Accumulators {
 impl Accumulators {
     /// Zeroed sums for `n_channels` spectra of `nf` bins and `pairs`.
     pub(super) fn new(n_channels: usize, pairs: &[(usize, usize)], nf: usize) -> Self {
+        let mut acc = Self::unzeroed(n_channels, pairs, nf);
+        acc.zero();
+        acc
+    }
+
+    /// [`Accumulators::new`] with its sums not yet zeroed: call
+    /// [`Accumulators::zero`] before adding. The buffers come from the
+    /// calling thread's kept ones; the zeroing can run on the thread that
+    /// adds.
+    pub(super) fn unzeroed(n_channels: usize, pairs: &[(usize, usize)], nf: usize) -> Self {
         let slots = if pairs.is_empty() { 0 } else { BATCH };
         Accumulators {
             nf,
-            planes: scratch::zeroed(n_channels * slots * 2 * nf),
-            auto: scratch::zeroed(n_channels * nf),
-            cross: scratch::zeroed(pairs.len() * 2 * nf),
+            // Every held value is written (`add_channel`) before it is read
+            // (`add_segments`): never zeroed (1.6 MB for a 6 × 6 report).
+            planes: scratch::reused(n_channels * slots * 2 * nf),
+            auto: scratch::reused(n_channels * nf),
+            cross: scratch::reused(pairs.len() * 2 * nf),
             pairs: pairs.to_vec(),
         }
+    }
+
+    /// Sets every sum to zero.
+    pub(super) fn zero(&mut self) {
+        self.auto.fill(0.0);
+        self.cross.fill(0.0);
     }
 
     /// Adds `|X|²` of channel `c`'s spectrum to its PSD and, when there are
@@ -147,6 +165,37 @@ impl Accumulators {
         }
     }
 
+    /// [`Accumulators::finish`] with the cross spectra left in their planes
+    /// (scaled in place: the same products as there).
+    pub(super) fn finish_planes(
+        mut self,
+        factors: &[f64],
+        freqs: Vec<f64>,
+        n_segments: usize,
+    ) -> PlaneSpectra {
+        let nf = self.nf;
+        let auto = self
+            .auto
+            .chunks_exact(nf.max(1))
+            .map(|c| c.iter().zip(factors).map(|(v, f)| v * f).collect())
+            .collect();
+        for plane in self.cross.chunks_exact_mut(nf.max(1)) {
+            for (v, f) in plane.iter_mut().zip(factors) {
+                *v *= f;
+            }
+        }
+        for buffer in [self.planes, self.auto] {
+            scratch::give_back(buffer);
+        }
+        PlaneSpectra {
+            freqs,
+            auto,
+            n_segments,
+            cross: self.cross,
+            nf,
+        }
+    }
+
     /// The spectra: sums times the density `factors`.
     pub(super) fn finish(
         self,
@@ -186,6 +235,39 @@ impl Accumulators {
     }
 }
 
+/// Welch spectra of several channels with the cross spectra in split
+/// planes, as the quality report reads them: [`MultiSpectra`] without its
+/// complex vectors. The planes' buffer is kept for the next call on the
+/// thread that drops it.
+pub(crate) struct PlaneSpectra {
+    /// Frequencies in Hz.
+    pub freqs: Vec<f64>,
+    /// One-sided PSD of each channel.
+    pub auto: Vec<Vec<f64>>,
+    /// Segments averaged.
+    pub n_segments: usize,
+    /// Cross spectra, `[pair][re | im][bin]`.
+    cross: Vec<f64>,
+    nf: usize,
+}
+
+impl PlaneSpectra {
+    /// `(Re P_ij, Im P_ij)` of the `p`-th requested pair (empty when out of
+    /// range).
+    pub(crate) fn cross(&self, p: usize) -> (&[f64], &[f64]) {
+        let nf = self.nf;
+        self.cross
+            .get(p * 2 * nf..(p + 1) * 2 * nf)
+            .map_or((&[][..], &[][..]), |c| c.split_at(nf))
+    }
+}
+
+impl Drop for PlaneSpectra {
+    fn drop(&mut self) {
+        scratch::give_back(std::mem::take(&mut self.cross));
+    }
+}
+
 /// `(re, im) + conj(x)·y`.
 #[inline(always)]
 fn term<const FMA: bool>(xr: f64, xi: f64, yr: f64, yi: f64, re: f64, im: f64) -> (f64, f64) {
@@ -213,8 +295,10 @@ mod scratch {
         static FREE: RefCell<Vec<Vec<f64>>> = const { RefCell::new(Vec::new()) };
     }
 
-    /// A zeroed buffer of `len` values, reusing a kept one when there is.
-    pub(super) fn zeroed(len: usize) -> Vec<f64> {
+    /// A buffer of `len` values, reusing a kept one when there is, with
+    /// unspecified (finite or not) contents: for values written before
+    /// they are read.
+    pub(super) fn reused(len: usize) -> Vec<f64> {
         let kept = FREE.with(|f| {
             let mut f = f.borrow_mut();
             // The smallest kept buffer that holds `len`, else the largest.
@@ -229,7 +313,7 @@ mod scratch {
         });
         match kept {
             Some(mut v) => {
-                v.clear();
+                v.truncate(len);
                 v.resize(len, 0.0);
                 v
             }

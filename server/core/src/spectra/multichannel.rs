@@ -21,7 +21,7 @@ use std::ops::Range;
 
 use realfft::num_complex::Complex;
 
-use super::accumulators::Accumulators;
+use super::accumulators::{Accumulators, PlaneSpectra};
 use super::batches::{batches, run_batches, split_point};
 use super::engine::SegmentFft;
 use super::{Detrend, SpectraError, WelchConfig};
@@ -139,10 +139,12 @@ pub fn multi_welch(
             .map(|b| b.start + covered(cfg, b.len()).min(b.len())..b.end)
             .collect();
         require_finite(channels, &uncovered)?;
-        compute(channels, blocks, pairs, cfg, n_segments, true)
+        let (acc, factors) = compute(channels, blocks, pairs, cfg, n_segments, true)?;
+        Ok(acc.finish(pairs, &factors, cfg.frequencies(), n_segments))
     } else {
         require_finite(channels, blocks)?;
-        compute(channels, blocks, pairs, cfg, n_segments, false)
+        let (acc, factors) = compute(channels, blocks, pairs, cfg, n_segments, false)?;
+        Ok(acc.finish(pairs, &factors, cfg.frequencies(), n_segments))
     }
 }
 
@@ -157,20 +159,24 @@ fn covered(cfg: &WelchConfig, len: usize) -> usize {
 /// [`multi_welch`] for channels the caller has already checked to be
 /// finite inside the blocks (the quality report does so while computing
 /// its statistics): skips that scan, one pass over every sample. A NaN
-/// left in gives NaN spectra, never a panic.
+/// left in gives NaN spectra, never a panic. The cross spectra stay in the
+/// accumulators' split planes (no copy into complex vectors); the values
+/// are those of [`multi_welch`] bit for bit.
 pub(crate) fn multi_welch_finite(
     channels: &[&[f64]],
     blocks: &[Range<usize>],
     pairs: &[(usize, usize)],
     cfg: &WelchConfig,
-) -> Result<MultiSpectra, SpectraError> {
+) -> Result<PlaneSpectra, SpectraError> {
     let n_segments = validate(channels, blocks, pairs, cfg)?;
-    compute(channels, blocks, pairs, cfg, n_segments, false)
+    let (acc, factors) = compute(channels, blocks, pairs, cfg, n_segments, false)?;
+    Ok(acc.finish_planes(&factors, cfg.frequencies(), n_segments))
 }
 
-/// The estimate on validated inputs, over `n_segments ≥ 1` segments; with
-/// `check_finite` (constant detrend only), a non-finite sample inside a
-/// segment is a [`SpectraError::NonFinite`].
+/// The sums of the estimate on validated inputs, over `n_segments ≥ 1`
+/// segments, and the density factors that scale them; with `check_finite`
+/// (constant detrend only), a non-finite sample inside a segment is a
+/// [`SpectraError::NonFinite`].
 ///
 /// Large estimates are split at a batch boundary near the middle of the
 /// segments: each half is summed on its own thread (see [`crate::par`])
@@ -184,7 +190,7 @@ fn compute(
     cfg: &WelchConfig,
     n_segments: usize,
     check_finite: bool,
-) -> Result<MultiSpectra, SpectraError> {
+) -> Result<(Accumulators, Vec<f64>), SpectraError> {
     // `SegmentFft` scales by its own segment count: give it a length that
     // holds exactly `n_segments` segments, nperseg + (n_segments − 1)·step.
     let step = cfg.step();
@@ -227,7 +233,7 @@ fn compute(
     } else {
         // Both sets of sums are taken here, so that their buffers are this
         // thread's kept ones (see `Accumulators::new`).
-        let mut second = Accumulators::new(channels.len(), pairs, nf);
+        let mut second = Accumulators::unzeroed(channels.len(), pairs, nf);
         let mut other_engine = engine.clone();
         let mut engine = engine;
         let (a, b) = crate::par::join(
@@ -244,6 +250,7 @@ fn compute(
                 )
             },
             || {
+                second.zero();
                 run_batches(
                     &mut other_engine,
                     &mut second,
@@ -260,7 +267,7 @@ fn compute(
         b?;
         acc.absorb(second);
     }
-    Ok(acc.finish(pairs, &factors, cfg.frequencies(), n_segments))
+    Ok((acc, factors))
 }
 
 /// True when every sample is finite: `v · 0` is 0 for a finite `v` and NaN
