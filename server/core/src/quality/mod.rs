@@ -27,6 +27,7 @@
 mod adherence;
 mod excitation;
 mod fastmath;
+mod gram;
 mod record;
 mod regressor;
 mod report;
