@@ -29,22 +29,23 @@ where
     if !parallel || cores() < 2 {
         return (a(), b());
     }
-    // `b` waits in a slot: the thread takes it, or the caller does when
-    // the thread could not be started.
+    // `b` waits in a slot: the thread takes it when it starts; the caller
+    // takes it back when it is done with `a` first (on a busy machine the
+    // thread may not have been scheduled yet) or no thread could start.
     let slot = Mutex::new(Some(b));
     let take = || slot.lock().ok().and_then(|mut s| s.take());
     std::thread::scope(|s| {
         let handle = std::thread::Builder::new().spawn_scoped(s, || take().map(|b| b()));
         let ra = a();
-        let rb = match handle {
+        let here = take().map(|b| b());
+        let there = match handle {
             Ok(h) => match h.join() {
                 Ok(rb) => rb,
                 Err(panic) => std::panic::resume_unwind(panic),
             },
             Err(_) => None,
         };
-        // Not run by a thread (none started): run it here.
-        let rb = rb.or_else(|| take().map(|b| b()));
+        let rb = here.or(there);
         (ra, rb.expect("the second half runs exactly once"))
     })
 }
