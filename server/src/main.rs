@@ -75,9 +75,14 @@ enum AuthMode {
     Required,
 }
 
-/// Two runtimes (see `seatrial::runtime`): the job workers' own, built first
+/// The service's allocator (see the workspace's Cargo.toml).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+/// The compute pool and two runtimes (see `seatrial::runtime`): the job workers' own, built first
 /// from the main thread at its priority, and the HTTP one that runs `serve`.
 fn main() -> anyhow::Result<()> {
+    seatrial::runtime::compute_pool()?;
     let jobs = seatrial::runtime::jobs()?;
     let http = seatrial::runtime::http()?;
     http.block_on(serve(jobs.handle().clone()))

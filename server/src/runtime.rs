@@ -20,6 +20,18 @@ pub fn http() -> std::io::Result<Runtime> {
         .build()
 }
 
+/// Starts rayon's global pool (the numerics' fork–join, see
+/// `server/core/src/par.rs`): one thread per core, `seatrial-compute-N` at nice
+/// 0. Called first from the main thread, so that no HTTP thread (nice
+/// [`HTTP_NICE`]) starts it and hands its priority down.
+pub fn compute_pool() -> std::io::Result<()> {
+    rayon::ThreadPoolBuilder::new()
+        .thread_name(|i| format!("seatrial-compute-{i}"))
+        .start_handler(|_| set_nice(0))
+        .build_global()
+        .map_err(std::io::Error::other)
+}
+
 /// The runtime of the job workers: one async thread, threads `seatrial-jobs`
 /// at nice 0 (the computations' blocking threads are spawned from it).
 pub fn jobs() -> std::io::Result<Runtime> {

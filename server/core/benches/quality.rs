@@ -19,6 +19,9 @@
 //! - `fft_pairs_only_*`: half as many complex FFTs of 4096 points (two real
 //!   channels packed in one), for reference: ~10 % below `fft_only`.
 //!
+//! The report runs as in the service: its halves on rayon's pool, memory
+//! from mimalloc.
+//!
 //! `cargo bench -p seatrial-core --bench quality`.
 
 use std::hint::black_box;
@@ -30,6 +33,10 @@ use seatrial_core::planning::Dof;
 use seatrial_core::quality::{DofChannels, QualitySpec, quality_report};
 use seatrial_core::spectra::{WelchConfig, multi_welch};
 use seatrial_core::timeseries::UniformRecord;
+
+/// The service's allocator (`server/src/main.rs`): measured as it runs.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 const FS: f64 = 10.0;
 const NPERSEG: usize = 4096;

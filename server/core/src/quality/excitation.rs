@@ -130,19 +130,17 @@ pub(crate) fn nyquist_check(
     }
 }
 
-/// Everything the report says about one input.
-#[allow(clippy::too_many_arguments)]
+/// Everything the report says about one input, from its statistics, its
+/// PE order and cap ([`pe_over_blocks`]) and its PSD.
 pub(crate) fn input_quality(
     name: &str,
-    x: &[f64],
-    blocks: &[Range<usize>],
     (mean, rms): (f64, f64),
+    (pe_order, pe_cap): (usize, usize),
     freqs: &[f64],
     psd: Vec<f64>,
     fs: f64,
     controller_rate_hz: Option<f64>,
 ) -> InputQuality {
-    let (pe_order, pe_cap) = pe_over_blocks(x, blocks, Some(mean));
     let spectrum = Spectrum {
         freqs: freqs.to_vec(),
         values: psd,

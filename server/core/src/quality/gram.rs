@@ -11,8 +11,8 @@ use crate::kernels::dots;
 /// (12 × 2048 doubles) stays in the L2 cache while all its dot products run.
 const CHUNK: usize = 2048;
 
-/// Core rows × channels from which a block's core sums are computed on two
-/// threads (see `crate::par`): ~0.2 ms of dot products.
+/// Core rows × channels per part of a block's core sums on the pool (see
+/// `crate::par`): ~0.2 ms of dot products; at most 4 parts.
 const PARALLEL_SAMPLES: usize = 1 << 18;
 
 /// Blocks whose core (rows common to all lags) is shorter than this are
@@ -73,6 +73,31 @@ pub(super) fn col(c: usize, l: usize, lags: usize) -> usize {
     c * lags + l - 1
 }
 
+/// [`core_sums`] of `range` in `parts` (a power of two) consecutive parts
+/// split at chunk boundaries (sizes only) on the pool, added in order.
+fn split_core_sums(
+    channels: &[&[f64]],
+    centre: &[(f64, f64)],
+    range: Range<usize>,
+    lags: usize,
+    parts: usize,
+) -> Vec<f64> {
+    let n_chunks = range.len().div_ceil(CHUNK);
+    if parts < 2 || n_chunks < 2 {
+        return core_sums(channels, centre, range, lags);
+    }
+    let mid = range.start + n_chunks / 2 * CHUNK;
+    let (mut a, b) = crate::par::join(
+        true,
+        || split_core_sums(channels, centre, range.start..mid, lags, parts / 2),
+        || split_core_sums(channels, centre, mid..range.end, lags, parts / 2),
+    );
+    for (x, y) in a.iter_mut().zip(b) {
+        *x += y;
+    }
+    a
+}
+
 /// Adds the rows of block `b` to the upper triangle of `g`, row by row.
 fn gram_direct(
     channels: &[&[f64]],
@@ -124,18 +149,15 @@ fn gram_structured(
     // the halves of a long core (split at a chunk boundary: sizes only)
     // on two threads, then added.
     let n_chunks = (core_end - core_start).div_ceil(CHUNK);
-    let parallel = (core_end - core_start).saturating_mul(nc) >= PARALLEL_SAMPLES;
-    let core = if parallel && n_chunks >= 2 {
-        let mid = core_start + n_chunks / 2 * CHUNK;
-        let (mut a, b) = crate::par::join(
-            true,
-            || core_sums(channels, centre, core_start..mid, lags),
-            || core_sums(channels, centre, mid..core_end, lags),
-        );
-        for (x, y) in a.iter_mut().zip(b) {
-            *x += y;
-        }
-        a
+    let parts = ((core_end - core_start).saturating_mul(nc) / PARALLEL_SAMPLES).clamp(1, 4);
+    let core = if parts >= 2 && n_chunks >= 2 {
+        split_core_sums(
+            channels,
+            centre,
+            core_start..core_end,
+            lags,
+            1 << parts.ilog2(),
+        )
     } else {
         core_sums(channels, centre, core_start..core_end, lags)
     };

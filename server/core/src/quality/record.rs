@@ -205,34 +205,41 @@ pub(crate) fn prepare<'a>(
 
     // The statistics double as the finiteness check: a NaN or ±∞ makes
     // them non-finite, and only then are the samples searched.
-    let stats = |names: &[&str], cols: &[&[f64]]| -> Result<Vec<(f64, f64)>, QualityError> {
-        names
-            .iter()
-            .zip(cols)
-            .map(|(name, x)| {
-                let (mean, rms) = mean_rms(x, &blocks);
-                if !(mean.is_finite() && rms.is_finite()) {
-                    require_finite(name, x, &blocks)?;
-                    return Err(QualityError::record(
-                        (*name).to_owned(),
-                        "values too large: their sum of squares overflows",
-                    ));
-                }
-                Ok((mean, rms))
-            })
-            .collect()
+    let stats = |name: &str, x: &[f64]| -> Result<(f64, f64), QualityError> {
+        let (mean, rms) = mean_rms(x, &blocks);
+        if !(mean.is_finite() && rms.is_finite()) {
+            require_finite(name, x, &blocks)?;
+            return Err(QualityError::record(
+                name.to_owned(),
+                "values too large: their sum of squares overflows",
+            ));
+        }
+        Ok((mean, rms))
     };
-    // One pass over every valid sample, memory-bound: inputs and outputs
-    // on two threads for long logs. An input's error comes first, as in
-    // one pass.
+    // One pass over every valid sample, memory-bound: the channels spread
+    // over the pool for long logs. The first channel's error (inputs
+    // first) is the one reported, as in one pass.
     let n_valid: usize = blocks.iter().map(|b| b.len()).sum();
-    let parallel = n_valid.saturating_mul(inputs.len() + outputs.len()) >= PARALLEL_SAMPLES;
-    let (input_stats, output_stats) = crate::par::join(
-        parallel,
-        || stats(&input_names, &inputs),
-        || stats(&output_names, &outputs),
-    );
-    let (input_stats, output_stats) = (input_stats?, output_stats?);
+    let names: Vec<&str> = input_names.iter().chain(&output_names).copied().collect();
+    let cols: Vec<&[f64]> = inputs.iter().chain(&outputs).copied().collect();
+    let all: Vec<Result<(f64, f64), QualityError>> =
+        if n_valid.saturating_mul(cols.len()) >= PARALLEL_SAMPLES {
+            use rayon::prelude::*;
+            names
+                .par_iter()
+                .zip(&cols)
+                .map(|(name, x)| stats(name, x))
+                .collect()
+        } else {
+            names
+                .iter()
+                .zip(&cols)
+                .map(|(name, x)| stats(name, x))
+                .collect()
+        };
+    let mut all = all.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let output_stats = all.split_off(inputs.len());
+    let input_stats = all;
     Ok(Prepared {
         fs,
         n_samples: n,

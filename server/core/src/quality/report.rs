@@ -3,7 +3,7 @@
 
 use super::MIN_INPUT_SHARE;
 use super::adherence::adherence;
-use super::excitation::input_quality;
+use super::excitation::{input_quality, pe_over_blocks};
 use super::record::prepare;
 use super::regressor::{analyse, sub_identifiable};
 use super::spectra::{compute, pair_index};
@@ -48,23 +48,52 @@ pub fn quality_report(
     spec: &QualitySpec,
 ) -> Result<QualityReport, QualityError> {
     let prep = prepare(rec, spec)?;
-    let spectral = compute(&prep)?;
     let fs = prep.fs;
     let no = prep.outputs.len();
-
     let (in_stats, out_stats) = (&prep.input_stats, &prep.output_stats);
-    let inputs: Vec<_> = prep
-        .inputs
+
+    // Φ = (Φ_y Φ_x): outputs first.
+    let names: Vec<&str> = prep
+        .output_names
         .iter()
-        .zip(&prep.input_names)
+        .chain(&prep.input_names)
+        .copied()
+        .collect();
+    let channels: Vec<&[f64]> = prep.outputs.iter().chain(&prep.inputs).copied().collect();
+    let lags = spec.regressor_lags;
+    let stats: Vec<(f64, f64)> = out_stats.iter().chain(in_stats).copied().collect();
+    // The spectra and the time-domain analyses (regressor Gram, PE orders)
+    // read the same samples and nothing of each other: on two threads.
+    let (spectral, (regressor, pe)) = crate::par::join(
+        true,
+        || compute(&prep),
+        || {
+            crate::par::join(
+                true,
+                || analyse(&names, &channels, no, &stats, &prep.blocks, lags),
+                || {
+                    prep.inputs
+                        .iter()
+                        .zip(in_stats)
+                        .map(|(x, &(mean, _))| pe_over_blocks(x, &prep.blocks, Some(mean)))
+                        .collect::<Vec<_>>()
+                },
+            )
+        },
+    );
+    let (spectral, regressor) = (spectral?, regressor?);
+
+    let inputs: Vec<_> = prep
+        .input_names
+        .iter()
         .zip(spectral.input_psd)
         .zip(in_stats)
-        .map(|(((x, name), psd), &stats)| {
+        .zip(pe)
+        .map(|(((name, psd), &stats), pe)| {
             input_quality(
                 name,
-                x,
-                &prep.blocks,
                 stats,
+                pe,
                 &spectral.freqs,
                 psd,
                 fs,
@@ -84,18 +113,6 @@ pub fn quality_report(
             psd,
         })
         .collect();
-
-    // Φ = (Φ_y Φ_x): outputs first.
-    let names: Vec<&str> = prep
-        .output_names
-        .iter()
-        .chain(&prep.input_names)
-        .copied()
-        .collect();
-    let channels: Vec<&[f64]> = prep.outputs.iter().chain(&prep.inputs).copied().collect();
-    let lags = spec.regressor_lags;
-    let stats: Vec<(f64, f64)> = out_stats.iter().chain(in_stats).copied().collect();
-    let regressor = analyse(&names, &channels, no, &stats, &prep.blocks, lags)?;
 
     let mut adherences = Vec::new();
     if let Some(plan) = &spec.planned {

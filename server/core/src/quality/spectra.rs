@@ -10,8 +10,8 @@ use crate::spectra::multichannel::multi_welch_finite;
 use crate::spectra::unwrap_into;
 
 /// Pair bins (pairs × frequencies) from which the pairs' Bode data are
-/// computed on two threads: 8 pairs of 2049 bins take ~0.2 ms, several
-/// times a thread's start.
+/// spread over the pool: 8 pairs of 2049 bins take ~0.2 ms, many times a
+/// hand-off.
 const PARALLEL_BINS: usize = 1 << 14;
 
 /// The spectral part of the report.
@@ -46,32 +46,30 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
     // Finite inside the blocks: checked by `prepare`.
     let mut ms = multi_welch_finite(&channels, &prep.blocks, &pairs, &cfg)?;
 
-    // Pairs are independent: the second half on a second thread when
-    // there is enough of them (see `crate::par`).
-    let pair_range = |range: std::ops::Range<usize>| -> Vec<PairSpectra> {
-        let mut scratch = Scratch::default();
-        range
-            .map(|p| {
-                let (i, o) = pairs[p];
-                pair_spectra(
-                    prep.input_names[i],
-                    prep.output_names[o - ni],
-                    ms.cross(p),
-                    &ms.auto[i],
-                    &ms.auto[o],
-                    &mut scratch,
-                )
-            })
-            .collect()
+    // Pairs are independent: spread over the pool when there are enough
+    // of them (each pair's result is the same on any thread).
+    let one = |scratch: &mut Scratch, p: usize| {
+        let (i, o) = pairs[p];
+        pair_spectra(
+            prep.input_names[i],
+            prep.output_names[o - ni],
+            ms.cross(p),
+            &ms.auto[i],
+            &ms.auto[o],
+            scratch,
+        )
     };
-    let half = pairs.len() / 2;
-    let parallel = pairs.len().saturating_mul(cfg.n_freqs()) >= PARALLEL_BINS;
-    let (mut pair_spectra, rest) = crate::par::join(
-        parallel,
-        || pair_range(0..half),
-        || pair_range(half..pairs.len()),
-    );
-    pair_spectra.extend(rest);
+    let pair_spectra: Vec<PairSpectra> =
+        if pairs.len().saturating_mul(cfg.n_freqs()) >= PARALLEL_BINS {
+            use rayon::prelude::*;
+            (0..pairs.len())
+                .into_par_iter()
+                .map_init(Scratch::default, one)
+                .collect()
+        } else {
+            let mut scratch = Scratch::default();
+            (0..pairs.len()).map(|p| one(&mut scratch, p)).collect()
+        };
     let welch = WelchSummary {
         nperseg: cfg.nperseg,
         noverlap: cfg.noverlap,

@@ -57,6 +57,12 @@ impl Accumulators {
     }
 
     /// Sets every sum to zero.
+    /// Unzeroed sums of the same shape (see [`Self::unzeroed`]).
+    pub(super) fn sibling(&self) -> Self {
+        let n_channels = self.auto.len() / self.nf.max(1);
+        Self::unzeroed(n_channels, &self.pairs, self.nf)
+    }
+
     pub(super) fn zero(&mut self) {
         self.auto.fill(0.0);
         self.cross.fill(0.0);

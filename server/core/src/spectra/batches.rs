@@ -38,22 +38,116 @@ pub(super) fn batches(blocks: &[Range<usize>], cfg: &WelchConfig) -> Vec<Batch> 
         .collect()
 }
 
-/// Index of the first batch of the second half: the first batch boundary
-/// at or after half of the `n_segments` segments, or `batches.len()` (no
-/// split) below [`PARALLEL_WORK`] samples transformed or with one batch.
-/// Depends on the sizes only.
-pub(super) fn split_point(batches: &[Batch], n_segments: usize, work: usize) -> usize {
-    if work < PARALLEL_WORK || batches.len() < 2 {
+/// Most parts an estimate is split into (see [`run_parts`]).
+const MAX_PARTS: usize = 4;
+
+/// Parts an estimate of `work` samples transformed (`n_segments ×
+/// channels × nperseg`) is split into: 1 below [`PARALLEL_WORK`], else
+/// the largest power of two up to one per [`PARALLEL_WORK`], 2 to
+/// [`MAX_PARTS`] (halves of halves stay even when the pool steals them).
+/// More parts than cores let the pool balance the spectra against the
+/// report's other work. Depends on the sizes only.
+pub(super) fn parts(work: usize) -> usize {
+    if work < PARALLEL_WORK {
+        return 1;
+    }
+    let whole = (work / PARALLEL_WORK).clamp(2, MAX_PARTS);
+    1 << whole.ilog2()
+}
+
+/// Index of the first batch after the first `share.0 / share.1` of the
+/// segments: the batch boundary nearest that share (the earlier on a
+/// tie), strictly inside the list (`batches.len()` when there are fewer
+/// than two batches). Depends on the sizes only.
+pub(super) fn split_point(batches: &[Batch], share: (usize, usize)) -> usize {
+    if batches.len() < 2 {
         return batches.len();
     }
+    let n_segments: usize = batches.iter().map(|b| b.count).sum();
+    // In segments × share.1, to stay in integers.
+    let target = n_segments * share.0;
     let mut seen = 0;
-    batches
-        .iter()
-        .position(|b| {
-            seen += b.count;
-            2 * seen >= n_segments
-        })
-        .map_or(batches.len(), |i| (i + 1).min(batches.len() - 1))
+    let mut best = (usize::MAX, 1);
+    for (i, b) in batches[..batches.len() - 1].iter().enumerate() {
+        seen += b.count;
+        let miss = (seen * share.1).abs_diff(target);
+        if miss < best.0 {
+            best = (miss, i + 1);
+        }
+    }
+    best.1
+}
+
+/// Transforms the segments of `batches` in `parts` consecutive parts (on
+/// the pool, see `crate::par`) and adds them to `acc` (zeroed): each part
+/// sums into its own accumulators, added in order afterwards, so the
+/// result depends on `parts` and the sizes, not on the threads.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn run_parts(
+    engine: &SegmentFft,
+    acc: &mut Accumulators,
+    batches: &[Batch],
+    parts: usize,
+    channels: &[&[f64]],
+    cfg: &WelchConfig,
+    own_mean: bool,
+    check_finite: bool,
+) -> Result<(), SpectraError> {
+    let split = if parts < 2 {
+        batches.len()
+    } else {
+        split_point(batches, (parts / 2, parts))
+    };
+    if split >= batches.len() {
+        let mut engine = engine.clone();
+        return run_batches(
+            &mut engine,
+            acc,
+            batches,
+            channels,
+            cfg,
+            own_mean,
+            check_finite,
+        );
+    }
+    let (head, tail) = batches.split_at(split);
+    let first = parts / 2;
+    // Taken on this thread, so that its buffers return to this thread's
+    // kept ones in `absorb`.
+    let mut second = acc.sibling();
+    let (a, b) = crate::par::join(
+        true,
+        || {
+            run_parts(
+                engine,
+                acc,
+                head,
+                first,
+                channels,
+                cfg,
+                own_mean,
+                check_finite,
+            )
+        },
+        || {
+            second.zero();
+            run_parts(
+                engine,
+                &mut second,
+                tail,
+                parts - first,
+                channels,
+                cfg,
+                own_mean,
+                check_finite,
+            )
+        },
+    );
+    // The first part's error first: a serial run would meet it first.
+    a?;
+    b?;
+    acc.absorb(second);
+    Ok(())
 }
 
 /// Transforms the segments of `batches` and adds them to `acc`.
@@ -114,16 +208,23 @@ mod tests {
     use super::*;
 
     #[test]
-    fn split_lands_on_a_batch_boundary_near_the_middle() {
+    fn splits_land_on_batch_boundaries_by_share() {
         let cfg = WelchConfig::hann(1.0, 4096);
         let one = batches(&[0..36_000], &cfg);
         assert_eq!(one.iter().map(|b| b.count).sum::<usize>(), 16);
-        assert_eq!(split_point(&one, 16, 16 * 12 * 4096), 2);
-        assert_eq!(split_point(&one, 16, PARALLEL_WORK - 1), one.len());
+        assert_eq!(split_point(&one, (1, 2)), 2);
+        assert_eq!(split_point(&one, (1, 4)), 1);
+        assert_eq!(split_point(&one, (1, 3)), 1);
+        assert_eq!(split_point(&one, (1, 1)), 3);
+        assert_eq!(split_point(&one[..1], (1, 2)), 1);
+        assert_eq!(parts(PARALLEL_WORK - 1), 1);
+        assert_eq!(parts(PARALLEL_WORK), 2);
+        assert_eq!(parts(16 * 12 * 4096), 2);
+        assert_eq!(parts(usize::MAX), MAX_PARTS);
         let two = batches(&[0..20_480, 30_000..50_480], &cfg);
         let counts: Vec<usize> = two.iter().map(|b| b.count).collect();
         assert_eq!(counts, vec![4, 4, 1, 4, 4, 1]);
-        assert_eq!(split_point(&two, 18, usize::MAX), 3);
+        assert_eq!(split_point(&two, (1, 2)), 3);
     }
 
     /// The two-thread estimate (large enough to be split) equals the
@@ -148,7 +249,8 @@ mod tests {
         ] {
             let n_seg = cfg.n_segments(n);
             let list = batches(&[0..n], &cfg);
-            assert!(split_point(&list, n_seg, n_seg * 6 * 256) < list.len());
+            assert!(parts(n_seg * 6 * 256) >= 2);
+            assert!(split_point(&list, (1, 2)) < list.len());
             let s = multi_welch(&refs, &[0..n], &pairs, &cfg).unwrap();
             for (c, x) in refs.iter().enumerate() {
                 let w = welch(x, &cfg).unwrap().values;

@@ -22,7 +22,7 @@ use std::ops::Range;
 use realfft::num_complex::Complex;
 
 use super::accumulators::{Accumulators, PlaneSpectra};
-use super::batches::{batches, run_batches, split_point};
+use super::batches::{batches, parts, run_parts};
 use super::engine::SegmentFft;
 use super::{Detrend, SpectraError, WelchConfig};
 
@@ -214,59 +214,19 @@ fn compute(
     let work = n_segments
         .saturating_mul(channels.len())
         .saturating_mul(cfg.nperseg);
-    let split = split_point(&batches, n_segments, work);
-    let (head, tail) = batches.split_at(split);
     let nf = cfg.n_freqs();
     let mut acc = Accumulators::new(channels.len(), pairs, nf);
     let factors = engine.density_factors(cfg.fs);
-    if tail.is_empty() {
-        let mut engine = engine;
-        run_batches(
-            &mut engine,
-            &mut acc,
-            head,
-            channels,
-            cfg,
-            own_mean,
-            check_finite,
-        )?;
-    } else {
-        // Both sets of sums are taken here, so that their buffers are this
-        // thread's kept ones (see `Accumulators::new`).
-        let mut second = Accumulators::unzeroed(channels.len(), pairs, nf);
-        let mut other_engine = engine.clone();
-        let mut engine = engine;
-        let (a, b) = crate::par::join(
-            true,
-            || {
-                run_batches(
-                    &mut engine,
-                    &mut acc,
-                    head,
-                    channels,
-                    cfg,
-                    own_mean,
-                    check_finite,
-                )
-            },
-            || {
-                second.zero();
-                run_batches(
-                    &mut other_engine,
-                    &mut second,
-                    tail,
-                    channels,
-                    cfg,
-                    own_mean,
-                    check_finite,
-                )
-            },
-        );
-        // The first half's error first: a serial run would meet it first.
-        a?;
-        b?;
-        acc.absorb(second);
-    }
+    run_parts(
+        &engine,
+        &mut acc,
+        &batches,
+        parts(work),
+        channels,
+        cfg,
+        own_mean,
+        check_finite,
+    )?;
     Ok((acc, factors))
 }
 
