@@ -9,9 +9,13 @@
 //! drawn anew), so the spread also holds the change of the closed loop.
 //! `--no-recursive` leaves the recursive family (REC runs) out of the plan;
 //! `--designed` flies the campaign as `design::design_campaign` designs it
-//! within the rule-based plan's hours.
+//! within the rule-based plan's hours; `--repeat N` flies the rule-based
+//! plan with every run repeated N times (the design's rule-based front).
+//! `--tsv PATH` writes each parameter's predicted and empirical std with
+//! the plan's ship hours, for `ship_hours.py` (the ship-hour ratio of a
+//! designed campaign against the rule-based plan repeated, on the truth).
 //!
-//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--designed] [--grid-kn 0.5,2,3.5]`
+//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--designed] [--repeat N] [--tsv PATH] [--grid-kn 0.5,2,3.5]`
 
 #[path = "../tests/support/precision_truth.rs"]
 mod precision_truth;
@@ -25,6 +29,7 @@ fn main() {
     let mut own = false;
     let mut retune = false;
     let mut variant = precision_truth::PlanVariant::default();
+    let mut tsv: Option<String> = None;
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
@@ -33,6 +38,10 @@ fn main() {
             "--retune" => retune = true,
             "--no-recursive" => variant.no_recursive = true,
             "--designed" => variant.designed = true,
+            "--tsv" => tsv = Some(it.next().expect("--tsv PATH").clone()),
+            "--repeat" => {
+                variant.repeat = it.next().and_then(|v| v.parse().ok()).expect("--repeat N")
+            }
             "--grid-kn" => {
                 variant.grid_kn = Some(
                     it.next()
@@ -47,6 +56,11 @@ fn main() {
     }
     let t0 = Instant::now();
     let setup = precision_truth::setup(&variant);
+    let hours = setup.plan.totals.total_time_s / 3600.0;
+    println!(
+        "plan: {} runs, {hours:.2} ship hours (runs and set-up)",
+        setup.plan.experiments.len()
+    );
     let pred = precision_truth::predict(&setup);
     eprintln!(
         "predicted {} parameters from {} runs in {:.1} s",
@@ -87,4 +101,8 @@ fn main() {
         );
     }
     precision_truth::print_table(&cmp, seeds);
+    if let Some(path) = tsv {
+        precision_truth::write_tsv(&path, &cmp, hours).expect("the TSV file");
+        eprintln!("rows written to {path}");
+    }
 }

@@ -68,6 +68,9 @@ pub struct PlanVariant {
     /// the rule-based plan's hours (prior: the source documents' vessel,
     /// as a supervisor would have; the truth flies it).
     pub designed: bool,
+    /// Repeats every run of the rule-based plan this many times (0 or 1:
+    /// once), as the design's rule-based front does (`repetitions`).
+    pub repeat: u32,
 }
 
 /// The service's rule-based Surveyor plan, as `variant` asks.
@@ -79,6 +82,9 @@ pub fn plan(variant: &PlanVariant) -> (VesselProfile, Plan) {
     }
     if variant.no_recursive {
         spec.families.retain(|f| *f != ExperimentFamily::Recursive);
+    }
+    if variant.repeat > 1 {
+        spec.repetitions = Some(spec.repetitions_for(profile.kind) * variant.repeat);
     }
     if variant.designed {
         let Prior::Rov(prior) = Prior::reference(&profile).expect("the reference prior") else {
@@ -534,6 +540,24 @@ pub fn summarize(c: &[Comparison]) -> Summary {
                 .collect(),
         ),
     }
+}
+
+/// One row per compared parameter (structural zeros left out): name,
+/// predicted std, empirical std, mean estimate, and the plan's ship hours.
+pub fn write_tsv(path: &str, c: &[Comparison], hours: f64) -> std::io::Result<()> {
+    use std::fmt::Write as _;
+    let mut out = String::from("parameter\tpredicted\tempirical\tmean\thours\n");
+    for c in c.iter().filter(|c| !c.structural_zero()) {
+        let pred = c.predicted.map_or(String::new(), |v| format!("{v:e}"));
+        let _ = writeln!(
+            out,
+            "{}\t{pred}\t{:e}\t{:e}\t{hours}",
+            c.name(),
+            c.empirical,
+            c.mean
+        );
+    }
+    std::fs::write(path, out)
 }
 
 /// Prints the table (worst ratio first when `sorted`) and the summary.
