@@ -88,6 +88,7 @@ pub async fn create_campaign(
         seed: req.seed.unwrap_or_else(|| {
             (uuid::Uuid::now_v7().as_u128() as u64) & seatrial_core::planning::design::MAX_SEED
         }),
+        deciding: Vec::new(),
     };
     let profile = vessel.profile.clone();
     let checked = spec.clone();

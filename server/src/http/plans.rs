@@ -41,6 +41,12 @@ pub struct CampaignRevision {
     /// Seed of every pseudo-random sequence (0 … 2⁵³−1).
     #[serde(default)]
     pub seed: Option<u64>,
+    /// Deciding experiments (replaced as a whole; `[]` removes them): the
+    /// `experiment` of a discovery report's ambiguity, as given, planned
+    /// after the plan's runs, one run `DEC{k}-{dof}-{heading}` per heading.
+    #[serde(default)]
+    #[schema(max_items = 8)]
+    pub deciding: Option<Vec<seatrial_core::discrepancy::experiment::ExperimentProposal>>,
 }
 
 impl CampaignRevision {
@@ -63,6 +69,9 @@ impl CampaignRevision {
         }
         if let Some(seed) = self.seed {
             s.seed = seed;
+        }
+        if let Some(d) = self.deciding {
+            s.deciding = d;
         }
         s
     }

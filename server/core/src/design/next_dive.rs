@@ -74,6 +74,9 @@ pub struct NextDive {
 /// runs' data (good and weak runs; rejected and insufficient ones left out
 /// by the caller) and the codes of the planned experiments already covered
 /// (`done`, not proposed again); candidates are flown with `truth`.
+/// Order: the validation run while none has been flown, then discovery's
+/// deciding runs (`Experiment::separates`) in plan order, then the runs
+/// with the most precision per hour.
 ///
 /// # Errors
 /// A dive of no hours; a planned experiment the identification's data path
@@ -176,6 +179,27 @@ pub fn propose_next_dive(
                 "no validation run has been flown, and the identification holds one out".into(),
             ));
         }
+    }
+    // Discovery's deciding runs next: they settle which physics the model
+    // needs, which no precision criterion of the current structure sees.
+    let mut k = 0;
+    while k < candidates.len() {
+        let i = candidates[k];
+        let pe = &plan.experiments[i];
+        let fits = used_s + pe.experiment.duration_s + setup_s <= budget_s;
+        let Some([a, b]) = pe.experiment.separates.as_ref().filter(|_| fits) else {
+            k += 1;
+            continue;
+        };
+        let reason = format!(
+            "a deciding run: discovery found {a} and {b} explain the flown runs about equally; this run separates them"
+        );
+        for (g, gram) in experiment_information(profile, &grid, pe, truth, &mut cache)? {
+            now.add(*g, gram);
+        }
+        used_s += pe.experiment.duration_s + setup_s;
+        candidates.remove(k);
+        proposed.push(proposal(plan, i, rel(&now).unwrap_or(0.0), reason));
     }
     let total = candidates.len();
     loop {

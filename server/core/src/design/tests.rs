@@ -254,3 +254,28 @@ fn after_a_dive_the_flown_runs_count_and_are_not_proposed_again() {
     // No hours, no dive.
     assert!(propose_next_dive(&profile, &plan, &[], &[], &truth, 0.0, &mut NoProgress).is_err());
 }
+
+/// A deciding run of discovery in the plan is proposed right after the
+/// validation run, with its reason; once flown it is not proposed again.
+#[test]
+fn a_deciding_run_comes_after_validation_until_it_is_flown() {
+    use crate::planning::Dof;
+    use crate::planning::deciding::example_proposal;
+    let (profile, _, truth, _) = two_speed_campaign();
+    let mut spec = surveyor_campaign(3);
+    spec.grid.speeds = vec![0.0, 1.5];
+    spec.deciding = vec![example_proposal(&profile, Dof::Sway, 0.5, vec![0.0])];
+    let plan = generate_plan(&profile, &spec).unwrap();
+    let dive = propose_next_dive(&profile, &plan, &[], &[], &truth, 3.0, &mut NoProgress).unwrap();
+    assert_eq!(dive.proposed[0].family, ExperimentFamily::Validation);
+    assert_eq!(dive.proposed[1].code, "DEC1-sway-000");
+    assert!(
+        dive.proposed[1].reason.starts_with("a deciding run"),
+        "{}",
+        dive.proposed[1].reason
+    );
+    let done = vec!["DEC1-sway-000".to_string()];
+    let later =
+        propose_next_dive(&profile, &plan, &[], &done, &truth, 3.0, &mut NoProgress).unwrap();
+    assert!(later.proposed.iter().all(|p| p.code != "DEC1-sway-000"));
+}

@@ -265,6 +265,11 @@ pub struct CampaignSpec {
     /// Seed of every pseudo-random sequence: the plan is a pure function of it.
     #[serde(default)]
     pub seed: u64,
+    /// Deciding experiments from discovery reports (their proposals as
+    /// given, at most 8), planned after the plan's own runs, one run per
+    /// heading leg.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub deciding: Vec<crate::discrepancy::experiment::ExperimentProposal>,
 }
 
 impl CampaignSpec {
@@ -442,7 +447,7 @@ impl CampaignSpec {
                 MIN_VALIDATION_S,
             ));
         }
-        Ok(())
+        super::deciding::validate(&self.deciding, vessel)
     }
 }
 

@@ -135,6 +135,7 @@ pub fn surveyor_campaign(seed: u64) -> CampaignSpec {
         excitation: Excitation::default(),
         durations: Durations::default(),
         seed,
+        deciding: Vec::new(),
     }
 }
 
@@ -156,6 +157,7 @@ pub fn supply_vessel_campaign(seed: u64) -> CampaignSpec {
         excitation: Excitation::default(),
         durations: Durations::default(),
         seed,
+        deciding: Vec::new(),
     }
 }
 

@@ -5,6 +5,7 @@
 
 pub mod analysis;
 pub mod campaign;
+pub mod deciding;
 pub mod design;
 pub mod dof;
 pub mod error;

@@ -79,6 +79,10 @@ pub struct Experiment {
     pub sign: Option<i8>,
     /// Repetition, from 1.
     pub repetition: u32,
+    /// For a deciding run (see `CampaignSpec::deciding`): the two
+    /// look-alike hypotheses it separates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub separates: Option<[String; 2]>,
     /// What the pilot does, in words.
     pub instruction: String,
     /// Run length (s).
@@ -467,6 +471,7 @@ pub fn generate_plan(vessel: &VesselProfile, spec: &CampaignSpec) -> Result<Plan
     if has(ExperimentFamily::Validation) {
         validation(&ctx, reps, &mut out)?;
     }
+    super::deciding::deciding_runs(&ctx, &mut out)?;
     let mut per_family = BTreeMap::new();
     let mut run_time_s = 0.0;
     for (i, p) in out.iter_mut().enumerate() {
@@ -611,6 +616,7 @@ pub(super) fn assemble(
         dofs: head.dofs,
         sign: head.sign,
         repetition: head.repetition,
+        separates: None,
         instruction: head.instruction,
         duration_s: n as f64 / ctx.fs,
         sample_rate_hz: ctx.fs,

@@ -23,6 +23,10 @@ use super::plan::Experiment;
 /// `static|0.771667|pitch|-|r1` (grid speed in m/s to the µm/s; `-` for
 /// the validation run that spans the grid).
 pub fn identity(e: &Experiment) -> String {
+    if e.separates.is_some() {
+        // Deciding runs: their code holds the proposal's place and heading.
+        return format!("deciding|{}", e.code);
+    }
     let speed = e
         .grid_speed_mps
         .map_or_else(|| "-".to_string(), |v| format!("{v:.6}"));
