@@ -7,7 +7,7 @@
 mod common;
 
 use common::flights::{flown_logs, linear_truth, upload_planned};
-use common::{Resp, TestApp, rov_log};
+use common::{Resp, TestApp, ids_by_code, rov_log};
 use serde_json::{Value, json};
 
 /// Pages of the database file (WAL included) and its rows of plans,
@@ -62,20 +62,6 @@ async fn coverage(app: &TestApp, cid: &str) -> Value {
         .await;
     assert_eq!(r.status, 200, "{}", r.text);
     r.json
-}
-
-fn ids_by_code(plan: &Value) -> Vec<(String, String)> {
-    plan["experiments"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| {
-            (
-                e["code"].as_str().unwrap().to_string(),
-                e["id"].as_str().unwrap().to_string(),
-            )
-        })
-        .collect()
 }
 
 #[tokio::test]

@@ -87,13 +87,48 @@ function beforeAfterTable(rows) {
       h('td', { class: 'hint' }, `${c.whiteness_before.lags_outside} → ${c.whiteness_after.lags_outside} lags outside; ${c.whiteness_before.zero_crossings} → ${c.whiteness_after.zero_crossings} zero crossings`))))));
 }
 
-function ambiguitySection(ambs) {
+/** Same proposal: both are the service's serialisation of one type. */
+const sameProposal = (a, b) => JSON.stringify(a) === JSON.stringify(b);
+
+/**
+ * "Add to the plan": the proposal joins the campaign's deciding runs (a
+ * re-plan; the plan's own runs keep their ids) and is flown one run per
+ * heading after them; the next-dive proposal puts it right after validation.
+ */
+function addToPlanButton(campaignId, experiment) {
+  const out = h('span', { class: 'hint', 'data-testid': 'deciding-added', role: 'status' });
+  const btn = h('button', { class: 'btn', type: 'button', 'data-testid': 'add-deciding' }, 'Add to the plan');
+  btn.addEventListener('click', async () => {
+    btn.disabled = true;
+    out.textContent = 'Re-planning…';
+    try {
+      const c = await api.campaign(campaignId);
+      const list = Array.isArray(c.deciding) ? c.deciding : [];
+      if (list.some((x) => sameProposal(x, experiment))) {
+        out.textContent = 'Already in the plan.';
+        return;
+      }
+      const r = await api.replan(campaignId, { deciding: [...list, experiment] });
+      const codes = (r.experiments || []).filter((e) => e.separates).map((e) => e.code);
+      fill(out, `Added to plan v${r.version}: `, codes.join(', '), ' · ',
+        h('a', { href: `#/campaigns/${campaignId}` }, 'open the plan'));
+    } catch (e) {
+      out.textContent = `Not added: ${e.message}`;
+      btn.disabled = false;
+    }
+  });
+  return [btn, ' ', out];
+}
+
+function ambiguitySection(ambs, campaignId) {
   if (!ambs.length) return null;
   return h('div', { class: 'card', 'data-testid': 'ambiguities' },
     h('h4', null, 'Look-alikes the data cannot separate'),
     ambs.map((a) => h('div', { class: 'ambiguity', 'data-testid': 'ambiguity' },
       h('p', null, a.text),
-      a.experiment ? h('p', { class: 'deciding', 'data-testid': 'deciding-experiment' }, h('b', null, 'Deciding experiment: '), a.experiment.instruction) : null)));
+      a.experiment ? h('p', { class: 'deciding', 'data-testid': 'deciding-experiment' }, h('b', null, 'Deciding experiment: '), a.experiment.instruction,
+        ` (${a.experiment.headings_deg.length} heading${a.experiment.headings_deg.length > 1 ? 's' : ''} × ${fmt(a.experiment.duration_s)} s) `,
+        ...addToPlanButton(campaignId, a.experiment)) : null)));
 }
 
 function unexplainedSection(list) {
@@ -144,7 +179,7 @@ export async function discoveryPage(view, id) {
         beforeAfterTable(r.validation || []),
         h('p', { class: 'hint' }, 'Free-run simulations on the recorded inputs; drag to zoom (all DOFs follow), double-click to reset.'),
         plots),
-      ambiguitySection(r.ambiguities || []),
+      ambiguitySection(r.ambiguities || [], d.discrepancy.campaign_id),
       unexplainedSection(r.unexplained || []));
     det.addEventListener('toggle', () => { if (det.open) draw(); });
     return { det, draw, open: pi === 0 };

@@ -413,3 +413,18 @@ pub async fn stored_model(
     .unwrap();
     m.id
 }
+
+/// A plan response's experiments as (code, id), in plan order.
+pub fn ids_by_code(plan: &Value) -> Vec<(String, String)> {
+    plan["experiments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| {
+            (
+                e["code"].as_str().unwrap().to_string(),
+                e["id"].as_str().unwrap().to_string(),
+            )
+        })
+        .collect()
+}

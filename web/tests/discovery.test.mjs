@@ -17,6 +17,7 @@ import { harness, tid, inked, waitJob as waitFor } from './harness.mjs';
 
 const H = harness({ extraArgs: ['--demo'] });
 let mid;
+let reportUrl;
 
 const waitJob = (id, seconds) => waitFor(H, id, seconds);
 
@@ -51,6 +52,7 @@ test('discover the demo ROV\'s missing restoring from the model page and read th
     await page.locator(tid('discover-progress')).waitFor();
     // Done: the report page opens by itself.
     await page.waitForURL(/#\/discrepancies\/[0-9a-f-]{36}$/, { timeout: 180000 });
+    reportUrl = page.url();
     await page.locator(tid('discovery-summary')).waitFor();
     const summary = await page.textContent(tid('discovery-summary'));
     assert.match(summary, /restoring cos θ sin φ in roll: named at every grid speed/, summary);
@@ -94,6 +96,73 @@ test('discover the demo ROV\'s missing restoring from the model page and read th
     await page.goto(`${H.base}/#/models/${mid}`);
     await page.locator(tid('discover-report-link')).first().waitFor();
   });
+});
+
+test('a look-alike\'s deciding experiment is added to the plan from the report', async () => {
+  assert.ok(reportUrl, 'the first test opened a report');
+  const did = reportUrl.split('/').pop();
+  const d = await H.api('GET', `/api/discrepancies/${did}`);
+  const cid = d.json.discrepancy.campaign_id;
+  const c = await H.api('GET', `/api/campaigns/${cid}`);
+  const v = await H.api('GET', `/api/vessels/${c.json.vessel_id}`);
+  const profile = v.json.profile || v.json;
+  // A proposal as discovery writes one: every force column, sway excited.
+  const channels = profile.dofs.map((dof) => {
+    const l = profile.limits[dof];
+    const excited = dof === 'sway';
+    return {
+      column: { surge: 'tau_X', sway: 'tau_Y', heave: 'tau_Z', roll: 'tau_K', pitch: 'tau_M', yaw: 'tau_N' }[dof],
+      unit: ['roll', 'pitch', 'yaw'].includes(dof) ? 'N·m' : 'N',
+      dof,
+      excited,
+      waveform: excited ? { shape: 'square', period_s: 10 * l.time_constant_s } : { shape: 'constant' },
+      offset: dof === 'surge' ? 0.3 * l.max_force : 0,
+      amplitude: excited ? 0.5 * l.max_force : 0,
+      limit: l.max_force,
+      rate_limit: l.max_force_rate,
+    };
+  });
+  const experiment = {
+    separates: ['quadratic damping (sway)', 'Coriolis from M'],
+    family: 'dynamic', dof: 'sway', signal: 'square', grid_speed_mps: 0.5,
+    headings_deg: [0, 90], duration_s: 90, channels, predicted_separation_sigma: 5,
+    instruction: 'a sway square wave at a steady surge offset',
+  };
+  const before = await H.api('GET', `/api/campaigns/${cid}/plan`);
+  await H.withPage([], async (page) => {
+    // The report as the service sends it, with one look-alike pair added
+    // at the first grid speed (the demo's data separate all of theirs).
+    await page.route(`**/api/discrepancies/${did}`, async (route) => {
+      const response = await route.fetch();
+      const json = await response.json();
+      json.report.points[0].report.ambiguities = [{
+        chosen: { effect: 'quadratic_damping', dof: 'sway' },
+        alternative: { effect: 'coriolis' }, cv_gains: [0.01, 0.009],
+        text: 'Sway quadratic damping and Coriolis explain the held-out runs about equally.',
+        experiment,
+      }];
+      await route.fulfill({ response, json });
+    });
+    await page.goto(reportUrl);
+    const amb = page.locator(tid('ambiguity')).first();
+    await amb.waitFor();
+    assert.match(await amb.textContent(), /2 headings × 90 s/);
+    await amb.locator(tid('add-deciding')).click();
+    await amb.locator(`${tid('deciding-added')} >> text=Added to plan`).waitFor();
+    assert.match(await amb.locator(tid('deciding-added')).textContent(), /DEC1-sway-000, DEC1-sway-090/);
+    // Twice: nothing new.
+    await page.reload();
+    await page.locator(tid('add-deciding')).first().click();
+    await page.locator(`${tid('deciding-added')} >> text=Already in the plan`).waitFor();
+    // On the plan: after the plan's own runs, tagged, the rest unchanged.
+    await page.unroute(`**/api/discrepancies/${did}`);
+    await page.goto(`${H.base}/#/campaigns/${cid}`);
+    await page.locator(`${tid('plan-row')}[data-code="DEC1-sway-090"] ${tid('deciding-tag')}`).waitFor();
+  });
+  const after = await H.api('GET', `/api/campaigns/${cid}/plan`);
+  const ids = (p) => p.json.experiments.map((e) => `${e.code}:${e.id}`);
+  assert.deepEqual(ids(after).slice(0, before.json.experiments.length), ids(before));
+  assert.deepEqual(after.json.experiments.slice(-2).map((e) => e.code), ['DEC1-sway-000', 'DEC1-sway-090']);
 });
 
 test('a discovery is cancelled from its panel, its progress never going backwards', async () => {

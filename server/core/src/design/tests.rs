@@ -260,11 +260,11 @@ fn after_a_dive_the_flown_runs_count_and_are_not_proposed_again() {
 #[test]
 fn a_deciding_run_comes_after_validation_until_it_is_flown() {
     use crate::planning::Dof;
-    use crate::planning::deciding::example_proposal;
+    use crate::planning::examples::deciding_proposal;
     let (profile, _, truth, _) = two_speed_campaign();
     let mut spec = surveyor_campaign(3);
     spec.grid.speeds = vec![0.0, 1.5];
-    spec.deciding = vec![example_proposal(&profile, Dof::Sway, 0.5, vec![0.0])];
+    spec.deciding = vec![deciding_proposal(&profile, Dof::Sway, 0.5, vec![0.0])];
     let plan = generate_plan(&profile, &spec).unwrap();
     let dive = propose_next_dive(&profile, &plan, &[], &[], &truth, 3.0, &mut NoProgress).unwrap();
     assert_eq!(dive.proposed[0].family, ExperimentFamily::Validation);

@@ -30,7 +30,7 @@ pub struct ExperimentProposal {
     pub grid_speed_mps: f64,
     /// Headings to fly it at (deg, one leg each).
     pub headings_deg: Vec<f64>,
-    /// Length of each leg (s).
+    /// Length of each leg (s; at most 1800 in a campaign's `deciding`).
     pub duration_s: f64,
     /// Force columns, as in a planned experiment (`Quantity::Force`).
     pub channels: Vec<ChannelPlan>,

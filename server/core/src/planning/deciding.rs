@@ -7,7 +7,6 @@
 //! DOFs only, offsets within the force limits, every channel clipped to
 //! the vessel's force and rate limits whatever the proposal says.
 
-use super::campaign::MAX_RUN_S;
 use super::plan::{ChannelSpec, Ctx, ExperimentHead, PlannedExperiment, assemble};
 use super::{Dof, ExperimentFamily, PlanError, VesselProfile};
 use crate::discrepancy::experiment::ExperimentProposal;
@@ -16,6 +15,9 @@ use crate::discrepancy::experiment::ExperimentProposal;
 pub const MAX_DECIDING: usize = 8;
 /// Most heading legs of one deciding experiment.
 pub const MAX_HEADINGS: usize = 4;
+/// Longest leg of a deciding run (s): discovery proposes 60 s legs; the
+/// bound keeps 8 proposals × 4 legs within a plan's usual size.
+pub const MAX_LEG_S: f64 = 1800.0;
 /// Longest text of a proposal (instruction, hypothesis labels).
 const MAX_TEXT: usize = 2000;
 
@@ -55,11 +57,11 @@ pub(super) fn validate(
                 format!("{} is not a DOF of vessel '{}'", p.dof.name(), vessel.name),
             ));
         }
-        if !(p.duration_s.is_finite() && p.duration_s > 0.0 && p.duration_s <= MAX_RUN_S) {
+        if !(p.duration_s.is_finite() && p.duration_s > 0.0 && p.duration_s <= MAX_LEG_S) {
             return Err(PlanError::over_limit(
                 field("duration_s"),
-                format!("must be a number of seconds in (0, {MAX_RUN_S}]"),
-                MAX_RUN_S,
+                format!("must be a number of seconds in (0, {MAX_LEG_S}]"),
+                MAX_LEG_S,
             ));
         }
         if !(p.grid_speed_mps.is_finite() && p.grid_speed_mps >= 0.0) {
@@ -213,68 +215,10 @@ fn nearest(speeds: &[f64], u: f64) -> Option<usize> {
         .map(|(i, _)| i)
 }
 
-/// A proposal as discovery writes it: every DOF's force column, the
-/// excited one a square wave about a surge offset, the others held.
-#[cfg(test)]
-pub(crate) fn example_proposal(
-    v: &VesselProfile,
-    dof: Dof,
-    amplitude: f64,
-    headings: Vec<f64>,
-) -> ExperimentProposal {
-    let channels = v
-        .dofs
-        .iter()
-        .map(|&d| {
-            let l = v.limit(d);
-            let excited = d == dof;
-            super::plan::ChannelPlan {
-                column: d.force_column().into(),
-                unit: d.force_unit().into(),
-                dof: Some(d),
-                thruster: None,
-                excited,
-                waveform: if excited {
-                    super::waveform::Waveform::Square {
-                        period_s: 10.0 * l.time_constant_s,
-                    }
-                } else {
-                    super::waveform::Waveform::Constant
-                },
-                offset: if d == Dof::Surge {
-                    0.3 * l.max_force
-                } else {
-                    0.0
-                },
-                amplitude: if excited {
-                    amplitude * l.max_force
-                } else {
-                    0.0
-                },
-                limit: l.max_force,
-                rate_limit: Some(l.max_force_rate),
-                analysis: None,
-            }
-        })
-        .collect();
-    ExperimentProposal {
-        separates: ["quadratic damping in sway".into(), "Coriolis from M".into()],
-        family: ExperimentFamily::Dynamic,
-        dof,
-        signal: super::SignalKind::Square,
-        grid_speed_mps: 0.4,
-        headings_deg: headings,
-        duration_s: 120.0,
-        channels,
-        predicted_separation_sigma: 6.5,
-        instruction: "sway square wave at a steady surge offset".into(),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::planning::examples::{surveyor_campaign, surveyor_rov};
+    use crate::planning::examples::{deciding_proposal, surveyor_campaign, surveyor_rov};
     use crate::planning::revision::identity;
     use crate::planning::{CampaignSpec, generate_plan};
 
@@ -290,7 +234,7 @@ mod tests {
         let v = surveyor_rov();
         let spec = surveyor_campaign(7);
         let base = generate_plan(&v, &spec).unwrap();
-        let p = example_proposal(&v, Dof::Sway, 0.5, vec![0.0, 90.0]);
+        let p = deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0, 90.0]);
         let plan = generate_plan(&v, &with(&spec, vec![p])).unwrap();
         let n = base.experiments.len();
         assert_eq!(plan.experiments.len(), n + 2);
@@ -360,30 +304,30 @@ mod tests {
         let spec = surveyor_campaign(7);
         let err = |p: ExperimentProposal| generate_plan(&v, &with(&spec, vec![p])).unwrap_err();
 
-        let mut p = example_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
+        let mut p = deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
         p.channels[0].offset = 2.0 * v.limit(Dof::Surge).max_force;
         assert_eq!(err(p).field, "deciding[0].channels[0].offset");
 
-        let mut p = example_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
+        let mut p = deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
         p.channels[2].column = "u_ref".into();
         assert_eq!(err(p).field, "deciding[0].channels[2].column");
 
-        let mut p = example_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
+        let mut p = deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
         p.family = ExperimentFamily::Validation;
         assert_eq!(err(p).field, "deciding[0].family");
 
-        let p = example_proposal(&v, Dof::Sway, 0.5, vec![0.0, 90.0, 180.0, 270.0, 45.0]);
+        let p = deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0, 90.0, 180.0, 270.0, 45.0]);
         assert_eq!(err(p).field, "deciding[0].headings_deg");
 
-        let mut p = example_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
+        let mut p = deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
         p.duration_s = f64::NAN;
         assert_eq!(err(p).field, "deciding[0].duration_s");
 
-        let mut p = example_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
+        let mut p = deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0]);
         p.instruction = "fly\u{1b}[31m".into();
         assert_eq!(err(p).field, "deciding[0].instruction");
 
-        let many = vec![example_proposal(&v, Dof::Sway, 0.5, vec![0.0]); MAX_DECIDING + 1];
+        let many = vec![deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0]); MAX_DECIDING + 1];
         let e = generate_plan(&v, &with(&spec, many)).unwrap_err();
         assert_eq!(e.field, "deciding");
     }
@@ -394,7 +338,7 @@ mod tests {
     fn channels_are_clipped_to_the_vessel_whatever_the_proposal_says() {
         let v = surveyor_rov();
         let spec = surveyor_campaign(7);
-        let mut p = example_proposal(&v, Dof::Heave, 2.0, vec![0.0]);
+        let mut p = deciding_proposal(&v, Dof::Heave, 2.0, vec![0.0]);
         for c in &mut p.channels {
             c.limit = 1e9;
             c.rate_limit = None;

@@ -169,3 +169,62 @@ pub fn supply_vessel_trial_campaign(seed: u64) -> CampaignSpec {
     c.durations.validation_s = 600.0;
     c
 }
+
+/// A deciding experiment as discovery proposes one (see
+/// `CampaignSpec::deciding`): every DOF's force column, `dof` a square wave
+/// of `amplitude` × its force limit about a surge offset of 0.3 × the surge
+/// limit, the others held; 120 s legs at `headings` (deg).
+pub fn deciding_proposal(
+    v: &VesselProfile,
+    dof: Dof,
+    amplitude: f64,
+    headings: Vec<f64>,
+) -> crate::discrepancy::experiment::ExperimentProposal {
+    let channels = v
+        .dofs
+        .iter()
+        .map(|&d| {
+            let l = v.limit(d);
+            let excited = d == dof;
+            super::plan::ChannelPlan {
+                column: d.force_column().into(),
+                unit: d.force_unit().into(),
+                dof: Some(d),
+                thruster: None,
+                excited,
+                waveform: if excited {
+                    super::waveform::Waveform::Square {
+                        period_s: 10.0 * l.time_constant_s,
+                    }
+                } else {
+                    super::waveform::Waveform::Constant
+                },
+                offset: if d == Dof::Surge {
+                    0.3 * l.max_force
+                } else {
+                    0.0
+                },
+                amplitude: if excited {
+                    amplitude * l.max_force
+                } else {
+                    0.0
+                },
+                limit: l.max_force,
+                rate_limit: Some(l.max_force_rate),
+                analysis: None,
+            }
+        })
+        .collect();
+    crate::discrepancy::experiment::ExperimentProposal {
+        separates: ["quadratic damping in sway".into(), "Coriolis from M".into()],
+        family: ExperimentFamily::Dynamic,
+        dof,
+        signal: super::SignalKind::Square,
+        grid_speed_mps: 0.4,
+        headings_deg: headings,
+        duration_s: 120.0,
+        channels,
+        predicted_separation_sigma: 6.5,
+        instruction: "sway square wave at a steady surge offset".into(),
+    }
+}
