@@ -43,7 +43,8 @@ pub struct CampaignRevision {
     pub seed: Option<u64>,
     /// Deciding experiments (replaced as a whole; `[]` removes them): the
     /// `experiment` of a discovery report's ambiguity, as given, planned
-    /// after the plan's runs, one run `DEC{k}-{dof}-{heading}` per heading.
+    /// after the plan's runs, one run `DEC{k}-{dof}-{heading}` per heading
+    /// (6-DOF ROVs only: a DP ship's plan is thruster schedules).
     #[serde(default)]
     #[schema(max_items = 8)]
     pub deciding: Option<Vec<seatrial_core::discrepancy::experiment::ExperimentProposal>>,

@@ -266,8 +266,8 @@ pub struct CampaignSpec {
     #[serde(default)]
     pub seed: u64,
     /// Deciding experiments from discovery reports (their proposals as
-    /// given, at most 8), planned after the plan's own runs, one run per
-    /// heading leg.
+    /// given, at most 8; 6-DOF ROVs only), planned after the plan's own
+    /// runs, one run per heading leg.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub deciding: Vec<crate::discrepancy::experiment::ExperimentProposal>,
 }

@@ -37,6 +37,15 @@ pub(super) fn validate(
             MAX_DECIDING as f64,
         ));
     }
+    if !deciding.is_empty() && vessel.kind != super::vessel::VesselKind::Rov6 {
+        return Err(PlanError::invalid(
+            "deciding",
+            format!(
+                "deciding runs are planned for 6-DOF ROVs (discovery's proposals are generalised forces); vessel '{}' flies thruster schedules",
+                vessel.name
+            ),
+        ));
+    }
     for (k, p) in deciding.iter().enumerate() {
         let field = |f: &str| format!("deciding[{k}].{f}");
         if !matches!(
@@ -330,6 +339,20 @@ mod tests {
         let many = vec![deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0]); MAX_DECIDING + 1];
         let e = generate_plan(&v, &with(&spec, many)).unwrap_err();
         assert_eq!(e.field, "deciding");
+
+        // A DP ship flies thruster schedules: no generalised-force runs.
+        let dp = crate::planning::examples::supply_vessel();
+        let dp_spec = crate::planning::examples::supply_vessel_campaign(7);
+        let e = generate_plan(
+            &dp,
+            &with(
+                &dp_spec,
+                vec![deciding_proposal(&v, Dof::Sway, 0.5, vec![0.0])],
+            ),
+        )
+        .unwrap_err();
+        assert_eq!(e.field, "deciding");
+        assert!(e.message.contains("6-DOF ROVs"), "{}", e.message);
     }
 
     /// The clip bound is the vessel's, whatever the proposal says: an
