@@ -96,6 +96,11 @@ mod tests {
         let base = current_nice().expect("Linux");
         assert_eq!(on_http, Some(HTTP_NICE.max(base)));
         assert_eq!(on_http_blocking, Some(HTTP_NICE.max(base)));
-        assert_eq!(on_jobs_blocking, Some(base));
+        // Jobs ask for nice 0: granted when privileged (root), else they
+        // keep the process's own (a test run under `nice` has base > 0).
+        assert!(
+            on_jobs_blocking == Some(0) || on_jobs_blocking == Some(base),
+            "jobs at nice {on_jobs_blocking:?}, process at {base}"
+        );
     }
 }
