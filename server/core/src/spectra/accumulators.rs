@@ -171,6 +171,14 @@ impl Accumulators {
         }
     }
 
+    /// The auto spectra: each channel's sums times the density `factors`.
+    fn scaled_auto(&self, factors: &[f64]) -> Vec<Vec<f64>> {
+        self.auto
+            .chunks_exact(self.nf.max(1))
+            .map(|c| c.iter().zip(factors).map(|(v, f)| v * f).collect())
+            .collect()
+    }
+
     /// [`Accumulators::finish`] with the cross spectra left in their planes
     /// (scaled in place: the same products as there).
     pub(super) fn finish_planes(
@@ -180,11 +188,7 @@ impl Accumulators {
         n_segments: usize,
     ) -> PlaneSpectra {
         let nf = self.nf;
-        let auto = self
-            .auto
-            .chunks_exact(nf.max(1))
-            .map(|c| c.iter().zip(factors).map(|(v, f)| v * f).collect())
-            .collect();
+        let auto = self.scaled_auto(factors);
         for plane in self.cross.chunks_exact_mut(nf.max(1)) {
             for (v, f) in plane.iter_mut().zip(factors) {
                 *v *= f;
@@ -211,11 +215,7 @@ impl Accumulators {
         n_segments: usize,
     ) -> MultiSpectra {
         let nf = self.nf;
-        let auto = self
-            .auto
-            .chunks_exact(nf.max(1))
-            .map(|c| c.iter().zip(factors).map(|(v, f)| v * f).collect())
-            .collect();
+        let auto = self.scaled_auto(factors);
         let cross = self
             .cross
             .chunks_exact(2 * nf.max(1))
