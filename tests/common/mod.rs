@@ -384,6 +384,7 @@ pub async fn stored_model(
                 augmentation: None,
             }],
             logged_controller: None,
+            extension: None,
         }),
         dp_ship: None,
         state_space: None,

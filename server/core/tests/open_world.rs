@@ -143,6 +143,52 @@ fn roll_and_pitch_free_runs_keep_their_restoring_spring() {
     assert!(good >= 4, "{good} of 5 vessels above 0.7");
 }
 
+/// Below the grid the model extends its lowest sub-models (damping
+/// linear, load quadratic in speed) instead of holding the 0.5 m/s one: on
+/// the staircase's 0.3 m/s leg (a fifth of the validation run) the
+/// free runs gain in sway, heave and yaw on every vessel (+0.006…+0.10
+/// measured) and lose nowhere more than surge's 0.03; over all channels and
+/// vessels +0.6 in sum. The stored document reproduces the identification's
+/// own validation, extension included.
+#[test]
+fn the_extension_below_the_grid_improves_free_runs() {
+    let mut total = 0.0;
+    for r in reports() {
+        for c in &r.fits {
+            let (ext, held) = (c.free_run_stored.unwrap(), c.free_run_held.unwrap());
+            assert!(
+                (ext - c.free_run.unwrap()).abs() < 1e-9,
+                "seed {} {}: stored {ext} against the job's {:?}",
+                r.seed,
+                c.channel,
+                c.free_run
+            );
+            assert!(
+                ext > held - 0.04,
+                "seed {} {}: {held:.3} held → {ext:.3} extended",
+                r.seed,
+                c.channel
+            );
+            if ["v", "w", "r"].contains(&c.channel.as_str()) {
+                assert!(
+                    ext > held,
+                    "seed {} {}: {held:.3} → {ext:.3}",
+                    r.seed,
+                    c.channel
+                );
+            }
+            total += ext - held;
+        }
+        assert!(
+            r.notes.iter().any(|n| n.contains("down to 0.20 m/s")),
+            "seed {}: {:?}",
+            r.seed,
+            r.notes
+        );
+    }
+    assert!(total > 0.4, "sum of free-run gains {total:.3}");
+}
+
 /// The issue's full criteria, not met yet (see the README's identification
 /// section): ≥ 95 % of parameters within ±3σ, 1-step within 0.02 and free
 /// run within 0.05 of the true model in every channel.

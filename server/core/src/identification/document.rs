@@ -172,6 +172,46 @@ pub struct LpvDoc {
     /// add the commands the log does not show (see `intersample`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub logged_controller: Option<LoggedController>,
+    /// The speeds the model extends to beyond its grid (interpolated
+    /// scheduling): there M and D̄ are extrapolated linearly in forward
+    /// speed from the two end sub-models and the load quadratically through
+    /// the three end ones. Absent: it holds its end sub-models (thesis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extension: Option<SpeedExtension>,
+}
+
+/// Speeds (m/s) an LPV model extends to beyond its grid.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct SpeedExtension {
+    /// Lowest forward speed modelled (m/s), ≤ the lowest grid speed.
+    pub from_mps: f64,
+    /// Highest forward speed modelled (m/s), ≥ the highest grid speed.
+    pub to_mps: f64,
+}
+
+impl SpeedExtension {
+    /// How to evaluate the model beyond a grid of `lowest`…`highest` m/s,
+    /// in words for an export's notes.
+    pub fn describe(&self, lowest: f64, highest: f64) -> String {
+        let mut sides = Vec::new();
+        if self.from_mps < lowest {
+            sides.push(format!(
+                "below {lowest:.2} m/s down to {:.2} m/s from the three lowest grid points",
+                self.from_mps
+            ));
+        }
+        if self.to_mps > highest {
+            sides.push(format!(
+                "above {highest:.2} m/s up to {:.2} m/s from the three highest",
+                self.to_mps
+            ));
+        }
+        format!(
+            "Beyond the grid the model extrapolates {}: M and D̄ linearly in forward speed from the two end points, the load b quadratically (Lagrange) through three; past that speed it holds the extrapolated point, elsewhere the end grid point.",
+            sides.join(" and ")
+        )
+    }
 }
 
 /// A feedback controller r times faster than its log, as read from the log:

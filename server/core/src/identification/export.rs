@@ -162,6 +162,11 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                     .into(),
                 "D is the λ-identified D̄ (linear damping about the grid speed).".into(),
             ];
+            if let (Some(e), Some(lo), Some(hi)) =
+                (lpv.extension, lpv.points.first(), lpv.points.last())
+            {
+                notes.push(e.describe(lo.speed_mps, hi.speed_mps));
+            }
             if augmented {
                 notes.push("Discovered physics: each point's `terms` add to the left-hand side (their coefficients times the regressor named in `label`), or shape τ before it acts (lag, delay, saturation, dead zone); M and D are then the refitted ones.".into());
             }
@@ -261,6 +266,7 @@ mod tests {
                     augmentation: None,
                 }],
                 logged_controller: None,
+                extension: None,
             }),
             dp_ship: None,
             state_space: None,

@@ -126,6 +126,14 @@ pub fn matlab_script(doc: &ModelDocument, name: &str, version: i64) -> String {
         let _ = writeln!(w, "model.lpv.structure = {};", string(&l.structure));
         let speeds: Vec<f64> = l.points.iter().map(|p| p.speed_mps).collect();
         let _ = writeln!(w, "model.lpv.speeds_mps = {};", vector(&speeds));
+        if let (Some(e), Some(&lo), Some(&hi)) = (l.extension, speeds.first(), speeds.last()) {
+            let _ = writeln!(w, "% {}", e.describe(lo, hi));
+            let _ = writeln!(
+                w,
+                "model.lpv.extension_mps = {};",
+                vector(&[e.from_mps, e.to_mps])
+            );
+        }
         for (i, p) in l.points.iter().enumerate() {
             let k = i + 1;
             for (field, m) in [
@@ -258,7 +266,9 @@ pub fn matlab_script(doc: &ModelDocument, name: &str, version: i64) -> String {
 mod tests {
     use super::*;
     use crate::estimation::restoring::RestoringParams;
-    use crate::identification::document::{LoggedController, ParameterRow, RestoringDoc};
+    use crate::identification::document::{
+        LoggedController, ParameterRow, RestoringDoc, SpeedExtension,
+    };
     use crate::identification::tests::lpv_doc;
     use crate::planning::dof::Dof;
 
@@ -302,6 +312,10 @@ mod tests {
             std: None,
             unit: "kg".into(),
         }];
+        doc.lpv.as_mut().unwrap().extension = Some(SpeedExtension {
+            from_mps: 0.2,
+            to_mps: 1.5,
+        });
         doc.notes = vec!["the pilot's note: it's fine".into()];
         doc
     }
@@ -338,6 +352,15 @@ mod tests {
         assert_eq!(
             read_matrix(&s, "model.lpv.speeds_mps ="),
             vec![vec![0.5, 1.5]]
+        );
+        // The extension below the grid, in numbers and in words.
+        assert_eq!(
+            read_matrix(&s, "model.lpv.extension_mps ="),
+            vec![vec![0.2, 1.5]]
+        );
+        assert!(
+            s.contains("% Beyond the grid the model extrapolates below 0.50 m/s down to 0.20 m/s"),
+            "{s}"
         );
         assert_eq!(
             read_matrix(&s, "model.lpv.b(:,2) ="),

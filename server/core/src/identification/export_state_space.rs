@@ -215,6 +215,11 @@ pub fn state_space_export(
             }
             .into();
             notes.push("Schedule on forward speed: nearest grid point, or interpolate between neighbours; g(η) is in the JSON and NumPy exports.".into());
+            if let (Some(e), Some(lo), Some(hi)) =
+                (lpv.extension, lpv.points.first(), lpv.points.last())
+            {
+                notes.push(e.describe(lo.speed_mps, hi.speed_mps));
+            }
             if lpv.logged_controller.is_some() {
                 notes.push("The logs came from a controller faster than the log; A and B are the vehicle's own (see the JSON export's logged_controller).".into());
             }

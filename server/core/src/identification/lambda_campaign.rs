@@ -9,7 +9,8 @@ use serde::{Deserialize, Serialize};
 use super::attitude_loop::AttitudeLoop;
 use super::dataset::{RunInput, segments};
 use super::document::{
-    LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, to_rows,
+    LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, SpeedExtension,
+    to_rows,
 };
 use super::error::IdentifyError;
 use super::intersample::{correct_estimates, logged_equivalent};
@@ -17,6 +18,7 @@ use super::joint_restoring::{Functions, PooledRestoring, load, specification};
 use super::lambda_consistency::inflate_inertia_std;
 use super::lambda_coriolis::fit_points;
 use super::lambda_data::{experiment, per_point, regression_columns, static_holds};
+use super::lambda_extension::{BELOW, choose_extension};
 use super::lambda_information::default_t_lambda;
 use super::lambda_physical::enforce;
 use super::lambda_structure::choose_structure;
@@ -112,6 +114,14 @@ pub struct LambdaCampaignSettings {
     /// from the log (see `intersample`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub controller_rate_hz: Option<f64>,
+    /// Extend the model a short way below its lowest grid speed (up to 0.6
+    /// of the first spacing, not below 0 m/s, as far as it stays physical
+    /// and stable: damping extrapolated linearly in speed, the load
+    /// quadratically) instead of holding the lowest sub-model there
+    /// (thesis). Interpolated scheduling on three or more grid speeds;
+    /// above the grid the highest sub-model is held.
+    #[serde(default = "default_true")]
+    pub extend_below_grid: bool,
 }
 
 fn default_threshold() -> f64 {
@@ -138,6 +148,7 @@ impl Default for LambdaCampaignSettings {
             constant_loads: true,
             coriolis_from_m: true,
             controller_rate_hz: None,
+            extend_below_grid: true,
         }
     }
 }
@@ -363,6 +374,7 @@ pub fn identify_lambda_campaign(
 
     // 3. Sub-models, physical structure enforced, parameters.
     let mut models = Vec::new();
+    let mut vehicle = Vec::new();
     let mut lpv_points = Vec::new();
     let mut parameters = Vec::new();
     let mut findings = Vec::new();
@@ -428,6 +440,7 @@ pub fn identify_lambda_campaign(
             run_ids: data.run_ids[idx].clone(),
             augmentation: None,
         });
+        vehicle.push(model.clone());
         // Validation predicts the logs: with the controller's unlogged
         // commands added back when it ran faster than the log.
         let for_logs = match &logged_controller {
@@ -449,9 +462,23 @@ pub fn identify_lambda_campaign(
         SchedulingChoice::Nearest => Scheduling::Nearest,
         SchedulingChoice::Interpolate => Scheduling::Interpolate,
     };
-    let lpv = LpvModel::new(estimates.iter().map(|(s, _)| *s).collect(), models)
+    let speeds: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
+    let lpv = LpvModel::new(speeds.clone(), models)
         .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
         .with_scheduling(scheduling);
+    // Beyond the grid: extended as far as the vehicle's model stays physical.
+    let extension = (settings.extend_below_grid && scheduling == Scheduling::Interpolate)
+        .then(|| LpvModel::new(speeds, vehicle).ok())
+        .flatten()
+        .and_then(|v| choose_extension(&v, settings.coriolis_from_m, g, BELOW));
+    let lpv = match &extension {
+        Some((ext, note)) => {
+            notes.push(note.clone());
+            lpv.with_extension(*ext)
+                .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
+        }
+        None => lpv,
+    };
 
     // 4. Validation on the held-out runs.
     progress.update(0.85, "validating on held-out runs")?;
@@ -503,17 +530,48 @@ pub fn identify_lambda_campaign(
             let u: Vec<f64> = longest.y.column(j).iter().copied().collect();
             let grid: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
             let (below, above) = super::roles::beyond_grid(&u, &grid);
-            for (share, side, end) in [
-                (below, "below", grid[0]),
-                (above, "above", grid[grid.len() - 1]),
+            let ext = lpv.extension();
+            let (below_ext, above_ext) = match ext {
+                Some(e) => {
+                    let finite = u.iter().filter(|v| v.is_finite()).count().max(1) as f64;
+                    let share = |f: &dyn Fn(f64) -> bool| {
+                        u.iter().filter(|v| v.is_finite() && f(**v)).count() as f64 / finite
+                    };
+                    (share(&|v| v < e.from_mps), share(&|v| v > e.to_mps))
+                }
+                None => (below, above),
+            };
+            for (share, beyond, side, end, edge) in [
+                (below, below_ext, "below", grid[0], ext.map(|e| e.from_mps)),
+                (
+                    above,
+                    above_ext,
+                    "above",
+                    grid[grid.len() - 1],
+                    ext.map(|e| e.to_mps),
+                ),
             ] {
-                if share >= 0.05 {
-                    notes.push(format!(
+                if share < 0.05 {
+                    continue;
+                }
+                let edge = edge.filter(|e| (e - end).abs() > 1e-9);
+                notes.push(match edge {
+                    Some(edge) => format!(
+                        "validation run {}: {:.0} % of it was flown {side} the identified speeds ({end:.2} m/s), where the model extrapolates its sub-models to {edge:.2} m/s{}; its fits there measure extrapolation, and a grid point at that speed would model it",
+                        r.name,
+                        100.0 * share,
+                        if beyond >= 0.005 {
+                            format!(" and holds that model {side} it ({:.0} % of the run)", 100.0 * beyond)
+                        } else {
+                            String::new()
+                        }
+                    ),
+                    None => format!(
                         "validation run {}: {:.0} % of it was flown {side} the identified speeds, where the model holds its {end:.2} m/s sub-model; its fits there measure extrapolation, and a grid point at that speed would model it",
                         r.name,
                         100.0 * share
-                    ));
-                }
+                    ),
+                });
             }
         }
         validation.push(RunValidation {
@@ -540,6 +598,10 @@ pub fn identify_lambda_campaign(
             coupling,
             points: lpv_points,
             logged_controller,
+            extension: extension.map(|(e, _)| SpeedExtension {
+                from_mps: e.from_mps,
+                to_mps: e.to_mps,
+            }),
         }),
         dp_ship: None,
         state_space: None,

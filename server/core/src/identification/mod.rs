@@ -52,6 +52,7 @@ pub mod lambda_campaign;
 mod lambda_consistency;
 mod lambda_coriolis;
 mod lambda_data;
+mod lambda_extension;
 pub mod lambda_information;
 mod lambda_physical;
 mod lambda_structure;

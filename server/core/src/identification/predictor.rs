@@ -16,7 +16,7 @@ use crate::estimation::ekf::IdentifiedDpShip;
 use crate::estimation::n4sid::{N4sidModel, NoiseCovariances, Weighting};
 use crate::estimation::restoring::RestoringParams;
 use crate::logs::schema::pose_column;
-use crate::models::{LinearVesselModel, LpvModel};
+use crate::models::{Extension, LinearVesselModel, LpvModel};
 use crate::planning::dof::Dof;
 use crate::simulation::dp_ship::{DpShip, Matrix3x6};
 use crate::validation::{
@@ -65,6 +65,15 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
             let speeds = lpv.points.iter().map(|p| p.speed_mps).collect();
             let model = LpvModel::new(speeds, models)
                 .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?;
+            let model = match lpv.extension {
+                Some(e) => model
+                    .with_extension(Extension {
+                        from_mps: e.from_mps,
+                        to_mps: e.to_mps,
+                    })
+                    .map_err(|e| IdentifyError::invalid("document.lpv.extension", e.to_string()))?,
+                None => model,
+            };
             match attitude_in_loop(doc) {
                 Some(g) => Ok(Box::new(
                     AttitudeLoop::new(model, g).expect("attitude_in_loop checked the DOFs"),

@@ -366,6 +366,7 @@ pub(crate) fn lpv_doc(
             coupling: vec![],
             points,
             logged_controller: None,
+            extension: None,
         }),
         dp_ship: None,
         state_space: None,

@@ -11,7 +11,10 @@
 //!   we take the linear weight w = (x_u − u)/(x_u − x_l), which is 1 at the
 //!   lower grid point and 0 at the upper one, so the blend is continuous in u
 //!   and returns the sub-model itself at a grid speed. Outside the grid only
-//!   the nearest end model is used, as in the thesis.
+//!   the nearest end model is used, as in the thesis — unless the model has
+//!   an [`Extension`]: then, over its stated range, the end sub-models are
+//!   extrapolated the way hull forces vary with speed (see
+//!   [`super::lpv_schedule`]).
 //!
 //! Since both sub-models start from the same x(k) and u(k), blending outputs
 //! equals blending the discrete matrices Φ and Γ ([`DiscreteLpv::at`]).
@@ -21,75 +24,13 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::error::{ModelError, check_finite};
+pub use super::lpv_schedule::{Blend, Extension, ScheduleWeights, Scheduling};
+use super::lpv_schedule::{blend as schedule_blend, schedule};
 use super::predict::{check_record, free_run, k_step, no_prediction};
 use super::state_space::DiscreteStateSpace;
 use super::vessel::LinearVesselModel;
 use crate::planning::dof::Dof;
 use crate::validation::{Predictor, ValidationRecord};
-
-/// How the sub-model at a forward speed is chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Scheduling {
-    /// Nearest grid point (thesis eq. 2.17).
-    Nearest,
-    /// Linear blend of the two neighbouring grid points (thesis eq. 2.18);
-    /// the scheme behind the thesis's reported predictions.
-    #[default]
-    Interpolate,
-}
-
-/// Which grid points a speed uses, and with which weight: the sub-model of
-/// `lower` gets `w_lower`, the one of `upper` gets 1 − `w_lower` (the
-/// thesis's w(k)). `lower == upper` and `w_lower = 1` for a single model.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ScheduleWeights {
-    /// Index of the lower (or only) grid point.
-    pub lower: usize,
-    /// Index of the upper (or only) grid point.
-    pub upper: usize,
-    /// Weight of the lower grid point's model, in [0, 1].
-    pub w_lower: f64,
-}
-
-/// The weights of `speed` on a strictly increasing, non-empty, finite `grid`.
-fn schedule(grid: &[f64], speed: f64, scheduling: Scheduling) -> ScheduleWeights {
-    let only = |i| ScheduleWeights {
-        lower: i,
-        upper: i,
-        w_lower: 1.0,
-    };
-    let last = grid.len() - 1;
-    match scheduling {
-        Scheduling::Nearest => {
-            let mut best = 0;
-            for (i, x) in grid.iter().enumerate() {
-                // Strict < keeps the lower point on a tie.
-                if (speed - x).abs() < (speed - grid[best]).abs() {
-                    best = i;
-                }
-            }
-            only(best)
-        }
-        Scheduling::Interpolate => {
-            if speed <= grid[0] {
-                return only(0);
-            }
-            if speed >= grid[last] {
-                return only(last);
-            }
-            // grid[i] ≤ speed < grid[i + 1].
-            let i = grid.partition_point(|x| *x <= speed) - 1;
-            if speed == grid[i] {
-                return only(i);
-            }
-            ScheduleWeights {
-                lower: i,
-                upper: i + 1,
-                w_lower: (grid[i + 1] - speed) / (grid[i + 1] - grid[i]),
-            }
-        }
-    }
-}
 
 /// M_x ν̇ + D̄_x ν = γ at each grid speed x (m/s, forward speed u through
 /// the water as the INS measures it).
@@ -98,6 +39,7 @@ pub struct LpvModel {
     grid_speeds: Vec<f64>,
     points: Vec<LinearVesselModel>,
     scheduling: Scheduling,
+    extension: Option<Extension>,
 }
 
 /// An [`LpvModel`] discretized (ZOH) at one sample time, ready to step.
@@ -107,7 +49,17 @@ pub struct DiscreteLpv {
     points: Vec<DiscreteStateSpace>,
     /// Column of ν holding the surge velocity u, if surge is modelled.
     surge: Option<usize>,
+    /// The extension's models (exact discretizations of [`LpvModel::at`])
+    /// at evenly spaced speeds from each grid end outwards to the edge,
+    /// below and above; empty without an extension.
+    beyond: [Vec<(f64, DiscreteStateSpace)>; 2],
 }
+
+/// Speeds tabulated over each side of an extension. Φ = e^{Ah} is not
+/// linear in A: extrapolating the end points' Φ linearly can leave the
+/// unit circle where the extrapolated A is stable, so the extension is
+/// discretized exactly at these speeds and interpolated between them.
+const BEYOND_STEPS: usize = 8;
 
 fn check_speed(speed: f64) -> Result<(), ModelError> {
     if speed.is_finite() {
@@ -119,10 +71,6 @@ fn check_speed(speed: f64) -> Result<(), ModelError> {
             requirement: "a finite forward speed in m/s",
         })
     }
-}
-
-fn blend(w: f64, a: &DMatrix<f64>, b: &DMatrix<f64>) -> DMatrix<f64> {
-    a * w + b * (1.0 - w)
 }
 
 impl LpvModel {
@@ -173,7 +121,50 @@ impl LpvModel {
             grid_speeds,
             points,
             scheduling: Scheduling::default(),
+            extension: None,
         })
+    }
+
+    /// The same model extended beyond its grid down to `ext.from_mps` and
+    /// up to `ext.to_mps` (see [`Extension`]).
+    ///
+    /// # Errors
+    /// [`ModelError::Grid`] when a bound is not finite or lies inside the
+    /// grid.
+    pub fn with_extension(mut self, ext: Extension) -> Result<Self, ModelError> {
+        let (lo, hi) = (
+            self.grid_speeds[0],
+            self.grid_speeds[self.grid_speeds.len() - 1],
+        );
+        if !(ext.from_mps.is_finite() && ext.to_mps.is_finite())
+            || ext.from_mps > lo
+            || ext.to_mps < hi
+        {
+            return Err(ModelError::Grid {
+                reason: format!(
+                    "an extension must reach from at most the lowest grid speed ({lo} m/s) to at least the highest ({hi} m/s); got {} … {} m/s",
+                    ext.from_mps, ext.to_mps
+                ),
+            });
+        }
+        self.extension = Some(ext);
+        Ok(self)
+    }
+
+    /// The speeds the model extends to beyond its grid, if any.
+    pub fn extension(&self) -> Option<Extension> {
+        self.extension
+    }
+
+    /// Weights of the sub-models at `speed` (m/s), with the extension.
+    pub fn blend_at(&self, speed: f64, scheduling: Scheduling) -> Result<Blend, ModelError> {
+        check_speed(speed)?;
+        Ok(schedule_blend(
+            &self.grid_speeds,
+            self.extension,
+            speed,
+            scheduling,
+        ))
     }
 
     /// The same model predicting with `scheduling`.
@@ -210,19 +201,27 @@ impl LpvModel {
     }
 
     /// The continuous model at forward speed `speed` (m/s): the nearest
-    /// sub-model, or M and D̄ blended with the weights of eq. 2.18.
+    /// sub-model, or M and D̄ blended with the weights of eq. 2.18 (and the
+    /// load with its own weights beyond the grid, see [`Extension`]).
     pub fn at(&self, speed: f64, scheduling: Scheduling) -> Result<LinearVesselModel, ModelError> {
-        let w = self.weights(speed, scheduling)?;
-        if w.lower == w.upper {
-            return Ok(self.points[w.lower].clone());
+        let b = self.blend_at(speed, scheduling)?;
+        let [(i, wi), (j, wj)] = b.dynamics;
+        if i == j {
+            return Ok(self.points[i].clone());
         }
-        let (l, u) = (&self.points[w.lower], &self.points[w.upper]);
+        let (l, u) = (&self.points[i], &self.points[j]);
+        let load = b
+            .load
+            .iter()
+            .fold(DVector::zeros(l.load().len()), |acc, &(k, v)| {
+                acc + self.points[k].load() * v
+            });
         LinearVesselModel::new(
             l.dofs().to_vec(),
-            blend(w.w_lower, l.m(), u.m()),
-            blend(w.w_lower, l.d_bar(), u.d_bar()),
+            l.m() * wi + u.m() * wj,
+            l.d_bar() * wi + u.d_bar() * wj,
         )?
-        .with_load(l.load() * w.w_lower + u.load() * (1.0 - w.w_lower))
+        .with_load(load)
     }
 
     /// Every sub-model discretized (ZOH) at sample time `h` (s).
@@ -232,10 +231,28 @@ impl LpvModel {
             .iter()
             .map(|p| p.discretize(h))
             .collect::<Result<Vec<_>, _>>()?;
+        let g = &self.grid_speeds;
+        let (lo, hi) = (g[0], g[g.len() - 1]);
+        let table = |end: f64, edge: f64| -> Result<Vec<(f64, DiscreteStateSpace)>, ModelError> {
+            if g.len() < 3 || edge == end {
+                return Ok(Vec::new());
+            }
+            (1..=BEYOND_STEPS)
+                .map(|k| {
+                    let s = end + (edge - end) * k as f64 / BEYOND_STEPS as f64;
+                    Ok((s, self.at(s, Scheduling::Interpolate)?.discretize(h)?))
+                })
+                .collect()
+        };
+        let beyond = match self.extension {
+            Some(e) => [table(lo, e.from_mps)?, table(hi, e.to_mps)?],
+            None => [Vec::new(), Vec::new()],
+        };
         Ok(DiscreteLpv {
             grid_speeds: self.grid_speeds.clone(),
             points,
             surge: self.dofs().iter().position(|d| *d == Dof::Surge),
+            beyond,
         })
     }
 
@@ -272,22 +289,60 @@ impl DiscreteLpv {
     }
 
     /// The discrete model at `speed` (m/s): Φ and Γ blended with the weights
-    /// of eq. 2.17/2.18, which is the thesis's blend of the two predictions.
+    /// of eq. 2.17/2.18, which is the thesis's blend of the two predictions
+    /// (beyond the grid, within an [`Extension`], the blend of its two
+    /// nearest tabulated models).
     pub fn at(&self, speed: f64, scheduling: Scheduling) -> Result<DiscreteStateSpace, ModelError> {
         check_speed(speed)?;
-        let w = schedule(&self.grid_speeds, speed, scheduling);
-        if w.lower == w.upper {
-            return Ok(self.points[w.lower].clone());
+        let ((l, wl), (u, wu)) = self.pair(speed, scheduling);
+        if wu == 0.0 {
+            return Ok(l.clone());
         }
-        let (l, u) = (&self.points[w.lower], &self.points[w.upper]);
         DiscreteStateSpace::new(
-            blend(w.w_lower, l.phi(), u.phi()),
-            blend(w.w_lower, l.gamma(), u.gamma()),
+            l.phi() * wl + u.phi() * wu,
+            l.gamma() * wl + u.gamma() * wu,
             l.c().clone(),
             l.d().clone(),
             l.h(),
         )?
-        .with_offset(l.offset() * w.w_lower + u.offset() * (1.0 - w.w_lower))
+        .with_offset(l.offset() * wl + u.offset() * wu)
+    }
+
+    /// The two discrete models blended at `speed` with their weights (the
+    /// second weight 0 when one model serves).
+    fn pair(
+        &self,
+        speed: f64,
+        scheduling: Scheduling,
+    ) -> ((&DiscreteStateSpace, f64), (&DiscreteStateSpace, f64)) {
+        let g = &self.grid_speeds;
+        let last = g.len() - 1;
+        let side = match scheduling {
+            Scheduling::Interpolate if speed < g[0] => Some((0, 0)),
+            Scheduling::Interpolate if speed > g[last] => Some((1, last)),
+            _ => None,
+        };
+        if let Some((side, end)) = side {
+            let table = &self.beyond[side];
+            if !table.is_empty() {
+                let dist = |s: f64| (s - g[end]).abs();
+                let d = dist(speed);
+                let mut prev = (g[end], &self.points[end]);
+                for (s, model) in table {
+                    if d <= dist(*s) {
+                        let w = (dist(*s) - d) / (dist(*s) - dist(prev.0));
+                        return ((prev.1, w), (model, 1.0 - w));
+                    }
+                    prev = (*s, model);
+                }
+                return ((prev.1, 1.0), (prev.1, 0.0));
+            }
+        }
+        let w = schedule(g, speed, scheduling);
+        (
+            (&self.points[w.lower], w.w_lower),
+            (&self.points[w.upper], 1.0 - w.w_lower),
+        )
     }
 
     /// x̂(k+1 | k) from ν(k) = `x` and γ(k) = `u`, scheduled on the surge
@@ -295,15 +350,15 @@ impl DiscreteLpv {
     /// first grid point. A non-finite speed schedules on the first grid point
     /// too (its prediction is non-finite anyway).
     pub fn step(&self, x: &DVector<f64>, u: &DVector<f64>, scheduling: Scheduling) -> DVector<f64> {
-        let w = match self.surge {
-            Some(i) if x[i].is_finite() => schedule(&self.grid_speeds, x[i], scheduling),
-            _ => schedule(&self.grid_speeds, self.grid_speeds[0], Scheduling::Nearest),
+        let ((l, wl), (m, wm)) = match self.surge {
+            Some(i) if x[i].is_finite() => self.pair(x[i], scheduling),
+            _ => self.pair(self.grid_speeds[0], Scheduling::Nearest),
         };
-        let lower = self.points[w.lower].step(x, u);
-        if w.lower == w.upper {
+        let lower = l.step(x, u);
+        if wm == 0.0 {
             return lower;
         }
-        lower * w.w_lower + self.points[w.upper].step(x, u) * (1.0 - w.w_lower)
+        lower * wl + m.step(x, u) * wm
     }
 }
 

@@ -12,12 +12,15 @@
 //! - [`coriolis`]: C(ν) from M (Fossen 2011, eq. 6.43), 6-DOF and 3-DOF.
 //! - [`lpv`]: sub-models on a forward-speed grid, nearest (eq. 2.17) or
 //!   interpolated (eq. 2.18) scheduling; a `Predictor` scheduled on u.
+//! - [`lpv_schedule`]: the sub-models' weights at a speed, and the optional
+//!   extension beyond the grid (damping linear, load quadratic in u₀).
 //! - [`error`]: the typed errors of all of the above.
 //! - `predict` (private): k-step and free-run loops shared by the predictors.
 
 pub mod coriolis;
 pub mod error;
 pub mod lpv;
+pub mod lpv_schedule;
 pub(crate) mod predict;
 pub mod projection;
 pub mod state_space;
@@ -26,7 +29,8 @@ pub mod vessel;
 
 pub use coriolis::{coriolis, coriolis_3dof, coriolis_6dof, skew};
 pub use error::ModelError;
-pub use lpv::{DiscreteLpv, LpvModel, ScheduleWeights, Scheduling};
+pub use lpv::{DiscreteLpv, LpvModel};
+pub use lpv_schedule::{Blend, Extension, ScheduleWeights, Scheduling};
 pub use projection::{Projection, project_physical};
 pub use state_space::{DiscreteStateSpace, StateSpace};
 pub use structure::StructureReport;

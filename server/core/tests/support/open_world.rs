@@ -55,6 +55,11 @@ pub struct ChannelFit {
     /// point's effective linearization of the truth over its runs, with
     /// the true g(η) — what the estimator could reach at best.
     pub free_run_oracle: Option<f64>,
+    /// The stored model's free run, validated from its document.
+    pub free_run_stored: Option<f64>,
+    /// The same with its extension below the grid removed: the lowest
+    /// sub-model held there (thesis).
+    pub free_run_held: Option<f64>,
     pub one_step_affine: Option<f64>,
 }
 
@@ -366,6 +371,21 @@ pub fn evaluate_with(
             .expect("the validation run is an input");
         validate_on_run_with(&doc, val_input, &columns, ValidationSettings::default()).ok()
     };
+    let val_input = inputs
+        .iter()
+        .find(|r| r.run_id == val_run.meta.name)
+        .expect("the validation run is an input");
+    let stored = validate_on_run_with(doc, val_input, &columns, ValidationSettings::default()).ok();
+    let held = {
+        let mut doc = doc.clone();
+        doc.lpv.as_mut().expect("an LPV model").extension = None;
+        validate_on_run_with(&doc, val_input, &columns, ValidationSettings::default()).ok()
+    };
+    let free_run = |r: &Option<seatrial_core::validation::ValidationReport>, j: usize| {
+        r.as_ref()
+            .and_then(|o| o.channels.get(j))
+            .and_then(|c| c.fit_simulation)
+    };
     let aff = affine.one_step(val_run);
     let fits = report
         .channels
@@ -377,10 +397,9 @@ pub fn evaluate_with(
             one_step_true: column_fit(&val_run.log.nu, &truth_pred.one_step, j, 1),
             free_run: c.fit_simulation,
             free_run_true: column_fit(&val_run.log.nu, &truth_pred.free_run, j, 0),
-            free_run_oracle: oracle
-                .as_ref()
-                .and_then(|o| o.channels.get(j))
-                .and_then(|c| c.fit_simulation),
+            free_run_oracle: free_run(&oracle, j),
+            free_run_stored: free_run(&stored, j),
+            free_run_held: free_run(&held, j),
             one_step_affine: column_fit(&val_run.log.nu, &aff, j, 1),
         })
         .collect();
