@@ -193,7 +193,7 @@ fn the_extension_below_the_grid_improves_free_runs() {
 /// section): ≥ 95 % of parameters within ±3σ, 1-step within 0.02 and free
 /// run within 0.05 of the true model in every channel.
 #[test]
-#[ignore = "known gap: 85–96 % within ±3σ; free runs 0.03–0.18 below the true model's (the 2.25 m/s leg beyond the grid, cross-flow damping under excitation), where the oracle linear LPV model falls short too"]
+#[ignore = "known gap: 85–96 % within ±3σ; free runs up to 0.40 below the true model's (vessel 5 roll; the 2.25 m/s leg beyond the grid, cross-flow damping under excitation), where the oracle linear LPV model falls short too"]
 fn the_issue_criteria_on_five_vessels() {
     for r in reports() {
         let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();

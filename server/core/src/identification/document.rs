@@ -173,9 +173,10 @@ pub struct LpvDoc {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub logged_controller: Option<LoggedController>,
     /// The speeds the model extends to beyond its grid (interpolated
-    /// scheduling): there M and D̄ are extrapolated linearly in forward
-    /// speed from the two end sub-models and the load quadratically through
-    /// the three end ones. Absent: it holds its end sub-models (thesis).
+    /// scheduling): there D̄ is extrapolated linearly in forward speed from
+    /// the two end sub-models, the load quadratically through the three end
+    /// ones, and M is the end one's. Absent: it holds its end sub-models
+    /// (thesis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extension: Option<SpeedExtension>,
 }
@@ -208,7 +209,7 @@ impl SpeedExtension {
             ));
         }
         format!(
-            "Beyond the grid the model extrapolates {}: M and D̄ linearly in forward speed from the two end points, the load b quadratically (Lagrange) through three; past that speed it holds the extrapolated point, elsewhere the end grid point.",
+            "Beyond the grid the model extrapolates {}: D̄ linearly in forward speed from the two end points, the load b quadratically (Lagrange) through three, M that of the end point; past that speed it holds the extrapolated point, elsewhere the end grid point.",
             sides.join(" and ")
         )
     }

@@ -216,12 +216,16 @@ impl LpvModel {
             .fold(DVector::zeros(l.load().len()), |acc, &(k, v)| {
                 acc + self.points[k].load() * v
             });
-        LinearVesselModel::new(
-            l.dofs().to_vec(),
-            l.m() * wi + u.m() * wj,
-            l.d_bar() * wi + u.d_bar() * wj,
-        )?
-        .with_load(load)
+        // Beyond the grid M stays the end point's: it does not change with
+        // speed, and extrapolating the points' estimates would amplify their
+        // scatter.
+        let m = if b.extrapolated {
+            l.m().clone()
+        } else {
+            l.m() * wi + u.m() * wj
+        };
+        LinearVesselModel::new(l.dofs().to_vec(), m, l.d_bar() * wi + u.d_bar() * wj)?
+            .with_load(load)
     }
 
     /// Every sub-model discretized (ZOH) at sample time `h` (s).
@@ -530,6 +534,72 @@ mod tests {
             "interpolated fit {f_interp}"
         );
         assert!(f_lti < 0.5, "LTI fit {f_lti} vs LPV {f_interp}");
+    }
+
+    /// Below the grid, within an extension: D̄ linear and the load quadratic
+    /// in speed (exact for the tangents of d_l·u + d_q·u|u|), M the lowest
+    /// point's even when the points' estimates of it differ; the discrete
+    /// model is the exact discretization there, not an extrapolated Φ.
+    #[test]
+    fn an_extension_extrapolates_damping_and_load_and_keeps_m() {
+        let (d_l, d_q) = (300.0, 600.0);
+        let points = GRID
+            .iter()
+            .map(|&x| {
+                let m = DMatrix::from_row_slice(2, 2, &[5000.0 + 200.0 * x, 0.0, 0.0, 3000.0]);
+                let d =
+                    DMatrix::from_row_slice(2, 2, &[d_l + 2.0 * d_q * x, 0.0, 150.0 * x, 400.0]);
+                LinearVesselModel::new(vec![Dof::Surge, Dof::Yaw], m, d)
+                    .unwrap()
+                    .with_load(DVector::from_vec(vec![-d_q * x * x, 10.0 * x]))
+                    .unwrap()
+            })
+            .collect();
+        let ext = Extension {
+            from_mps: 0.2,
+            to_mps: 1.5,
+        };
+        let lpv = LpvModel::new(GRID.to_vec(), points).unwrap();
+        assert!(
+            lpv.clone()
+                .with_extension(Extension {
+                    from_mps: 0.6,
+                    to_mps: 1.5
+                })
+                .is_err()
+        );
+        let lpv = lpv.with_extension(ext).unwrap();
+        let at = lpv.at(0.35, Scheduling::Interpolate).unwrap();
+        assert_eq!(at.m(), lpv.points()[0].m());
+        assert!((at.d_bar()[(0, 0)] - (d_l + 2.0 * d_q * 0.35)).abs() < 1e-9);
+        assert!((at.d_bar()[(1, 0)] - 150.0 * 0.35).abs() < 1e-9);
+        assert!((at.load()[0] + d_q * 0.35 * 0.35).abs() < 1e-9);
+        assert!((at.load()[1] - 3.5).abs() < 1e-9);
+        // Below the extension: its edge model; above the grid: held.
+        assert_eq!(
+            lpv.at(0.05, Scheduling::Interpolate).unwrap(),
+            lpv.at(0.2, Scheduling::Interpolate).unwrap()
+        );
+        assert_eq!(
+            &lpv.at(1.9, Scheduling::Interpolate).unwrap(),
+            &lpv.points()[2]
+        );
+        // 0.35 m/s is one of the tabulated speeds (0.5 − 0.3·4/8).
+        let d = lpv.discretize(0.1).unwrap();
+        let exact = at.discretize(0.1).unwrap();
+        let tab = d.at(0.35, Scheduling::Interpolate).unwrap();
+        assert!((tab.phi() - exact.phi()).amax() < 1e-12);
+        assert!((tab.offset() - exact.offset()).amax() < 1e-12);
+        // Between tabulated speeds, close to the exact discretization.
+        let mid = d.at(0.3, Scheduling::Interpolate).unwrap();
+        let exact = lpv
+            .at(0.3, Scheduling::Interpolate)
+            .unwrap()
+            .discretize(0.1)
+            .unwrap();
+        assert!((mid.phi() - exact.phi()).amax() < 1e-5);
+        // Nearest scheduling ignores the extension.
+        assert_eq!(&lpv.at(0.3, Scheduling::Nearest).unwrap(), &lpv.points()[0]);
     }
 
     #[test]

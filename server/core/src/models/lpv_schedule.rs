@@ -9,9 +9,10 @@
 //! ν₀ = (u₀, 0, …), quadratic damping d|u|u gives D̄(u₀) = 2d|u₀| and
 //! C(ν)ν's Munk terms give entries ∝ u₀ — D̄ is affine in u₀ — while the
 //! constant load of the tangent, b(u₀) = d(u₀) − D̄(u₀)u₀ = −d u₀², is
-//! quadratic. So M and D̄ (and Φ, Γ) are extrapolated linearly from the two
-//! end grid points and the load quadratically through the three end points
-//! (Lagrange). Extrapolating the load linearly, as a plain blend would,
+//! quadratic. So D̄ is extrapolated linearly from the two end grid points
+//! and the load quadratically through the three end points (Lagrange); M,
+//! which does not change with speed, stays the end point's (extrapolating
+//! the points' estimates of it would amplify their scatter). Extrapolating the load linearly, as a plain blend would,
 //! gets the steady force wrong by d·w(w − 1)(Δx)² (at u = 0.3 m/s from a
 //! 0.5/1.0 m/s grid, 0.14 d against a true 0.09 d).
 
@@ -55,6 +56,8 @@ pub struct Extension {
 /// Weights of the sub-models at one speed: the dynamics (M, D̄; Φ, Γ) are
 /// Σ `dynamics` wᵢ·(model i), the load Σ `load` vⱼ·(load j). Inside the
 /// grid both are the thesis's blend; entries with weight 0 are unused.
+/// Beyond it (`extrapolated`) the first dynamics entry is the end grid
+/// point, whose M the model keeps ([`super::LpvModel::at`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Blend {
     /// (grid index, weight) of the dynamics; the weights sum to 1.
@@ -119,9 +122,9 @@ pub(crate) fn schedule(grid: &[f64], speed: f64, scheduling: Scheduling) -> Sche
 }
 
 /// [`schedule`] with the model's extension: beyond the grid ends (and
-/// within the extension, the speed clamped to it) M and D̄ extrapolated
-/// linearly from the two end points, the load quadratically through the
-/// three end points.
+/// within the extension, the speed clamped to it) D̄ extrapolated linearly
+/// from the two end points, the load quadratically through the three end
+/// points.
 pub(crate) fn blend(
     grid: &[f64],
     extension: Option<Extension>,
