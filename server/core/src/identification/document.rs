@@ -191,6 +191,24 @@ pub struct SpeedExtension {
     pub to_mps: f64,
 }
 
+impl From<crate::models::Extension> for SpeedExtension {
+    fn from(e: crate::models::Extension) -> Self {
+        SpeedExtension {
+            from_mps: e.from_mps,
+            to_mps: e.to_mps,
+        }
+    }
+}
+
+impl From<SpeedExtension> for crate::models::Extension {
+    fn from(e: SpeedExtension) -> Self {
+        crate::models::Extension {
+            from_mps: e.from_mps,
+            to_mps: e.to_mps,
+        }
+    }
+}
+
 impl SpeedExtension {
     /// How to evaluate the model beyond a grid of `lowest`…`highest` m/s,
     /// in words for an export's notes.

@@ -18,7 +18,7 @@ use super::joint_restoring::{Functions, PooledRestoring, load, specification};
 use super::lambda_consistency::inflate_inertia_std;
 use super::lambda_coriolis::fit_points;
 use super::lambda_data::{experiment, per_point, regression_columns, static_holds};
-use super::lambda_extension::{BELOW, choose_extension};
+use super::lambda_extension::{BELOW, choose_extension, speed_coverage_notes};
 use super::lambda_information::default_t_lambda;
 use super::lambda_physical::enforce;
 use super::lambda_structure::choose_structure;
@@ -529,50 +529,7 @@ pub fn identify_lambda_campaign(
         if let Some(j) = dofs.iter().position(|d| *d == Dof::Surge) {
             let u: Vec<f64> = longest.y.column(j).iter().copied().collect();
             let grid: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
-            let (below, above) = super::roles::beyond_grid(&u, &grid);
-            let ext = lpv.extension();
-            let (below_ext, above_ext) = match ext {
-                Some(e) => {
-                    let finite = u.iter().filter(|v| v.is_finite()).count().max(1) as f64;
-                    let share = |f: &dyn Fn(f64) -> bool| {
-                        u.iter().filter(|v| v.is_finite() && f(**v)).count() as f64 / finite
-                    };
-                    (share(&|v| v < e.from_mps), share(&|v| v > e.to_mps))
-                }
-                None => (below, above),
-            };
-            for (share, beyond, side, end, edge) in [
-                (below, below_ext, "below", grid[0], ext.map(|e| e.from_mps)),
-                (
-                    above,
-                    above_ext,
-                    "above",
-                    grid[grid.len() - 1],
-                    ext.map(|e| e.to_mps),
-                ),
-            ] {
-                if share < 0.05 {
-                    continue;
-                }
-                let edge = edge.filter(|e| (e - end).abs() > 1e-9);
-                notes.push(match edge {
-                    Some(edge) => format!(
-                        "validation run {}: {:.0} % of it was flown {side} the identified speeds ({end:.2} m/s), where the model extrapolates its sub-models to {edge:.2} m/s{}; its fits there measure extrapolation, and a grid point at that speed would model it",
-                        r.name,
-                        100.0 * share,
-                        if beyond >= 0.005 {
-                            format!(" and holds that model {side} it ({:.0} % of the run)", 100.0 * beyond)
-                        } else {
-                            String::new()
-                        }
-                    ),
-                    None => format!(
-                        "validation run {}: {:.0} % of it was flown {side} the identified speeds, where the model holds its {end:.2} m/s sub-model; its fits there measure extrapolation, and a grid point at that speed would model it",
-                        r.name,
-                        100.0 * share
-                    ),
-                });
-            }
+            notes.extend(speed_coverage_notes(&r.name, &u, &grid, lpv.extension()));
         }
         validation.push(RunValidation {
             run_id: r.run_id.clone(),
@@ -598,10 +555,7 @@ pub fn identify_lambda_campaign(
             coupling,
             points: lpv_points,
             logged_controller,
-            extension: extension.map(|(e, _)| SpeedExtension {
-                from_mps: e.from_mps,
-                to_mps: e.to_mps,
-            }),
+            extension: extension.map(|(e, _)| SpeedExtension::from(e)),
         }),
         dp_ship: None,
         state_space: None,

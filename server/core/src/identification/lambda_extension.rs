@@ -211,6 +211,50 @@ pub(crate) fn choose_extension(
     (below.is_some() || above.is_some()).then_some((ext, note))
 }
 
+/// Notes on validation run `run`'s forward speeds `u` outside the `grid`
+/// (≥ 5 % of the run on a side, with [`super::roles::beyond_grid`]'s
+/// margin): where the model extrapolates (`ext`) or holds its end
+/// sub-model, and how much of the run lies beyond the extension.
+pub(crate) fn speed_coverage_notes(
+    run: &str,
+    u: &[f64],
+    grid: &[f64],
+    ext: Option<Extension>,
+) -> Vec<String> {
+    let (below, above) = super::roles::beyond_grid(u, grid);
+    let (lo, hi) = (grid[0], grid[grid.len() - 1]);
+    let (below_ext, above_ext) = match ext {
+        Some(e) => super::roles::shares_outside(u, e.from_mps, e.to_mps),
+        None => (below, above),
+    };
+    let sides = [
+        (below, below_ext, "below", lo, ext.map(|e| e.from_mps)),
+        (above, above_ext, "above", hi, ext.map(|e| e.to_mps)),
+    ];
+    let mut notes = Vec::new();
+    for (share, beyond, side, end, edge) in sides {
+        if share < 0.05 {
+            continue;
+        }
+        notes.push(match edge.filter(|e| (e - end).abs() > 1e-9) {
+            Some(edge) => format!(
+                "validation run {run}: {:.0} % of it was flown {side} the identified speeds ({end:.2} m/s), where the model extrapolates its sub-models to {edge:.2} m/s{}; its fits there measure extrapolation, and a grid point at that speed would model it",
+                100.0 * share,
+                if beyond >= 0.005 {
+                    format!(" and holds that model {side} it ({:.0} % of the run)", 100.0 * beyond)
+                } else {
+                    String::new()
+                }
+            ),
+            None => format!(
+                "validation run {run}: {:.0} % of it was flown {side} the identified speeds, where the model holds its {end:.2} m/s sub-model; its fits there measure extrapolation, and a grid point at that speed would model it",
+                100.0 * share
+            ),
+        });
+    }
+    notes
+}
+
 #[cfg(test)]
 mod tests {
     use nalgebra::{DMatrix, DVector};

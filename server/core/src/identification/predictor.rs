@@ -16,7 +16,7 @@ use crate::estimation::ekf::IdentifiedDpShip;
 use crate::estimation::n4sid::{N4sidModel, NoiseCovariances, Weighting};
 use crate::estimation::restoring::RestoringParams;
 use crate::logs::schema::pose_column;
-use crate::models::{Extension, LinearVesselModel, LpvModel};
+use crate::models::{LinearVesselModel, LpvModel};
 use crate::planning::dof::Dof;
 use crate::simulation::dp_ship::{DpShip, Matrix3x6};
 use crate::validation::{
@@ -67,10 +67,7 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
                 .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?;
             let model = match lpv.extension {
                 Some(e) => model
-                    .with_extension(Extension {
-                        from_mps: e.from_mps,
-                        to_mps: e.to_mps,
-                    })
+                    .with_extension(e.into())
                     .map_err(|e| IdentifyError::invalid("document.lpv.extension", e.to_string()))?,
                 None => model,
             };

@@ -109,14 +109,20 @@ pub fn beyond_grid(u: &[f64], grid: &[f64]) -> (f64, f64) {
         1 => (margin(lo, lo), margin(hi, hi)),
         n => (margin(grid[1], lo), margin(hi, grid[n - 2])),
     };
-    let finite: Vec<f64> = u.iter().copied().filter(|v| v.is_finite()).collect();
-    if finite.is_empty() {
+    shares_outside(u, lo - below_by, hi + above_by)
+}
+
+/// Shares of the forward speeds `u` (non-finite samples ignored) below
+/// `lo` and above `hi`; (0, 0) without a finite sample.
+pub fn shares_outside(u: &[f64], lo: f64, hi: f64) -> (f64, f64) {
+    let finite = u.iter().filter(|v| v.is_finite()).count();
+    if finite == 0 {
         return (0.0, 0.0);
     }
     let share = |f: &dyn Fn(f64) -> bool| {
-        finite.iter().filter(|v| f(**v)).count() as f64 / finite.len() as f64
+        u.iter().filter(|v| v.is_finite() && f(**v)).count() as f64 / finite as f64
     };
-    (share(&|v| v < lo - below_by), share(&|v| v > hi + above_by))
+    (share(&|v| v < lo), share(&|v| v > hi))
 }
 
 #[cfg(test)]
