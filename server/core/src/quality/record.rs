@@ -1,6 +1,7 @@
 //! Checks a record and a spec against each other and gathers what the
-//! analyses need: the channels by role, the valid blocks, the Welch
-//! segment length and per-channel statistics over the valid samples.
+//! analyses need: the channels by role, the valid blocks and the Welch
+//! segment length; the per-channel statistics' arithmetic (the sums
+//! themselves come with the regressor's Gram matrix, in the same pass).
 
 use std::collections::HashSet;
 use std::ops::Range;
@@ -14,10 +15,6 @@ use crate::timeseries::UniformRecord;
 /// ≈ 170 MB for the five spectra of every pair. A 6 × 6 report with
 /// `nperseg = 4096` holds 74 k.
 pub const MAX_PAIR_BINS: usize = 1 << 22;
-
-/// Valid samples (all channels) from which the statistics are computed
-/// on two threads: ~0.2 ms of reading, several times a thread's start.
-const PARALLEL_SAMPLES: usize = 1 << 18;
 
 /// A validated request: borrowed channels, the non-empty valid blocks and
 /// the resolved parameters.
@@ -36,10 +33,6 @@ pub(crate) struct Prepared<'a> {
     pub output_names: Vec<&'a str>,
     /// Output samples.
     pub outputs: Vec<&'a [f64]>,
-    /// Mean and RMS about it of each input over the valid samples.
-    pub input_stats: Vec<(f64, f64)>,
-    /// Mean and RMS about it of each output over the valid samples.
-    pub output_stats: Vec<(f64, f64)>,
     /// `(input index, output index)` of each DOF of the spec.
     pub dof_pairs: Vec<(usize, usize)>,
     /// Welch segment length.
@@ -53,22 +46,11 @@ impl Prepared<'_> {
     }
 }
 
-/// Mean and RMS about the mean of `x` over `blocks` (0, 0 without samples;
-/// non-finite when a sample is), in one pass: sums of `x − x₀` and
-/// `(x − x₀)²` about the first valid sample `x₀`, eight partial sums each
-/// (vectorised). The shift keeps the variance accurate unless the mean
-/// lies ~10⁶ standard deviations from `x₀` (relative error ≈ 1e-16 ·
-/// ((mean − x₀)/σ)²).
-pub(crate) fn mean_rms(x: &[f64], blocks: &[Range<usize>]) -> (f64, f64) {
-    let n: usize = blocks.iter().map(|b| b.len()).sum();
-    let Some(x0) = blocks.iter().find(|b| !b.is_empty()).map(|b| x[b.start]) else {
+/// Mean and RMS about it from `n` samples' sums `s1 = Σ (x − x₀)` and
+/// `s2 = Σ (x − x₀)²` (0, 0 without samples; non-finite when a sum is).
+pub(crate) fn from_shifted_sums(x0: f64, n: usize, s1: f64, s2: f64) -> (f64, f64) {
+    if n == 0 {
         return (0.0, 0.0);
-    };
-    let (mut s1, mut s2) = (0.0, 0.0);
-    for b in blocks {
-        let (a, c) = shifted_sums(&x[b.clone()], x0);
-        s1 += a;
-        s2 += c;
     }
     let nf = n as f64;
     let d = s1 / nf;
@@ -79,7 +61,7 @@ pub(crate) fn mean_rms(x: &[f64], blocks: &[Range<usize>]) -> (f64, f64) {
 }
 
 /// `(Σ (x − c), Σ (x − c)²)` with eight independent partial sums each.
-fn shifted_sums(x: &[f64], c: f64) -> (f64, f64) {
+pub(crate) fn shifted_sums(x: &[f64], c: f64) -> (f64, f64) {
     let (mut a1, mut a2) = ([0.0f64; 8], [0.0f64; 8]);
     let chunks = x.chunks_exact(8);
     let (mut t1, mut t2) = (0.0, 0.0);
@@ -203,43 +185,6 @@ pub(crate) fn prepare<'a>(
     }
     validate_plan(rec, spec)?;
 
-    // The statistics double as the finiteness check: a NaN or ±∞ makes
-    // them non-finite, and only then are the samples searched.
-    let stats = |name: &str, x: &[f64]| -> Result<(f64, f64), QualityError> {
-        let (mean, rms) = mean_rms(x, &blocks);
-        if !(mean.is_finite() && rms.is_finite()) {
-            require_finite(name, x, &blocks)?;
-            return Err(QualityError::record(
-                name.to_owned(),
-                "values too large: their sum of squares overflows",
-            ));
-        }
-        Ok((mean, rms))
-    };
-    // One pass over every valid sample, memory-bound: the channels spread
-    // over the pool for long logs. The first channel's error (inputs
-    // first) is the one reported, as in one pass.
-    let n_valid: usize = blocks.iter().map(|b| b.len()).sum();
-    let names: Vec<&str> = input_names.iter().chain(&output_names).copied().collect();
-    let cols: Vec<&[f64]> = inputs.iter().chain(&outputs).copied().collect();
-    let all: Vec<Result<(f64, f64), QualityError>> =
-        if n_valid.saturating_mul(cols.len()) >= PARALLEL_SAMPLES {
-            use rayon::prelude::*;
-            names
-                .par_iter()
-                .zip(&cols)
-                .map(|(name, x)| stats(name, x))
-                .collect()
-        } else {
-            names
-                .iter()
-                .zip(&cols)
-                .map(|(name, x)| stats(name, x))
-                .collect()
-        };
-    let mut all = all.into_iter().collect::<Result<Vec<_>, _>>()?;
-    let output_stats = all.split_off(inputs.len());
-    let input_stats = all;
     Ok(Prepared {
         fs,
         n_samples: n,
@@ -248,8 +193,6 @@ pub(crate) fn prepare<'a>(
         inputs,
         output_names,
         outputs,
-        input_stats,
-        output_stats,
         dof_pairs,
         nperseg,
     })
@@ -395,6 +338,24 @@ fn validate_plan(rec: &UniformRecord, spec: &QualitySpec) -> Result<(), QualityE
     Ok(())
 }
 
+/// A channel's `(mean, rms)` as computed, or the error a non-finite one
+/// stands for: the first non-finite sample, else sums that overflow.
+pub(crate) fn checked_stats(
+    name: &str,
+    x: &[f64],
+    blocks: &[Range<usize>],
+    (mean, rms): (f64, f64),
+) -> Result<(f64, f64), QualityError> {
+    if mean.is_finite() && rms.is_finite() {
+        return Ok((mean, rms));
+    }
+    require_finite(name, x, blocks)?;
+    Err(QualityError::record(
+        name.to_owned(),
+        "values too large: their sum of squares overflows",
+    ))
+}
+
 fn require_finite(name: &str, x: &[f64], blocks: &[Range<usize>]) -> Result<(), QualityError> {
     for b in blocks {
         if let Some(k) = x[b.clone()].iter().position(|v| !v.is_finite()) {
@@ -418,26 +379,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn one_pass_statistics_match_two_pass() {
-        let x: Vec<f64> = (0..10_001)
-            .map(|i| 1e6 + 0.25 * (i as f64 * 0.37).sin() + 1e-3 * i as f64)
-            .collect();
-        for blocks in [vec![0..10_001], vec![3..4000, 4100..9000, 9000..9001]] {
-            let vals: Vec<f64> = blocks
-                .iter()
-                .flat_map(|b| x[b.clone()].iter().copied())
-                .collect();
-            let n = vals.len() as f64;
-            let mean = vals.iter().sum::<f64>() / n;
-            let rms = (vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
-            let (m, r) = mean_rms(&x, &blocks);
-            assert!((m - mean).abs() < 1e-14 * mean, "{m} vs {mean}");
-            assert!((r / rms - 1.0).abs() < 1e-9, "{r} vs {rms}");
-        }
-        assert_eq!(mean_rms(&x, &[5..5]), (0.0, 0.0));
-        assert_eq!(mean_rms(&[2.5; 9], &[0..9]), (2.5, 0.0));
-        let (m, r) = mean_rms(&[1.0, f64::NAN], &[0..2]);
-        assert!(m.is_nan() && r.is_nan());
+    fn partial_sums_match_the_plain_sums() {
+        let x: Vec<f64> = (0..10_001).map(|i| 1e6 + (i as f64 * 0.37).sin()).collect();
         assert!((sum(&x[..17]) - x[..17].iter().sum::<f64>()).abs() < 1e-6);
+        let (a1, a2) = shifted_sums(&x[3..42], 1e6);
+        let want1: f64 = x[3..42].iter().map(|v| v - 1e6).sum();
+        let want2: f64 = x[3..42].iter().map(|v| (v - 1e6).powi(2)).sum();
+        assert!((a1 - want1).abs() < 1e-9 && (a2 - want2).abs() < 1e-9);
+        assert_eq!(from_shifted_sums(7.0, 0, 1.0, 1.0), (0.0, 0.0));
     }
 }

@@ -21,7 +21,7 @@ use std::ops::Range;
 use nalgebra::{DMatrix, SymmetricEigen};
 
 use super::gram::normalized_gram;
-use super::record::mean_rms;
+use super::record::checked_stats;
 use super::{ColumnWeight, DeficientDirection, QualityError, RegressorReport};
 
 /// Lags `na = nb` when the spec gives none. One lag: the identified model is first order in ν (ν̇ = Aν + Bτ, thesis
@@ -50,11 +50,13 @@ pub const MAX_REGRESSOR_COLUMNS: usize = 256;
 /// large (see [`DeficientDirection`]).
 pub const DIRECTION_WEIGHT: f64 = 0.1;
 
-/// The analysis and the normalized Gram matrix (unit-RMS columns, `ΦᵀΦ /
-/// n_rows`), kept for sub-regressors.
+/// The analysis, the normalized Gram matrix (unit-RMS columns, `ΦᵀΦ /
+/// n_rows`), kept for sub-regressors, and each channel's mean and RMS
+/// about it over the valid samples (same order as the channels).
 pub(crate) struct Analysis {
     pub report: RegressorReport,
     pub gram: DMatrix<f64>,
+    pub stats: Vec<(f64, f64)>,
 }
 
 /// Singular values and identifiable-parameter count of the ARX regressor
@@ -122,17 +124,16 @@ pub fn regressor_analysis(
             }
         }
     }
-    let stats: Vec<(f64, f64)> = channels.iter().map(|x| mean_rms(x, blocks)).collect();
-    analyse(names, channels, n_outputs, &stats, blocks, lags).map(|a| a.report)
+    analyse(names, channels, n_outputs, blocks, lags).map(|a| a.report)
 }
 
-/// The analysis on validated input; `stats` are each channel's mean and
-/// RMS about it over the valid samples.
+/// The analysis on validated channels and blocks (samples may be
+/// non-finite: that is the error returned, inputs — channels from
+/// `n_outputs` on — searched first).
 pub(crate) fn analyse(
     names: &[&str],
     channels: &[&[f64]],
     n_outputs: usize,
-    stats: &[(f64, f64)],
     blocks: &[Range<usize>],
     lags: usize,
 ) -> Result<Analysis, QualityError> {
@@ -141,7 +142,13 @@ pub(crate) fn analyse(
         .iter()
         .flat_map(|n| (1..=lags).map(move |l| format!("{n}(t-{l})")))
         .collect();
-    let gram = normalized_gram(channels, stats, blocks, lags);
+    let (gram, stats) = normalized_gram(channels, blocks, lags);
+    // Before any use of the matrix: it is meaningless if a sample is not
+    // finite (and the eigen-solver need not converge on it).
+    let nc = channels.len();
+    for c in (n_outputs..nc).chain(0..n_outputs.min(nc)) {
+        checked_stats(names[c], channels[c], blocks, stats[c])?;
+    }
     let n_rows = blocks.iter().map(|b| b.len().saturating_sub(lags)).sum();
 
     let (sigma, vectors) = singular_values(&gram)?;
@@ -176,6 +183,7 @@ pub(crate) fn analyse(
             deficient_directions,
         },
         gram,
+        stats,
     })
 }
 

@@ -50,7 +50,6 @@ pub fn quality_report(
     let prep = prepare(rec, spec)?;
     let fs = prep.fs;
     let no = prep.outputs.len();
-    let (in_stats, out_stats) = (&prep.input_stats, &prep.output_stats);
 
     // Φ = (Φ_y Φ_x): outputs first.
     let names: Vec<&str> = prep
@@ -61,33 +60,35 @@ pub fn quality_report(
         .collect();
     let channels: Vec<&[f64]> = prep.outputs.iter().chain(&prep.inputs).copied().collect();
     let lags = spec.regressor_lags;
-    let stats: Vec<(f64, f64)> = out_stats.iter().chain(in_stats).copied().collect();
-    // The spectra and the time-domain analyses (regressor Gram, PE orders)
-    // read the same samples and nothing of each other: on two threads.
-    let (spectral, (regressor, pe)) = crate::par::join(
+    // The spectra and the time-domain analyses (the regressor's Gram
+    // matrix with every channel's statistics, in one pass; then the PE
+    // orders, which centre on the means) read the same samples and nothing
+    // of each other: on two threads. A non-finite sample is found by the
+    // second (the first does not look; its result is then dropped).
+    let (spectral, time_domain) = crate::par::join(
         true,
         || compute(&prep),
         || {
-            crate::par::join(
-                true,
-                || analyse(&names, &channels, no, &stats, &prep.blocks, lags),
-                || {
-                    prep.inputs
-                        .iter()
-                        .zip(in_stats)
-                        .map(|(x, &(mean, _))| pe_over_blocks(x, &prep.blocks, Some(mean)))
-                        .collect::<Vec<_>>()
-                },
-            )
+            let regressor = analyse(&names, &channels, no, &prep.blocks, lags)?;
+            let pe: Vec<_> = prep
+                .inputs
+                .iter()
+                .zip(&regressor.stats[no..])
+                .map(|(x, &(mean, _))| pe_over_blocks(x, &prep.blocks, Some(mean)))
+                .collect();
+            Ok::<_, QualityError>((regressor, pe))
         },
     );
-    let (spectral, regressor) = (spectral?, regressor?);
+    let (mut regressor, pe) = time_domain?;
+    let spectral = spectral?;
+    let in_stats = regressor.stats.split_off(no);
+    let out_stats = std::mem::take(&mut regressor.stats);
 
     let inputs: Vec<_> = prep
         .input_names
         .iter()
         .zip(spectral.input_psd)
-        .zip(in_stats)
+        .zip(&in_stats)
         .zip(pe)
         .map(|(((name, psd), &stats), pe)| {
             input_quality(
@@ -105,7 +106,7 @@ pub fn quality_report(
         .output_names
         .iter()
         .zip(spectral.output_psd)
-        .zip(out_stats)
+        .zip(&out_stats)
         .map(|((name, psd), &(mean, rms))| OutputQuality {
             name: (*name).to_owned(),
             mean,
