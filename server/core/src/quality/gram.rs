@@ -373,6 +373,23 @@ mod tests {
             .collect()
     }
 
+    /// The Gram matrix to 1e-12 of the explicit one, the statistics to
+    /// 1e-12 of the two-pass ones.
+    fn assert_matches_explicit(refs: &[&[f64]], blocks: &[Range<usize>], lags: usize) {
+        let (got, stats) = normalized_gram(refs, blocks, lags);
+        for (x, &(mean, rms)) in refs.iter().zip(&stats) {
+            let (m, r) = mean_rms(x, blocks);
+            assert!(
+                (mean - m).abs() < 1e-12 * m.abs().max(1.0),
+                "mean {mean} vs {m}"
+            );
+            assert!((rms - r).abs() < 1e-12 * r, "rms {rms} vs {r}");
+        }
+        let want = gram_reference(refs, blocks, lags);
+        let err = (&got - &want).amax();
+        assert!(err < 1e-12, "lags {lags}: max error {err:e}");
+    }
+
     #[test]
     fn structured_gram_matches_explicit_regressor() {
         let chans = signals(2000);
@@ -381,18 +398,7 @@ mod tests {
         // too short for a row.
         let blocks = vec![0..700, 705..760, 800..802, 810..2000];
         for lags in [1, 2, 3, 5] {
-            let (got, stats) = normalized_gram(&refs, &blocks, lags);
-            for (x, &(mean, rms)) in refs.iter().zip(&stats) {
-                let (m, r) = mean_rms(x, &blocks);
-                assert!(
-                    (mean - m).abs() < 1e-12 * m.abs().max(1.0),
-                    "mean {mean} vs {m}"
-                );
-                assert!((rms - r).abs() < 1e-12 * r, "rms {rms} vs {r}");
-            }
-            let want = gram_reference(&refs, &blocks, lags);
-            let err = (&got - &want).amax();
-            assert!(err < 1e-12, "lags {lags}: max error {err:e}");
+            assert_matches_explicit(&refs, &blocks, lags);
         }
     }
 
@@ -405,18 +411,7 @@ mod tests {
         let blocks = vec![0..70_000];
         assert!(70_000 * refs.len() >= PARALLEL_SAMPLES && 70_000 > 2 * CHUNK);
         for lags in [1, 2] {
-            let (got, stats) = normalized_gram(&refs, &blocks, lags);
-            for (x, &(mean, rms)) in refs.iter().zip(&stats) {
-                let (m, r) = mean_rms(x, &blocks);
-                assert!(
-                    (mean - m).abs() < 1e-12 * m.abs().max(1.0),
-                    "mean {mean} vs {m}"
-                );
-                assert!((rms - r).abs() < 1e-12 * r, "rms {rms} vs {r}");
-            }
-            let want = gram_reference(&refs, &blocks, lags);
-            let err = (&got - &want).amax();
-            assert!(err < 1e-12, "lags {lags}: max error {err:e}");
+            assert_matches_explicit(&refs, &blocks, lags);
         }
     }
 
