@@ -19,6 +19,20 @@ pub fn has_avx2_fma() -> bool {
     }
 }
 
+/// Asks the cache line holding `x` into L2 (a hint, no effect on values).
+#[inline(always)]
+pub fn prefetch_line(x: &f64) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch never faults and reads nothing; SSE is baseline
+    // on x86_64.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T1, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T1>((x as *const f64).cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
+
 /// `x·y + acc`, fused when `FMA`.
 #[inline(always)]
 pub fn madd<const FMA: bool>(x: f64, y: f64, acc: f64) -> f64 {

@@ -5,7 +5,7 @@ use std::ops::Range;
 
 use nalgebra::DMatrix;
 
-use crate::kernels::dots;
+use crate::kernels::{dots, prefetch_line};
 
 /// Rows per chunk of the Gram accumulation: the chunk of every channel
 /// (12 × 2048 doubles) stays in the L2 cache while all its dot products run.
@@ -275,12 +275,21 @@ fn core_sums(channels: &[&[f64]], shift: &[f64], rows: Range<usize>, lags: usize
     while s0 < core_end {
         let w = CHUNK.min(core_end - s0);
         let lo = s0 - margin;
+        // The next chunk's samples are asked into the cache meanwhile, a
+        // line per line copied: the pass is bound by memory, not by the
+        // arithmetic.
+        let next = (lo + w + 2 * margin)..(lo + 2 * w + 2 * margin).min(core_end + margin);
         for (c, x) in channels.iter().enumerate() {
-            for (dst, v) in buf[c * width..c * width + w + 2 * margin]
-                .iter_mut()
-                .zip(&x[lo..lo + w + 2 * margin])
-            {
-                *dst = v - shift[c];
+            let ahead = x.get(next.clone()).unwrap_or(&[]);
+            let src = &x[lo..lo + w + 2 * margin];
+            let dst = &mut buf[c * width..c * width + w + 2 * margin];
+            for (k, (d, v)) in dst.iter_mut().zip(src).enumerate() {
+                if k % 8 == 0
+                    && let Some(p) = ahead.get(k)
+                {
+                    prefetch_line(p);
+                }
+                *d = v - shift[c];
             }
         }
         for i in 0..nc {

@@ -337,3 +337,49 @@ mod scratch {
         });
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    /// The cross sums are Σ conj(X_i)·X_j over the held segments, and the
+    /// auto sums Σ |X_c|².
+    #[test]
+    fn sums_are_the_products_of_the_held_spectra() {
+        let mut rng = SplitMix64::new(4);
+        let (nf, count) = (13, 3);
+        let pairs = [(0, 1), (1, 0)];
+        let mut acc = Accumulators::new(2, &pairs, nf);
+        let specs: Vec<Vec<Vec<Complex<f64>>>> = (0..count)
+            .map(|_| {
+                (0..2)
+                    .map(|_| {
+                        (0..nf)
+                            .map(|_| Complex::new(rng.normal(), rng.normal()))
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect();
+        for (slot, chans) in specs.iter().enumerate() {
+            for (c, spec) in chans.iter().enumerate() {
+                acc.add_channel(slot, c, spec);
+            }
+        }
+        acc.add_segments(count);
+        for (p, &(i, j)) in pairs.iter().enumerate() {
+            for k in 0..nf {
+                let want: Complex<f64> = specs.iter().map(|s| s[i][k].conj() * s[j][k]).sum();
+                let got = Complex::new(acc.cross[p * 2 * nf + k], acc.cross[p * 2 * nf + nf + k]);
+                assert!((got - want).norm() < 1e-12, "pair {p} bin {k}");
+            }
+        }
+        for c in 0..2 {
+            for k in 0..nf {
+                let want: f64 = specs.iter().map(|s| s[c][k].norm_sqr()).sum();
+                assert!((acc.auto[c * nf + k] - want).abs() < 1e-12);
+            }
+        }
+    }
+}

@@ -8,7 +8,7 @@ use realfft::{RealFftPlanner, RealToComplex};
 
 use super::detrend::detrend_in_place;
 use super::{Detrend, SpectraError, WelchConfig};
-use crate::kernels::has_avx2_fma;
+use crate::kernels::{has_avx2_fma, prefetch_line};
 
 /// Windowed, detrended real FFTs of the successive segments of a signal.
 ///
@@ -249,20 +249,6 @@ fn window_shifted_body(
         input[k] = d * window[k];
     }
     ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + tail
-}
-
-/// Asks the cache line holding `x` into L2 (a hint, no effect on values).
-#[inline(always)]
-fn prefetch_line(x: &f64) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch never faults and reads nothing; SSE is baseline
-    // on x86_64.
-    unsafe {
-        use std::arch::x86_64::{_MM_HINT_T1, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T1>((x as *const f64).cast());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
 }
 
 #[cfg(test)]
