@@ -48,14 +48,24 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
 
     // Pairs are independent: spread over the pool when there are enough
     // of them (each pair's result is the same on any thread).
+    // 1/P per channel, 0 where P = 0: shared by the channel's pairs.
+    let inv: Vec<Vec<f64>> = ms
+        .auto
+        .iter()
+        .map(|p| {
+            p.iter()
+                .map(|&v| if v == 0.0 { 0.0 } else { 1.0 / v })
+                .collect()
+        })
+        .collect();
     let one = |scratch: &mut Scratch, p: usize| {
         let (i, o) = pairs[p];
         pair_spectra(
             prep.input_names[i],
             prep.output_names[o - ni],
             ms.cross(p),
-            &ms.auto[i],
-            &ms.auto[o],
+            (&ms.auto[i], &inv[i]),
+            &inv[o],
             scratch,
         )
     };
@@ -89,7 +99,8 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
     })
 }
 
-/// The plotted spectra of one pair from its CSD and the two PSDs.
+/// The plotted spectra of one pair from its CSD, its input PSD and the
+/// reciprocals of both PSDs (0 where a PSD is 0).
 ///
 /// Same definitions as [`crate::spectra::CrossSpectra::coherence`] and
 /// [`crate::spectra::TransferEstimate`] (H1 = Pxy / Pxx, 0 where Pxx = 0;
@@ -104,16 +115,16 @@ fn pair_spectra(
     input: &str,
     output: &str,
     planes: (&[f64], &[f64]),
-    pxx: &[f64],
-    pyy: &[f64],
+    pxx: (&[f64], &[f64]),
+    inv_pyy: &[f64],
     scratch: &mut Scratch,
 ) -> PairSpectra {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has the feature the function is compiled for.
-        return unsafe { pair_spectra_avx2(input, output, planes, pxx, pyy, scratch) };
+        return unsafe { pair_spectra_avx2(input, output, planes, pxx, inv_pyy, scratch) };
     }
-    pair_spectra_body(input, output, planes, pxx, pyy, scratch)
+    pair_spectra_body(input, output, planes, pxx, inv_pyy, scratch)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -122,11 +133,11 @@ fn pair_spectra_avx2(
     input: &str,
     output: &str,
     planes: (&[f64], &[f64]),
-    pxx: &[f64],
-    pyy: &[f64],
+    pxx: (&[f64], &[f64]),
+    inv_pyy: &[f64],
     scratch: &mut Scratch,
 ) -> PairSpectra {
-    pair_spectra_body(input, output, planes, pxx, pyy, scratch)
+    pair_spectra_body(input, output, planes, pxx, inv_pyy, scratch)
 }
 
 #[inline(always)]
@@ -134,12 +145,11 @@ fn pair_spectra_body(
     input: &str,
     output: &str,
     (re, im): (&[f64], &[f64]),
-    pxx: &[f64],
-    pyy: &[f64],
+    (pxx, inv_pxx): (&[f64], &[f64]),
+    inv_pyy: &[f64],
     scratch: &mut Scratch,
 ) -> PairSpectra {
     let nf = re.len();
-    let inv = |p: f64| if p == 0.0 { 0.0 } else { 1.0 / p };
     // |Pxy|² as `Complex::norm_sqr`: re² + im².
     let norm_sqr = &mut scratch.norm_sqr;
     norm_sqr.clear();
@@ -147,13 +157,13 @@ fn pair_spectra_body(
     let csd_magnitude: Vec<f64> = norm_sqr.iter().map(|v| v.sqrt()).collect();
     let coherence = norm_sqr
         .iter()
-        .zip(pxx.iter().zip(pyy))
-        .map(|(v, (&a, &b))| v * inv(a) * inv(b))
+        .zip(inv_pxx.iter().zip(inv_pyy))
+        .map(|(v, (&a, &b))| v * a * b)
         .collect();
     let h1_magnitude: Vec<f64> = csd_magnitude
         .iter()
-        .zip(pxx)
-        .map(|(m, &a)| m * inv(a))
+        .zip(inv_pxx)
+        .map(|(m, &a)| m * a)
         .collect();
     let mut h1_magnitude_db = vec![0.0; nf];
     log10_into(&h1_magnitude, &mut h1_magnitude_db);

@@ -112,8 +112,12 @@ pub fn pe_order(u: &[f64], max_order: usize, rel_tol: f64) -> Result<usize, Sign
 fn regressor_covariance(u: &[f64], n: usize) -> DMatrix<f64> {
     let len = u.len();
     let mut s = DMatrix::<f64>::zeros(n, n);
-    for j in 0..n {
-        s[(0, j)] = (n - 1..len).map(|t| u[t] * u[t - j]).sum();
+    // First row: s[0][j] = Σ_{t ≥ n−1} u[t]·u[t−j], as lagged dot products
+    // (out[k] = Σ_s u[n−1+s]·u[s+k], k = n−1−j).
+    let mut first = vec![0.0; n];
+    crate::kernels::lagged_dots(&u[n - 1..], u, &mut first);
+    for (k, v) in first.into_iter().enumerate() {
+        s[(0, n - 1 - k)] = v;
     }
     for i in 0..n - 1 {
         for j in i..n - 1 {
