@@ -1,5 +1,6 @@
 //! The normalized Gram matrix `ΦᵀΦ / n_rows` of the ARX regressor (see
-//! [`super::regressor`]), accumulated from the channels without forming Φ.
+//! [`super::regressor`]), accumulated from the channels without forming Φ,
+//! and in the same pass every channel's mean and RMS.
 
 use std::ops::Range;
 
