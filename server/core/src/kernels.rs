@@ -33,6 +33,13 @@ pub fn prefetch_line(x: &f64) {
     let _ = x;
 }
 
+/// The sum of eight partial sums, pairwise: the fold every eight-lane
+/// accumulation here ends with (one order, so one rounding).
+#[inline(always)]
+pub fn fold8(a: [f64; 8]) -> f64 {
+    ((a[0] + a[1]) + (a[2] + a[3])) + ((a[4] + a[5]) + (a[6] + a[7]))
+}
+
 /// `x·y + acc`, fused when `FMA`.
 #[inline(always)]
 pub fn madd<const FMA: bool>(x: f64, y: f64, acc: f64) -> f64 {
@@ -112,8 +119,7 @@ fn group_avx2<const G: usize>(a: &[f64], ys: &[&[f64]], out: &mut [f64], full: u
             _mm256_storeu_pd(accq.as_mut_ptr(), lo[q]);
             _mm256_storeu_pd(accq.as_mut_ptr().add(4), hi[q]);
         }
-        let mut sum = ((accq[0] + accq[1]) + (accq[2] + accq[3]))
-            + ((accq[4] + accq[5]) + (accq[6] + accq[7]));
+        let mut sum = fold8(accq);
         for (x, y) in tail.iter().zip(&ys[q][full..]) {
             sum = x.mul_add(*y, sum);
         }
@@ -156,8 +162,7 @@ fn group<const FMA: bool, const G: usize>(a: &[f64], ys: &[&[f64]], out: &mut [f
         }
     }
     for (q, accq) in acc.iter().enumerate() {
-        let mut sum = ((accq[0] + accq[1]) + (accq[2] + accq[3]))
-            + ((accq[4] + accq[5]) + (accq[6] + accq[7]));
+        let mut sum = fold8(*accq);
         for (x, y) in a[full..].iter().zip(&ys[q][full..]) {
             sum = madd::<FMA>(*x, *y, sum);
         }

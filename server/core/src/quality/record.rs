@@ -9,6 +9,7 @@ use std::ops::Range;
 use super::regressor::MAX_REGRESSOR_COLUMNS;
 use super::report::default_quality_nperseg;
 use super::{QualityError, QualitySpec};
+use crate::kernels::fold8;
 use crate::timeseries::UniformRecord;
 
 /// Most values per spectrum of the report (pairs × frequencies): 4 Mi, i.e.
@@ -76,8 +77,7 @@ pub(crate) fn shifted_sums(x: &[f64], c: f64) -> (f64, f64) {
             a2[k] += d * d;
         }
     }
-    let fold = |a: [f64; 8]| ((a[0] + a[1]) + (a[2] + a[3])) + ((a[4] + a[5]) + (a[6] + a[7]));
-    (fold(a1) + t1, fold(a2) + t2)
+    (fold8(a1) + t1, fold8(a2) + t2)
 }
 
 /// `Σ x` with eight independent partial sums (vectorised).
@@ -90,7 +90,7 @@ pub(crate) fn sum(x: &[f64]) -> f64 {
             *a += v;
         }
     }
-    ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + tail
+    fold8(acc) + tail
 }
 
 /// Validates `rec` and `spec` and resolves the channels.

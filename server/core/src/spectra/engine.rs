@@ -8,7 +8,7 @@ use realfft::{RealFftPlanner, RealToComplex};
 
 use super::detrend::detrend_in_place;
 use super::{Detrend, SpectraError, WelchConfig};
-use crate::kernels::{has_avx2_fma, prefetch_line};
+use crate::kernels::{fold8, has_avx2_fma, prefetch_line};
 
 /// Windowed, detrended real FFTs of the successive segments of a signal.
 ///
@@ -248,7 +248,7 @@ fn window_shifted_body(
         tail += d;
         input[k] = d * window[k];
     }
-    ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + tail
+    fold8(acc) + tail
 }
 
 #[cfg(test)]
