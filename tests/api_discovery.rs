@@ -195,6 +195,54 @@ async fn discovery_names_the_righting_moment_and_stores_the_augmented_model() {
         .await;
     assert_eq!(ss.status, 200, "{}", ss.text);
     assert!(!ss.json["terms"].as_array().unwrap().is_empty());
+
+    // Discovery on the augmented model continues from its terms: they are
+    // carried (not named again), and a further version, if any, keeps them
+    // and the model's name.
+    let job = run_job(
+        &app,
+        json!({ "kind": "discover", "campaign_id": cid, "model_id": aug }),
+    )
+    .await;
+    let did2 = job["result"]["discrepancy_id"].as_str().unwrap();
+    let d2 = app
+        .call("GET", "/api/discrepancies/{id}", &[did2], None)
+        .await;
+    assert_eq!(d2.status, 200, "{}", d2.text);
+    for (p, s) in d2.json["report"]["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(stored)
+    {
+        let kept: Vec<&Value> = s["augmentation"]["terms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| &t["effect"])
+            .collect();
+        let carried: Vec<&Value> = p["report"]["carried"].as_array().unwrap().iter().collect();
+        assert_eq!(carried, kept);
+        for f in p["report"]["findings"].as_array().unwrap() {
+            assert!(!kept.contains(&&f["effect"]), "named again: {f}");
+        }
+    }
+    let summary = d2.json["report"]["summary"].to_string();
+    match job["result"]["augmented_model_id"].as_str() {
+        None => assert!(
+            summary.contains("Nothing found beyond the model's discovered terms"),
+            "{summary}"
+        ),
+        Some(v3) => {
+            let v3 = app.call("GET", "/api/models/{id}", &[v3], None).await;
+            assert_eq!(v3.json["model"]["version"], 3);
+            assert_eq!(v3.json["model"]["name"], new.json["model"]["name"]);
+            assert!(
+                summary.contains("Continued from the model's discovered terms"),
+                "{summary}"
+            );
+        }
+    }
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

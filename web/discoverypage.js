@@ -65,8 +65,12 @@ function hypothesesSection(hyps) {
       })))));
 }
 
-function findingsSection(findings) {
-  if (!findings.length) return h('p', { class: 'hint', 'data-testid': 'no-findings' }, 'No term was chosen at this speed.');
+function findingsSection(findings, carried) {
+  if (!findings.length) {
+    return h('p', { class: 'hint', 'data-testid': 'no-findings' }, carried.length
+      ? `No further term was chosen at this speed; the model's ${carried.length} discovered term(s) were kept.`
+      : 'No term was chosen at this speed.');
+  }
   return h('div', { class: 'card', 'data-testid': 'findings' },
     h('h4', null, 'Named'),
     findings.map((f) => h('div', { class: 'finding', 'data-testid': 'finding' },
@@ -173,7 +177,7 @@ export async function discoveryPage(view, id) {
         ' · held out: ', p.validation_run_ids.map((x, i) => [i ? ', ' : '', h('a', { href: urls.run(x) }, runName(x))])),
       locationSection(r.location || {}),
       hypothesesSection(r.hypotheses || []),
-      findingsSection(r.findings || []),
+      findingsSection(r.findings || [], r.carried || []),
       h('div', { class: 'card' },
         h('h4', null, 'Before / after on held-out runs'),
         beforeAfterTable(r.validation || []),

@@ -92,6 +92,15 @@ test('discover the demo ROV\'s missing restoring from the model page and read th
     const groups = await page.locator(`${tid('param-row')} td:first-child`).allTextContents();
     assert.ok(groups.some((g) => /^discovered: restoring/.test(g)), 'discovered terms in the parameter table');
     assert.match(await page.textContent(tid('discover-origin')), /produced by/);
+    // Discovery on the augmented model continues from its terms: they are
+    // kept, not named again.
+    await page.getByRole('button', { name: 'Discover missing physics' }).click();
+    await page.waitForURL((u) => /#\/discrepancies\/[0-9a-f-]{36}$/.test(u.toString()) && u.toString() !== reportUrl, { timeout: 180000 });
+    await page.locator(tid('discovery-summary')).waitFor();
+    const again = await page.textContent(tid('discovery-summary'));
+    assert.match(again, /(Nothing found beyond|Continued from) the model's discovered terms \(.*restoring/, again);
+    assert.doesNotMatch(again, /restoring cos θ sin φ in roll: named/, again);
+    assert.match(await page.locator(tid('discovery-point')).first().textContent(), /Started from the model's discovered terms/);
     // Back on the examined model the report is listed.
     await page.goto(`${H.base}/#/models/${mid}`);
     await page.locator(tid('discover-report-link')).first().waitFor();

@@ -158,7 +158,7 @@ impl JobHandler for Discover {
                         vessel_id: base.vessel_id.clone(),
                         kind: base.kind.clone(),
                         method: a.document.method.name().to_string(),
-                        name: format!("{} + discovered physics", base.name),
+                        name: augmented_name(&base.name),
                         settings: a.settings_used,
                         run_ids: a.estimation_run_ids,
                         validation_run_ids: a.validation_run_ids,
@@ -183,6 +183,17 @@ impl JobHandler for Discover {
                 })
             }))
         })
+    }
+}
+
+/// The name of a model augmented from `base`: marked once, however often
+/// discovery continues from an augmented model.
+fn augmented_name(base: &str) -> String {
+    const MARK: &str = " + discovered physics";
+    if base.ends_with(MARK) {
+        base.to_owned()
+    } else {
+        format!("{base}{MARK}")
     }
 }
 

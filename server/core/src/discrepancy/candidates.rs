@@ -175,6 +175,18 @@ pub enum ShapeKind {
     DeadZoneWidth,
 }
 
+impl ShapeKind {
+    /// The parameter's name in reports and parameter tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShapeKind::LagTime => "T_a (s)",
+            ShapeKind::DelaySamples => "delay (samples)",
+            ShapeKind::SaturationLevel => "τ_max",
+            ShapeKind::DeadZoneWidth => "δ",
+        }
+    }
+}
+
 /// Coriolis products of each DOF's equation for a diagonal M:
 /// (C(ν)ν)_i = Σ ±(m_a − m_b)·ν_a·ν_b over these pairs.
 pub const CORIOLIS_PAIRS: [(Dof, [(Dof, Dof); 2]); 6] = [

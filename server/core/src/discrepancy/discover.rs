@@ -7,15 +7,13 @@ use super::data::{Baseline, Record};
 use super::drift::current_drift;
 use super::error::DiscoveryError;
 use super::evidence::{effect_text, separating_evidence};
-use super::experiment::propose;
 use super::fit::{Prepared, Spec};
-use super::locate::{
-    BAND_EXCESS_DB, Predictions, capital, channel_fits, locate, phi_diag, predict, residual,
-    signature_words,
-};
+use super::locate::{Predictions, channel_fits, locate, predict, residual};
+use super::lookalike::{Selection, look_alikes};
 use super::model::AugmentedModel;
+use super::narrate::{hypothesis, plot_series, rows_of, summary, unexplained};
 use super::report::*;
-use super::residual::{residual_spectrum, whiteness};
+use super::residual::whiteness;
 use super::select::{Criteria, Scored, step};
 use crate::estimation::Progress;
 use crate::planning::VesselProfile;
@@ -153,6 +151,32 @@ pub fn discover(
     settings: &DiscoverySettings,
     progress: &mut dyn Progress,
 ) -> Result<DiscoveryReport, DiscoveryError> {
+    // Before the model is built from it (shapes, invertible M).
+    baseline.validate()?;
+    discover_from(
+        &AugmentedModel::from_baseline(baseline),
+        estimation_runs,
+        validation_runs,
+        settings,
+        progress,
+    )
+}
+
+/// [`discover`] continuing from a model that already carries discovered
+/// terms (an earlier discovery's result): its terms are kept and refitted
+/// with any new ones, not tested again, and the before/after comparison
+/// starts from it. Nothing new found: the report's model is `start`.
+///
+/// # Errors
+/// As [`discover`].
+pub fn discover_from(
+    start: &AugmentedModel,
+    estimation_runs: &[Record],
+    validation_runs: &[Record],
+    settings: &DiscoverySettings,
+    progress: &mut dyn Progress,
+) -> Result<DiscoveryReport, DiscoveryError> {
+    let baseline = &start.baseline();
     baseline.validate()?;
     settings.validate()?;
     let n = baseline.n();
@@ -223,7 +247,7 @@ pub fn discover(
     };
     let k = settings.k_step;
     check(progress, 0.0, "locating the misfit")?;
-    let base_model = AugmentedModel::from_baseline(baseline);
+    let base_model = start.clone();
     let all_runs: Vec<&Record> = est.iter().chain(&validation_runs).collect();
     let location = locate(&base_model, &all_runs, k, settings.segment_s);
 
@@ -253,8 +277,17 @@ pub fn discover(
     };
     let runs: Vec<usize> = (0..est.len()).collect();
 
-    // Forward selection.
-    let mut chosen: Vec<Spec> = Vec::new();
+    // Forward selection, from the terms the model already carries.
+    let carried: Vec<Spec> = start
+        .terms
+        .iter()
+        .map(|t| Spec {
+            effect: t.effect,
+            shape: t.shape,
+        })
+        .collect();
+    let n_carried = carried.len();
+    let mut chosen: Vec<Spec> = carried;
     let mut winners: Vec<Scored> = Vec::new();
     let mut steps: Vec<Vec<Scored>> = Vec::new();
     let mut pool = lib.clone();
@@ -285,8 +318,13 @@ pub fn discover(
     }
 
     check(progress, 0.8, "fitting the augmented model")?;
-    let shape_std: Vec<Option<f64>> = winners.iter().map(|w| w.shape_std).collect();
-    let model = if chosen.is_empty() {
+    let shape_std: Vec<Option<f64>> = start
+        .terms
+        .iter()
+        .map(|t| t.shape_std)
+        .chain(winners.iter().map(|w| w.shape_std))
+        .collect();
+    let model = if winners.is_empty() {
         base_model.clone()
     } else {
         // Three fits of the chosen terms: couplings of the touched rows held,
@@ -370,85 +408,20 @@ pub fn discover(
             (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
         })
         .collect();
-    let mut ambiguities = Vec::new();
-    for (si, w) in winners.iter().enumerate() {
-        let wg = w.cv_gain.unwrap_or(0.0);
-        let w_rows = prep.rows_of(&[w.spec], &[]);
-        let rival = steps[si]
-            .iter()
-            .filter(|o| o.spec.effect.family() != w.spec.effect.family())
-            .filter(|o| !chosen.iter().any(|c| c.effect == o.spec.effect))
-            .filter(|o| {
-                o.cv_gain
-                    .is_some_and(|g| g >= settings.ambiguity_ratio * wg)
-            })
-            .find(|o| {
-                prep.rows_of(&[o.spec], &[])
-                    .iter()
-                    .any(|r| w_rows.contains(r))
-            });
-        if let Some(o) = rival {
-            let before_terms = &chosen[..si];
-            let fit_with = |s: Spec| {
-                let mut v = before_terms.to_vec();
-                v.push(s);
-                prep.fit(&v, &[], &runs, false)
-                    .map(|f| prep.model(&v, &f, &[]))
-            };
-            let labels = [w.spec.effect.label(), o.spec.effect.label()];
-            let mut focus: Vec<_> = prep
-                .rows_of(&[w.spec, o.spec], &[])
-                .iter()
-                .map(|&r| baseline.dofs[r])
-                .collect();
-            focus.dedup();
-            let (experiment, why_none) = match (
-                &settings.vessel,
-                fit_with(w.spec),
-                fit_with(o.spec),
-            ) {
-                (None, _, _) => (
-                    None,
-                    "no vessel profile was given to design the run that separates them.",
-                ),
-                (Some(v), Some(ma), Some(mb)) => (
-                    propose(
-                        v,
-                        &ma,
-                        &mb,
-                        labels.clone(),
-                        &focus,
-                        &noise_sigma,
-                        est[0].eta[(0, 5)],
-                        h,
-                    ),
-                    "no run within the vessel profile's force and velocity limits separates them.",
-                ),
-                _ => (
-                    None,
-                    "one of the two could not be fitted on its own, so no run was designed to separate them.",
-                ),
-            };
-            let og = o.cv_gain.unwrap_or(0.0);
-            ambiguities.push(Ambiguity {
-                chosen: w.spec.effect,
-                alternative: o.spec.effect,
-                cv_gains: [wg, og],
-                text: format!(
-                    "{} and {} explain these runs about equally well (held-out fit gained {:.3} vs {:.3}); {}",
-                    capital(&labels[0]),
-                    labels[1],
-                    wg,
-                    og,
-                    match &experiment {
-                        Some(e) => format!("a deciding run: {}", e.instruction),
-                        None => why_none.into(),
-                    }
-                ),
-                experiment,
-            });
-        }
-    }
+    let ambiguities = look_alikes(
+        &prep,
+        &Selection {
+            winners: &winners,
+            steps: &steps,
+            chosen: &chosen,
+            n_carried,
+        },
+        &runs,
+        settings,
+        &noise_sigma,
+        est[0].eta[(0, 5)],
+        h,
+    );
 
     check(progress, 0.92, "looking for unexplained structure")?;
     let unexplained = unexplained(&model, &all_runs, &chosen);
@@ -483,7 +456,7 @@ pub fn discover(
         .iter()
         .enumerate()
         .map(|(i, w)| {
-            let term = &model.terms[i];
+            let term = &model.terms[n_carried + i];
             let mut evidence = vec![format!(
                 "ΔBIC {:.0}, significance z = {:.1}; on held-out runs the free-run fit gains {:.3} (summed over channels).",
                 w.delta_bic,
@@ -544,8 +517,10 @@ pub fn discover(
             f.effect_text = format!("{} {}", f.effect_text, d.text);
         }
     }
+    let carried: Vec<Effect> = start.terms.iter().map(|t| t.effect).collect();
     let mut summary = summary(
         &location,
+        &carried,
         &findings,
         &validation,
         &ambiguities,
@@ -573,166 +548,8 @@ pub fn discover(
         plots,
         ambiguities,
         unexplained,
+        carried,
     })
-}
-
-fn rows_of(m: &nalgebra::DMatrix<f64>) -> Vec<Vec<f64>> {
-    (0..m.nrows())
-        .map(|i| m.row(i).iter().copied().collect())
-        .collect()
-}
-
-fn hypothesis(s: &Scored, step: usize, verdict: Verdict, _c: &Criteria) -> HypothesisReport {
-    let e = s.spec.effect;
-    let own = s.own();
-    let cov = s.fit.theta_cov(own);
-    let coefficients = s.fit.theta[own]
-        .iter()
-        .zip(e.coefficient_names())
-        .enumerate()
-        .map(|(i, (v, name))| Estimate {
-            name,
-            value: *v,
-            std: cov
-                .as_ref()
-                .map(|c| c[(i, i)].max(0.0).sqrt())
-                .filter(|s| s.is_finite()),
-        })
-        .collect();
-    let shape = s.spec.shape.map(|v| Estimate {
-        name: match e.shape() {
-            Some(super::candidates::ShapeKind::LagTime) => "T_a (s)".into(),
-            Some(super::candidates::ShapeKind::DelaySamples) => "delay (samples)".into(),
-            Some(super::candidates::ShapeKind::SaturationLevel) => "τ_max".into(),
-            _ => "δ".into(),
-        },
-        value: v,
-        std: s.shape_std.filter(|s| s.is_finite()),
-    });
-    HypothesisReport {
-        effect: e,
-        family: e.family(),
-        label: e.label(),
-        step,
-        coefficients,
-        shape,
-        delta_bic: s.delta_bic,
-        z: s.z,
-        cv_gain: s.cv_gain,
-        verdict,
-    }
-}
-
-fn plot_series(
-    rec: &Record,
-    before: &Predictions,
-    after: &Predictions,
-    dofs: &[crate::planning::Dof],
-    points: usize,
-) -> Vec<PlotSeries> {
-    let step = rec.len().div_ceil(points).max(1);
-    let idx: Vec<usize> = (0..rec.len()).step_by(step).collect();
-    dofs.iter()
-        .enumerate()
-        .map(|(i, &dof)| PlotSeries {
-            run: rec.name.clone(),
-            dof,
-            t: idx.iter().map(|&k| k as f64 * rec.h).collect(),
-            measured: idx.iter().map(|&k| rec.nu[(k, i)]).collect(),
-            before: idx.iter().map(|&k| before.free[(k, i)]).collect(),
-            after: idx.iter().map(|&k| after.free[(k, i)]).collect(),
-        })
-        .collect()
-}
-
-/// Bands of the augmented model's 1-step residual still above the noise floor.
-fn unexplained(model: &AugmentedModel, runs: &[&Record], chosen: &[Spec]) -> Vec<Unexplained> {
-    let h = runs.first().map_or(0.1, |r| r.h);
-    let phi = phi_diag(model, h);
-    let preds: Vec<_> = runs.iter().map(|r| model.predict_k_step(r, 1)).collect();
-    let mut out = Vec::new();
-    for (i, &dof) in model.dofs.iter().enumerate() {
-        let e: Vec<Vec<f64>> = runs
-            .iter()
-            .zip(&preds)
-            .map(|(r, p)| residual(r, p, i))
-            .collect();
-        let Some(spec) = residual_spectrum(&e, 1.0 / h, phi[i]) else {
-            continue;
-        };
-        let Some(b) = spec
-            .bands
-            .iter()
-            .filter(|b| b.excess_db > BAND_EXCESS_DB)
-            .max_by(|a, b| a.excess_db.total_cmp(&b.excess_db))
-        else {
-            continue;
-        };
-        let signature = signature_words(spec.low_slope, b)
-            .trim_start_matches(", ")
-            .to_string();
-        let explained_here = chosen.iter().any(|c| c.effect.dof() == Some(dof));
-        out.push(Unexplained {
-            dof,
-            band: b.clone(),
-            low_slope: spec.low_slope,
-            text: format!(
-                "{}: structure no candidate explains{} — 1-step residual {:.0} dB above the noise floor at {:.3}–{:.3} Hz, {signature}.",
-                capital(dof.name()),
-                if explained_here { " after the chosen terms" } else { "" },
-                b.excess_db,
-                b.f_lo_hz,
-                b.f_hi_hz
-            ),
-            signature,
-        });
-    }
-    out
-}
-
-fn summary(
-    loc: &super::locate::LocationReport,
-    findings: &[Finding],
-    validation: &[ChannelComparison],
-    ambiguities: &[Ambiguity],
-    unexplained: &[Unexplained],
-) -> Vec<String> {
-    let mut out = Vec::new();
-    let parting: Vec<&str> = loc
-        .per_dof
-        .iter()
-        .filter(|d| d.parts)
-        .map(|d| d.dof.name())
-        .collect();
-    if parting.is_empty() && findings.is_empty() {
-        out.push(
-            "The baseline explains the recordings: no candidate term improves held-out runs."
-                .into(),
-        );
-    } else if !parting.is_empty() {
-        out.push(format!(
-            "The baseline parts from the recordings in {}.",
-            parting.join(", ")
-        ));
-    }
-    for f in findings {
-        out.push(f.effect_text.clone());
-    }
-    for c in validation {
-        if let (Some(b), Some(a)) = (c.before.free_run, c.after.free_run)
-            && (a - b).abs() >= 0.01
-        {
-            out.push(format!(
-                "{}: validation free-run fit {:.2} → {:.2}.",
-                capital(c.dof.name()),
-                b,
-                a
-            ));
-        }
-    }
-    out.extend(ambiguities.iter().map(|a| a.text.clone()));
-    out.extend(unexplained.iter().map(|u| u.text.clone()));
-    out
 }
 
 /// A change of an NRMSE fit (1 − NRMSE) below this is noise.

@@ -130,7 +130,9 @@ pub mod evidence;
 pub mod experiment;
 pub mod fit;
 pub mod locate;
+mod lookalike;
 pub mod model;
+mod narrate;
 pub mod proof;
 pub mod report;
 pub mod residual;
@@ -139,7 +141,7 @@ pub mod svf;
 
 pub use candidates::{Effect, Family, LibrarySettings, RestoringShape};
 pub use data::{Baseline, Record, Restoring};
-pub use discover::{DiscoverySettings, discover};
+pub use discover::{DiscoverySettings, discover, discover_from};
 pub use error::DiscoveryError;
 pub use experiment::ExperimentProposal;
 pub use model::{AugmentedModel, ModelTerm};

@@ -100,6 +100,17 @@ pub(crate) fn actuate(tau: &[f64], dof: Dof, shapes: &[(Effect, f64)]) -> (Vec<f
 }
 
 impl AugmentedModel {
+    /// Its M, D̄ and g(η) without the terms: what a further discovery
+    /// refits the terms against.
+    pub fn baseline(&self) -> Baseline {
+        Baseline {
+            dofs: self.dofs.clone(),
+            m: self.m.clone(),
+            d_bar: self.d_bar.clone(),
+            restoring: self.restoring,
+        }
+    }
+
     /// The baseline alone.
     pub fn from_baseline(b: &Baseline) -> Self {
         Self::new(

@@ -211,6 +211,10 @@ pub struct DiscoveryReport {
     pub ambiguities: Vec<Ambiguity>,
     /// Structure left unexplained.
     pub unexplained: Vec<Unexplained>,
+    /// Terms the examined model already carried (an earlier discovery's):
+    /// kept and refitted, not tested again. Empty for a baseline.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub carried: Vec<super::candidates::Effect>,
 }
 
 #[cfg(test)]
