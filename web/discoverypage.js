@@ -192,10 +192,13 @@ export async function discoveryPage(view, id) {
   const effects = rep.effects || [];
   const effectsTable = effects.length
     ? h('div', { class: 'table-x' }, h('table', { class: 'grid-table compact', 'data-testid': 'effects-table' },
-      h('thead', null, h('tr', null, h('th', null, 'Effect'), h('th', null, 'Grid speeds'), h('th', null, 'First coefficient per speed (± std)'))),
+      h('thead', null, h('tr', null, h('th', null, 'Effect'), h('th', null, 'Grid speeds'),
+        h('th', { title: 'Held-out free-run fit gained where it was chosen (1 − NRMSE summed over channels and speeds); effects are ranked by the speeds that chose them, then by it' }, 'Held-out gain'),
+        h('th', null, 'First coefficient per speed (± std)'))),
       h('tbody', null, effects.map((e) => h('tr', { 'data-testid': 'effect-row' },
         h('td', null, h('b', null, e.label)),
         h('td', null, e.grid_speeds_mps.map((s) => `${fmtKn(s)} kn`).join(', ')),
+        h('td', { class: 'num mono', 'data-testid': 'effect-evidence' }, fmt((e.held_out_gains || []).reduce((a, b) => a + b, 0), 3)),
         h('td', { class: 'mono small' }, e.magnitudes.map((m) => `${exact(m[0])}${m[1] != null ? ` ± ${exact(m[1])}` : ''}`).join('; ')))))))
     : h('p', { class: 'empty', 'data-testid': 'no-effects' }, 'Nothing named: the model explains the recordings within the evidence.');
 

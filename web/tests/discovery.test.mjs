@@ -59,6 +59,11 @@ test('discover the demo ROV\'s missing restoring from the model page and read th
     assert.match(summary, /restoring sin θ in pitch/, summary);
     const effects = await page.locator(tid('effect-row')).allTextContents();
     assert.ok(effects.some((e) => /roll/.test(e)) && effects.some((e) => /pitch/.test(e)), effects.join('\n'));
+    // Ranked by the speeds that chose them, then by held-out evidence.
+    const gains = (await page.locator(tid('effect-evidence')).allTextContents()).map((t) => parseFloat(t.replace(/\u2212/g, '-')));
+    const speeds = (await page.locator(`${tid('effect-row')} td:nth-child(2)`).allTextContents()).map((t) => t.split(',').length);
+    assert.ok(gains.every((g, i) => g > 0 && (i === 0 || speeds[i] < speeds[i - 1] || (speeds[i] === speeds[i - 1] && g <= gains[i - 1]))),
+      `${gains.join(', ')} at ${speeds.join(', ')} speeds`);
 
     // The first grid speed is open: location, hypotheses, findings, before/after.
     const point = page.locator(tid('discovery-point')).first();

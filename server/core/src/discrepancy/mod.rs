@@ -145,7 +145,7 @@ pub use discover::{DiscoverySettings, discover, discover_from};
 pub use error::DiscoveryError;
 pub use experiment::ExperimentProposal;
 pub use model::{AugmentedModel, ModelTerm};
-pub use report::DiscoveryReport;
+pub use report::{DiscoveryReport, Verdict};
 
 #[cfg(test)]
 mod tests;

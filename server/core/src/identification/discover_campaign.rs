@@ -22,7 +22,8 @@ use super::outcome::{Identified, RunValidation};
 use super::predictor::validate_on_run;
 use super::roles::nearest_grid_index;
 use crate::discrepancy::{
-    DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, ModelTerm, Record, discover_from,
+    DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, ModelTerm, Record, Verdict,
+    discover_from,
 };
 use crate::estimation::{Progress, SubProgress};
 use crate::logs::schema::pose_column;
@@ -76,6 +77,19 @@ pub struct EffectAcrossGrid {
     /// Its first coefficient at each of those speeds: [value, std] (std
     /// `null` when the fit gives none).
     pub magnitudes: Vec<[Option<f64>; 2]>,
+    /// The evidence at each of those speeds: the held-out free-run fit it
+    /// gained there when chosen (1 − NRMSE, summed over channels). Effects
+    /// are ranked by how many speeds chose them, then by its sum.
+    #[serde(default)]
+    pub held_out_gains: Vec<f64>,
+}
+
+impl EffectAcrossGrid {
+    /// The campaign's evidence for the effect: its held-out gains summed
+    /// over the grid speeds.
+    pub fn evidence(&self) -> f64 {
+        self.held_out_gains.iter().sum()
+    }
 }
 
 /// Discovery over a model's grid.
@@ -393,8 +407,18 @@ fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
                 label: f.label.clone(),
                 grid_speeds_mps: vec![],
                 magnitudes: vec![],
+                held_out_gains: vec![],
             });
             e.grid_speeds_mps.push(p.grid_speed_mps);
+            let gain = p
+                .report
+                .hypotheses
+                .iter()
+                .find(|h| h.effect == f.effect && h.verdict == Verdict::Chosen)
+                .and_then(|h| h.cv_gain)
+                .filter(|g| g.is_finite())
+                .unwrap_or(0.0);
+            e.held_out_gains.push(gain);
             let m = f
                 .coefficients
                 .first()
@@ -404,8 +428,17 @@ fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
             e.magnitudes.push(m);
         }
     }
+    // By how many speeds chose it (a property of the vehicle shows at
+    // every speed), then by the held-out evidence. (By evidence alone, a
+    // term one speed chose late could outrank one every speed chose: each
+    // gain is conditional on the terms chosen before it there.)
     let mut v: Vec<_> = by.into_values().collect();
-    v.sort_by_key(|e| std::cmp::Reverse(e.grid_speeds_mps.len()));
+    v.sort_by(|a, b| {
+        b.grid_speeds_mps
+            .len()
+            .cmp(&a.grid_speeds_mps.len())
+            .then(b.evidence().total_cmp(&a.evidence()))
+    });
     v
 }
 
@@ -473,7 +506,11 @@ fn summarize(
                 speeds_text(&e.grid_speeds_mps)
             )
         };
-        out.push(format!("{}: named {scope}; {range}.", e.label));
+        out.push(format!(
+            "{}: named {scope}; {range}; held-out fit gained {:.3} (summed over speeds and channels).",
+            e.label,
+            e.evidence()
+        ));
     }
     // Unexplained structure, per DOF across the grid (the per-speed
     // signatures are in each point's report).

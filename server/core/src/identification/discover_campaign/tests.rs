@@ -108,6 +108,34 @@ fn concealed_righting_moment_is_named_at_every_speed_and_the_stored_model_fits()
             .unwrap_or_else(|| panic!("no {dof:?} restoring in {:#?}", rep.summary));
         assert_eq!(e.grid_speeds_mps.len(), speeds, "{:?}", rep.summary);
     }
+    // Ranked by the speeds that chose them, then by held-out evidence: the
+    // gain each term brought where it was chosen, as its hypothesis says.
+    for e in &rep.effects {
+        assert_eq!(e.held_out_gains.len(), e.grid_speeds_mps.len());
+        for (speed, gain) in e.grid_speeds_mps.iter().zip(&e.held_out_gains) {
+            let p = rep
+                .points
+                .iter()
+                .find(|p| p.grid_speed_mps == *speed)
+                .unwrap();
+            let h = p
+                .report
+                .hypotheses
+                .iter()
+                .find(|h| h.effect == e.effect)
+                .unwrap();
+            assert_eq!(h.cv_gain, Some(*gain));
+            assert!(*gain >= DiscoverySettings::default().min_cv_gain);
+        }
+    }
+    for w in rep.effects.windows(2) {
+        let key = |e: &EffectAcrossGrid| (e.grid_speeds_mps.len(), e.evidence());
+        let (a, b) = (key(&w[0]), key(&w[1]));
+        assert!(
+            a.0 > b.0 || (a.0 == b.0 && a.1 >= b.1),
+            "{a:?} before {b:?}"
+        );
+    }
     let aug = out.augmented.as_ref().expect("an augmented model");
     assert_eq!(aug.document.method, Method::Discovery);
     assert_eq!(aug.validation_run_ids, base.validation_run_ids);
