@@ -25,7 +25,7 @@ use crate::discrepancy::{
     DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, ModelTerm, Record, Verdict,
     discover_from,
 };
-use crate::estimation::{Progress, SubProgress};
+use crate::estimation::Progress;
 use crate::logs::schema::pose_column;
 use crate::numbers::sig3;
 use crate::planning::VesselProfile;
@@ -335,26 +335,31 @@ pub fn discover_campaign(
         ));
     }
 
-    let mut points = Vec::new();
-    let share = 0.9 / todo.len() as f64;
-    for (step, &i) in todo.iter().enumerate() {
-        let speed = grid[i];
-        progress.update(
-            step as f64 * share,
-            &format!("discovery at {speed} m/s ({} of {})", step + 1, todo.len()),
-        )?;
-        // A model from an earlier discovery continues from its terms.
-        let start = augmented_at(doc, &lpv.points[i])?;
-        let mut sub = SubProgress::new(progress, step as f64 * share, (step + 1) as f64 * share);
-        let report = discover_from(&start, &est[i].0, &val[i].0, &dset, &mut sub)
-            .map_err(|e| discovery_error(e, speed))?;
-        points.push(PointDiscovery {
-            grid_speed_mps: speed,
+    // The grid speeds are independent: side by side on the pool, each with
+    // its sub-model as the start (a model from an earlier discovery
+    // continues from its terms).
+    let reports = crate::par::fan_out(
+        todo.len(),
+        progress,
+        (0.0, 0.9),
+        &format!("discovery at {} grid speed(s)", todo.len()),
+        |k, p| {
+            let i = todo[k];
+            let start = augmented_at(doc, &lpv.points[i])?;
+            discover_from(&start, &est[i].0, &val[i].0, &dset, p)
+                .map_err(|e| discovery_error(e, grid[i]))
+        },
+    )?;
+    let points: Vec<PointDiscovery> = todo
+        .iter()
+        .zip(reports)
+        .map(|(&i, report)| PointDiscovery {
+            grid_speed_mps: grid[i],
             estimation_run_ids: est[i].1.clone(),
             validation_run_ids: val[i].1.clone(),
             report,
-        });
-    }
+        })
+        .collect();
 
     let effects = effects_across(&points);
     let mut summary = summarize(&points, &effects, &skipped);
