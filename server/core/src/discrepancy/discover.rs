@@ -489,7 +489,7 @@ pub fn discover_from(
                     .map(|(j, (v, name))| Estimate {
                         name,
                         value: *v,
-                        std: term.covariance.get(j).and_then(|r| r.get(j)).map(|x| x.max(0.0).sqrt()).filter(|s| s.is_finite()),
+                        std: term.coefficient_std(j),
                     })
                     .collect(),
                 shape: h_rep.shape,

@@ -29,6 +29,18 @@ pub struct ModelTerm {
     pub shape_std: Option<f64>,
 }
 
+impl ModelTerm {
+    /// Standard deviation of coefficient `j` from the covariance's diagonal
+    /// (`None` when absent or not finite).
+    pub fn coefficient_std(&self, j: usize) -> Option<f64> {
+        self.covariance
+            .get(j)
+            .and_then(|r| r.get(j))
+            .map(|v| v.max(0.0).sqrt())
+            .filter(|s| s.is_finite())
+    }
+}
+
 /// Baseline plus chosen terms.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AugmentedModel {

@@ -661,13 +661,6 @@ fn augmented_model(
 /// coefficients, then its shape (lag, delay, level), each with its std.
 fn term_rows(term: &ModelTerm, speed: f64) -> Vec<ParameterRow> {
     let group = format!("discovered: {}", term.effect.label());
-    let std_of = |j: usize| {
-        term.covariance
-            .get(j)
-            .and_then(|r| r.get(j))
-            .map(|v| v.max(0.0).sqrt())
-            .filter(|s| s.is_finite())
-    };
     let row = |symbol: String, value: f64, std: Option<f64>| ParameterRow {
         group: group.clone(),
         symbol,
@@ -681,7 +674,7 @@ fn term_rows(term: &ModelTerm, speed: f64) -> Vec<ParameterRow> {
         .iter()
         .zip(term.effect.coefficient_names())
         .enumerate()
-        .map(|(j, (v, name))| row(name, *v, std_of(j)))
+        .map(|(j, (v, name))| row(name, *v, term.coefficient_std(j)))
         .collect();
     if let (Some(v), Some(kind)) = (term.shape, term.effect.shape()) {
         rows.push(row(kind.name().to_owned(), v, term.shape_std));
