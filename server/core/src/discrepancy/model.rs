@@ -1,7 +1,9 @@
 //! The augmented model: the baseline M ν̇ + D̄ ν = τ_a − g(η) plus the chosen
 //! terms, with its simulator (free run) and k-step predictor on recorded
-//! inputs. η is taken from the record (as γ = τ − g(η) is in the thesis),
-//! so the model is driven by (τ_c, η) and predicts ν.
+//! inputs. The model is driven by (τ_c, η) and predicts ν; η is taken from
+//! the record (as γ = τ − g(η) is in the thesis), except that a 6-DOF
+//! model integrates φ and θ from its own p, q, r (see
+//! [`AugmentedModel::attitude_in_loop`]), as the baseline's predictor does.
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -10,6 +12,7 @@ use super::candidates::{Effect, ShapeKind, TermContext};
 use super::data::{Baseline, Record, Restoring};
 use super::svf::lag_zoh;
 use crate::planning::Dof;
+use crate::simulation::integrate::rk4_step;
 use crate::validation::{Predictor, ValidationRecord};
 
 /// One term of the augmented model with its estimates.
@@ -227,92 +230,100 @@ impl AugmentedModel {
         }
     }
 
-    /// Runs the model from `nu0` (and lag states `lag0`) over samples
-    /// `start..end` of the record; returns ν at samples start+1..=end.
-    #[allow(clippy::too_many_arguments)]
-    fn run(
-        &self,
-        rec: &Record,
-        input: &AppliedInput,
-        start: usize,
-        end: usize,
-        nu0: &[f64],
-        lag0: &[f64],
-        out: &mut Vec<Vec<f64>>,
-    ) {
+    /// Whether φ and θ are integrated from the model's own p, q, r (six
+    /// DOFs in [`Dof::ALL`] order), as the vehicle does: driven by the
+    /// measured attitude, roll and pitch would lose their restoring spring
+    /// and a force error δ would drift the rate by δ/D instead of tilting
+    /// the hull by δ/(z_G·W − z_B·B).
+    pub fn attitude_in_loop(&self) -> bool {
+        self.dofs == Dof::ALL
+    }
+
+    /// The actuator chain of `rec` as this model sees it: the held command
+    /// per DOF and the lag states at every sample (exact for ZOH input).
+    pub(crate) fn drive(&self, rec: &Record) -> Drive {
+        let input = self.applied_input(rec);
+        let lags = self.lag_states(&input, rec.h);
+        Drive { input, lags }
+    }
+
+    /// The state at sample `k` taken from the record: measured ν and, with
+    /// the attitude in the loop, measured (φ, θ).
+    pub(crate) fn measured_state(&self, rec: &Record, k: usize) -> State {
+        State {
+            nu: (0..self.dofs.len()).map(|i| rec.nu[(k, i)]).collect(),
+            attitude: self
+                .attitude_in_loop()
+                .then(|| [rec.eta[(k, 3)], rec.eta[(k, 4)]]),
+        }
+    }
+
+    /// One sample interval k → k+1 from `x` (RK4, sub-stepped for a stiff
+    /// model): τ held, η between samples linear in the record (φ and θ the
+    /// model's own when in the loop), the lag states starting from their
+    /// exact values at k.
+    pub(crate) fn step(&self, rec: &Record, drive: &Drive, k: usize, x0: &State) -> State {
         let n = self.dofs.len();
+        let input = &drive.input;
         let lag_dofs: Vec<usize> = (0..n).filter(|&i| input.lag[i].is_some()).collect();
-        let mut x: Vec<f64> = nu0.to_vec();
-        x.extend(lag_dofs.iter().map(|&i| lag0[i]));
-        let mut u = vec![0.0; n];
-        let len = rec.len();
-        let dim = x.len();
-        let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (
-            vec![0.0; dim],
-            vec![0.0; dim],
-            vec![0.0; dim],
-            vec![0.0; dim],
-            vec![0.0; dim],
+        let att = x0.attitude.is_some();
+        let mut x: Vec<f64> = x0.nu.clone();
+        x.extend(
+            lag_dofs
+                .iter()
+                .map(|&i| drive.lags[i].as_ref().map_or(0.0, |l| l[k])),
         );
-        // Sub-steps for a stiff model (a fast, stable mode an explicit step
-        // of the log interval would turn unstable).
+        let a0 = x.len();
+        if let Some([phi, theta]) = x0.attitude {
+            x.extend([phi, theta]);
+        }
+        // The time within the sample interval as a state (ḟ = 1/h): RK4
+        // evaluates its stages at the right fraction of the interval.
+        let fr = x.len();
+        x.push(0.0);
+        let u: Vec<f64> = (0..n).map(|i| input.held[i][k]).collect();
+        let len = rec.len();
+        let e0 = rec.eta_at(k);
+        let e1 = rec.eta_at((k + 1).min(len - 1));
         let sub = ((rec.h * self.rate / 2.0).ceil() as usize).clamp(1, 200);
         let h = rec.h / sub as f64;
-        for k in start..end {
-            // η is recorded: linear between samples, so restoring and
-            // heading-dependent terms move within the step as they do at sea.
-            let e0 = rec.eta_at(k);
-            let e1 = rec.eta_at((k + 1).min(len - 1));
-            let eta_at =
-                |frac: f64| -> [f64; 6] { std::array::from_fn(|j| e0[j] + frac * (e1[j] - e0[j])) };
-            for (i, ui) in u.iter_mut().enumerate() {
-                *ui = input.held[i][k];
+        let mut f = |x: &[f64], u: &[f64], dx: &mut [f64]| {
+            let frac = x[fr];
+            dx[fr] = 1.0 / rec.h;
+            let mut eta: [f64; 6] = std::array::from_fn(|j| e0[j] + frac * (e1[j] - e0[j]));
+            if att {
+                eta[3] = x[a0];
+                eta[4] = x[a0 + 1];
+                let (phi, theta) = (x[a0], x[a0 + 1]);
+                let (p, q, r) = (x[3], x[4], x[5]);
+                let (sp, cp) = phi.sin_cos();
+                dx[a0] = p + (q * sp + r * cp) * theta.tan();
+                dx[a0 + 1] = q * cp - r * sp;
             }
-            for s in 0..sub {
-                let f0 = s as f64 / sub as f64;
-                let etas = [
-                    eta_at(f0),
-                    eta_at(f0 + 0.5 / sub as f64),
-                    eta_at(f0 + 1.0 / sub as f64),
-                ];
-                let gs: Vec<Vec<f64>> = etas
-                    .iter()
-                    .map(|e| {
-                        let g = self.restoring.g(e);
-                        self.dofs.iter().map(|d| g[d.index()]).collect()
-                    })
-                    .collect();
-                let f = |x: &[f64], stage: usize, dx: &mut [f64]| {
-                    let mut tau_a = u.clone();
-                    for (s, &i) in lag_dofs.iter().enumerate() {
-                        let t_a = input.lag[i].unwrap_or(1.0);
-                        tau_a[i] = x[n + s];
-                        dx[n + s] = (u[i] - x[n + s]) / t_a;
-                    }
-                    self.nu_dot(&x[..n], &tau_a, &gs[stage], &etas[stage], &mut dx[..n]);
-                };
-                f(&x, 0, &mut k1);
-                for i in 0..dim {
-                    tmp[i] = x[i] + 0.5 * h * k1[i];
-                }
-                f(&tmp, 1, &mut k2);
-                for i in 0..dim {
-                    tmp[i] = x[i] + 0.5 * h * k2[i];
-                }
-                f(&tmp, 1, &mut k3);
-                for i in 0..dim {
-                    tmp[i] = x[i] + h * k3[i];
-                }
-                f(&tmp, 2, &mut k4);
-                for i in 0..dim {
-                    x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                }
+            let mut tau_a = u.to_vec();
+            for (s, &i) in lag_dofs.iter().enumerate() {
+                let t_a = input.lag[i].unwrap_or(1.0);
+                tau_a[i] = x[n + s];
+                dx[n + s] = (u[i] - x[n + s]) / t_a;
             }
-            if x.iter().any(|v| !v.is_finite()) {
-                // A diverging candidate: restart from rest rather than overflow.
-                x.iter_mut().for_each(|v| *v = 0.0);
-            }
-            out.push(x[..n].to_vec());
+            let g = self.restoring.g(&eta);
+            let g: Vec<f64> = self.dofs.iter().map(|d| g[d.index()]).collect();
+            self.nu_dot(&x[..n], &tau_a, &g, &eta, &mut dx[..n]);
+        };
+        for _ in 0..sub {
+            rk4_step(&mut f, &mut x, &u, h);
+        }
+        let next = State {
+            nu: x[..n].to_vec(),
+            attitude: att.then(|| [x[a0], x[a0 + 1]]),
+        };
+        if next.is_finite() {
+            next
+        } else {
+            // A diverging candidate: restart from rest rather than overflow.
+            let mut rest = self.measured_state(rec, (k + 1).min(len - 1));
+            rest.nu.iter_mut().for_each(|v| *v = 0.0);
+            rest
         }
     }
 
@@ -330,37 +341,73 @@ impl AugmentedModel {
     pub fn simulate(&self, rec: &Record) -> DMatrix<f64> {
         let n = self.dofs.len();
         let len = rec.len();
-        let input = self.applied_input(rec);
-        let nu0: Vec<f64> = (0..n).map(|i| rec.nu[(0, i)]).collect();
-        let lag0: Vec<f64> = input.held.iter().map(|x| x[0]).collect();
-        let mut rows = vec![nu0.clone()];
-        if len > 1 {
-            self.run(rec, &input, 0, len - 1, &nu0, &lag0, &mut rows);
+        let mut out = DMatrix::zeros(len, n);
+        if len == 0 {
+            return out;
         }
-        DMatrix::from_fn(len, n, |k, i| rows[k][i])
+        let drive = self.drive(rec);
+        let mut x = self.measured_state(rec, 0);
+        out.row_mut(0).copy_from_slice(&x.nu);
+        for k in 0..len - 1 {
+            x = self.step(rec, &drive, k, &x);
+            out.row_mut(k + 1).copy_from_slice(&x.nu);
+        }
+        out
     }
 
-    /// k-step-ahead prediction ν̂(t | t−k) from the measured ν(t−k); rows
-    /// t < k are NaN.
+    /// k-step-ahead prediction ν̂(t | t−k) from the measured ν(t−k) (and
+    /// attitude); rows t < k are NaN.
     pub fn predict_k_step(&self, rec: &Record, k: usize) -> DMatrix<f64> {
         let n = self.dofs.len();
         let len = rec.len();
         let k = k.max(1);
-        let input = self.applied_input(rec);
-        let lags = self.lag_states(&input, rec.h);
+        let drive = self.drive(rec);
         let mut out = DMatrix::from_element(len, n, f64::NAN);
-        let mut buf = Vec::with_capacity(k);
         for t in k..len {
-            let s = t - k;
-            let nu0: Vec<f64> = (0..n).map(|i| rec.nu[(s, i)]).collect();
-            let lag0: Vec<f64> = lags
-                .iter()
-                .map(|l| l.as_ref().map_or(0.0, |v| v[s]))
-                .collect();
-            buf.clear();
-            self.run(rec, &input, s, t, &nu0, &lag0, &mut buf);
-            for i in 0..n {
-                out[(t, i)] = buf[k - 1][i];
+            let mut x = self.measured_state(rec, t - k);
+            for s in t - k..t {
+                x = self.step(rec, &drive, s, &x);
+            }
+            out.row_mut(t).copy_from_slice(&x.nu);
+        }
+        out
+    }
+}
+
+/// The actuator chain of one record as one model sees it.
+pub(crate) struct Drive {
+    input: AppliedInput,
+    lags: Vec<Option<Vec<f64>>>,
+}
+
+/// A model's state between samples: ν, and (φ, θ) when the attitude is in
+/// the loop.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct State {
+    pub nu: Vec<f64>,
+    pub attitude: Option<[f64; 2]>,
+}
+
+impl State {
+    fn is_finite(&self) -> bool {
+        self.nu
+            .iter()
+            .chain(self.attitude.iter().flatten())
+            .all(|v| v.is_finite())
+    }
+
+    /// Σ wᵢ·xᵢ of states of the same shape (the LPV blend of predictions).
+    pub(crate) fn blend(parts: &[(f64, State)]) -> State {
+        let (w0, first) = &parts[0];
+        let mut out = State {
+            nu: first.nu.iter().map(|v| w0 * v).collect(),
+            attitude: first.attitude.map(|a| a.map(|v| w0 * v)),
+        };
+        for (w, x) in &parts[1..] {
+            out.nu.iter_mut().zip(&x.nu).for_each(|(o, v)| *o += w * v);
+            if let (Some(o), Some(a)) = (out.attitude.as_mut(), x.attitude) {
+                o[0] += w * a[0];
+                o[1] += w * a[1];
             }
         }
         out

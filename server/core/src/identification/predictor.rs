@@ -42,35 +42,7 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
     match doc.kind {
         ModelKind::Lpv if is_augmented(doc) => Ok(Box::new(AugmentedLpv::from_doc(doc)?)),
         ModelKind::Lpv => {
-            let lpv = doc
-                .lpv
-                .as_ref()
-                .ok_or_else(|| IdentifyError::invalid("document.lpv", "missing"))?;
-            let mut models = Vec::new();
-            for p in &lpv.points {
-                let (m, d_bar) = (matrix(&p.m, "M")?, matrix(&p.d_bar, "D̄")?);
-                // Predictions on logs of a controller faster than the log
-                // add its unlogged commands back.
-                let (m, d_bar) = match &lpv.logged_controller {
-                    Some(lc) => logged_equivalent(&m, &d_bar, lc, &doc.dofs)
-                        .ok_or_else(super::intersample::malformed_controller)?,
-                    None => (m, d_bar),
-                };
-                models.push(
-                    LinearVesselModel::new(doc.dofs.clone(), m, d_bar)
-                        .and_then(|m| m.with_load(super::augmented::load_of(doc, p)))
-                        .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?,
-                );
-            }
-            let speeds = lpv.points.iter().map(|p| p.speed_mps).collect();
-            let model = LpvModel::new(speeds, models)
-                .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?;
-            let model = match lpv.extension {
-                Some(e) => model
-                    .with_extension(e.into())
-                    .map_err(|e| IdentifyError::invalid("document.lpv.extension", e.to_string()))?,
-                None => model,
-            };
+            let model = baseline_lpv(doc)?;
             match attitude_in_loop(doc) {
                 Some(g) => Ok(Box::new(
                     AttitudeLoop::new(model, g).expect("attitude_in_loop checked the DOFs"),
@@ -108,6 +80,40 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
             })))
         }
         ModelKind::DpShip => Ok(Box::new(dp_ship(doc)?)),
+    }
+}
+
+/// The LPV model of a stored LPV document's M, D̄ and loads (as the logs
+/// see them behind a controller faster than the log), with its extension.
+pub(crate) fn baseline_lpv(doc: &ModelDocument) -> Result<LpvModel, IdentifyError> {
+    let lpv = doc
+        .lpv
+        .as_ref()
+        .ok_or_else(|| IdentifyError::invalid("document.lpv", "missing"))?;
+    let mut models = Vec::new();
+    for p in &lpv.points {
+        let (m, d_bar) = (matrix(&p.m, "M")?, matrix(&p.d_bar, "D̄")?);
+        // Predictions on logs of a controller faster than the log add its
+        // unlogged commands back.
+        let (m, d_bar) = match &lpv.logged_controller {
+            Some(lc) => logged_equivalent(&m, &d_bar, lc, &doc.dofs)
+                .ok_or_else(super::intersample::malformed_controller)?,
+            None => (m, d_bar),
+        };
+        models.push(
+            LinearVesselModel::new(doc.dofs.clone(), m, d_bar)
+                .and_then(|m| m.with_load(super::augmented::load_of(doc, p)))
+                .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?,
+        );
+    }
+    let speeds = lpv.points.iter().map(|p| p.speed_mps).collect();
+    let model = LpvModel::new(speeds, models)
+        .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?;
+    match lpv.extension {
+        Some(e) => model
+            .with_extension(e.into())
+            .map_err(|e| IdentifyError::invalid("document.lpv.extension", e.to_string())),
+        None => Ok(model),
     }
 }
 

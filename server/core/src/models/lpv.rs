@@ -59,7 +59,7 @@ pub struct DiscreteLpv {
 /// linear in A: extrapolating the end points' Φ linearly can leave the
 /// unit circle where the extrapolated A is stable, so the extension is
 /// discretized exactly at these speeds and interpolated between them.
-const BEYOND_STEPS: usize = 8;
+pub(crate) const BEYOND_STEPS: usize = 8;
 
 fn check_speed(speed: f64) -> Result<(), ModelError> {
     if speed.is_finite() {
