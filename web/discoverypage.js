@@ -194,12 +194,16 @@ export async function discoveryPage(view, id) {
     ? h('div', { class: 'table-x' }, h('table', { class: 'grid-table compact', 'data-testid': 'effects-table' },
       h('thead', null, h('tr', null, h('th', null, 'Effect'), h('th', null, 'Grid speeds'),
         h('th', { title: 'Held-out free-run fit gained where it was chosen (1 − NRMSE summed over channels and speeds); effects are ranked by the speeds that chose them, then by it' }, 'Held-out gain'),
-        h('th', null, 'First coefficient per speed (± std)'))),
+        h('th', null, 'First coefficient per speed (± std)'),
+        h('th', { title: 'The model with every finding, or else each grid speed\u2019s findings added one speed at a time, is kept only where the held-out runs are better with them than without and no worse anywhere' }, 'In the stored model'))),
       h('tbody', null, effects.map((e) => h('tr', { 'data-testid': 'effect-row' },
         h('td', null, h('b', null, e.label)),
         h('td', null, e.grid_speeds_mps.map((s) => `${fmtKn(s)} kn`).join(', ')),
         h('td', { class: 'num mono', 'data-testid': 'effect-evidence' }, fmt((e.held_out_gains || []).reduce((a, b) => a + b, 0), 3)),
-        h('td', { class: 'mono small' }, e.magnitudes.map((m) => `${exact(m[0])}${m[1] != null ? ` ± ${exact(m[1])}` : ''}`).join('; ')))))))
+        h('td', { class: 'mono small' }, e.magnitudes.map((m) => `${exact(m[0])}${m[1] != null ? ` ± ${exact(m[1])}` : ''}`).join('; ')),
+        h('td', { class: 'small', 'data-testid': 'effect-kept', 'data-kept': e.kept == null ? '' : String(e.kept) },
+          e.kept == null ? '—' : h('span', { class: `badge ${e.kept ? 'good' : 'neutral'}` }, e.kept ? 'kept' : 'left out'),
+          e.held_out_verdict ? h('div', { class: 'hint' }, e.held_out_verdict) : null))))))
     : h('p', { class: 'empty', 'data-testid': 'no-effects' }, 'Nothing named: the model explains the recordings within the evidence.');
 
   fill(view,

@@ -64,6 +64,10 @@ test('discover the demo ROV\'s missing restoring from the model page and read th
     const speeds = (await page.locator(`${tid('effect-row')} td:nth-child(2)`).allTextContents()).map((t) => t.split(',').length);
     assert.ok(gains.every((g, i) => g > 0 && (i === 0 || speeds[i] < speeds[i - 1] || (speeds[i] === speeds[i - 1] && g <= gains[i - 1]))),
       `${gains.join(', ')} at ${speeds.join(', ')} speeds`);
+    // Each effect says whether the stored model keeps it, and why.
+    const kept = await page.locator(tid('effect-kept')).evaluateAll((xs) => xs.map((x) => x.dataset.kept));
+    assert.ok(kept.length === effects.length && kept.every((k) => k === 'true' || k === 'false') && kept.includes('true'), kept.join(', '));
+    assert.match(await page.locator(tid('effect-kept')).first().textContent(), /on the held-out runs/);
 
     // The first grid speed is open: location, hypotheses, findings, before/after.
     const point = page.locator(tid('discovery-point')).first();

@@ -16,9 +16,13 @@ mod support;
 use support::open_world_discovery::{Concealed, DiscoveryCase, discover_case};
 
 /// Nothing kept is worse than the baseline on any held-out channel (1-step
-/// or 10 s restarted free run, beyond 0.005), and a refused model's
-/// verdict says why.
+/// or 10 s restarted free run, beyond 0.005), every named effect carries
+/// its held-out verdict, and a refused model's verdict says why.
 fn gate_holds(c: &DiscoveryCase) {
+    for (k, (label, _, _)) in c.kept.iter().zip(&c.named) {
+        let why = k.1.as_deref().unwrap_or_default();
+        assert!(k.0.is_some() && !why.is_empty(), "{label}: {k:?}");
+    }
     if c.stored {
         for g in &c.gaps {
             let a = g.augmented.expect("a stored model is validated");
@@ -33,7 +37,9 @@ fn gate_holds(c: &DiscoveryCase) {
                 }
             }
         }
+        assert!(c.kept.iter().any(|k| k.0 == Some(true)), "{}", c.verdict);
     } else {
+        assert!(c.kept.iter().all(|k| k.0 != Some(true)), "{:?}", c.kept);
         assert!(
             c.verdict
                 .starts_with("The augmented model was not stored: ")

@@ -9,21 +9,16 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::augmented::{augmented_at, pieces_by_speed};
 use super::dataset::{RunInput, segments};
-use super::discover_gate::{compare_held_out, inertia_verdict};
-use super::document::{Method, ModelDocument, ModelKind, ParameterRow, PointAugmentation, to_rows};
+use super::document::{ModelDocument, ModelKind};
 use super::error::IdentifyError;
-use super::intersample::vehicle_from_logged;
-use super::outcome::{Identified, RunValidation};
-use super::predictor::validate_on_run;
+use super::outcome::Identified;
 use super::roles::nearest_grid_index;
 use crate::discrepancy::{
-    DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, ModelTerm, Record, Verdict,
-    discover_from,
+    DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, Record, Verdict, discover_from,
 };
 use crate::estimation::Progress;
 use crate::logs::schema::pose_column;
@@ -82,6 +77,15 @@ pub struct EffectAcrossGrid {
     /// are ranked by how many speeds chose them, then by its sum.
     #[serde(default)]
     pub held_out_gains: Vec<f64>,
+    /// Whether the stored model keeps it: the model with every finding, or
+    /// else each grid speed's findings added one speed at a time, is kept
+    /// only where the held-out runs are better with them than without and
+    /// no worse anywhere (`null` when it was not judged).
+    #[serde(default)]
+    pub kept: Option<bool>,
+    /// Why it was kept or left out, with the deciding held-out fits.
+    #[serde(default)]
+    pub held_out_verdict: Option<String>,
 }
 
 impl EffectAcrossGrid {
@@ -361,37 +365,36 @@ pub fn discover_campaign(
         })
         .collect();
 
-    let effects = effects_across(&points);
-    let mut summary = summarize(&points, &effects, &skipped);
-    progress.update(0.92, "validating the augmented model")?;
-    let augmented = if effects.is_empty() {
-        None
-    } else {
-        let candidate = augmented_model(
-            doc,
-            &points,
-            &summary,
-            forces,
-            runs,
-            est_ids,
-            val_ids,
-            settings,
-            dset.k_step,
-        )?;
-        // The baseline through the same validation, on the same runs.
-        let mut before = Vec::new();
-        for r in runs.iter().filter(|r| val_ids.contains(&r.run_id)) {
-            before.push(RunValidation {
-                run_id: r.run_id.clone(),
-                run_name: r.name.clone(),
-                report: validate_on_run(doc, r, forces, dset.k_step)?,
-            });
-        }
-        let verdict = inertia_verdict(&candidate.document)
-            .unwrap_or_else(|| compare_held_out(&before, &candidate.validation));
-        summary.push(verdict.text);
-        verdict.keep.then_some(candidate)
+    let mut effects = effects_across(&points);
+    progress.update(0.9, "validating the baseline on the held-out runs")?;
+    let asm = Assembly {
+        doc,
+        points: &points,
+        forces,
+        runs,
+        est_ids,
+        val_ids,
+        settings,
+        k: dset.k_step,
     };
+    let (augmented, overall) = if effects.is_empty() {
+        (None, None)
+    } else {
+        // The start model through the same validation, on the same runs.
+        let before = asm.validate(doc)?;
+        let gate = keep_better(&asm, &effects, &before, progress, (0.9, 0.99))?;
+        for (e, v) in effects.iter_mut().zip(&gate.verdicts) {
+            e.kept = Some(v.keep && gate.model.is_some());
+            e.held_out_verdict = Some(v.reason.clone());
+        }
+        (gate.model, Some(gate.overall.text()))
+    };
+    let mut summary = summarize(&points, &effects, &skipped);
+    summary.extend(overall);
+    let augmented = augmented.map(|mut a| {
+        a.document.notes.extend(summary.iter().cloned());
+        a
+    });
     Ok(CampaignDiscovery {
         report: DiscrepancyReport {
             summary,
@@ -413,6 +416,8 @@ fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
                 grid_speeds_mps: vec![],
                 magnitudes: vec![],
                 held_out_gains: vec![],
+                kept: None,
+                held_out_verdict: None,
             });
             e.grid_speeds_mps.push(p.grid_speed_mps);
             let gain = p
@@ -447,7 +452,7 @@ fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
     v
 }
 
-fn speeds_text(v: &[f64]) -> String {
+pub(super) fn speeds_text(v: &[f64]) -> String {
     v.iter()
         .map(|s| format!("{s:.2}"))
         .collect::<Vec<_>>()
@@ -511,8 +516,13 @@ fn summarize(
                 speeds_text(&e.grid_speeds_mps)
             )
         };
+        let gate = match (e.kept, &e.held_out_verdict) {
+            (Some(true), Some(v)) => format!(" Kept: {v}."),
+            (Some(false), Some(v)) => format!(" Left out: {v}."),
+            _ => String::new(),
+        };
         out.push(format!(
-            "{}: named {scope}; {range}; held-out fit gained {:.3} (summed over speeds and channels).",
+            "{}: named {scope}; {range}; held-out fit gained {:.3} (summed over speeds and channels).{gate}",
             e.label,
             e.evidence()
         ));
@@ -564,123 +574,11 @@ fn summarize(
     out
 }
 
-#[allow(clippy::too_many_arguments)]
-fn augmented_model(
-    doc: &ModelDocument,
-    points: &[PointDiscovery],
-    summary: &[String],
-    forces: &[String],
-    runs: &[RunInput],
-    est_ids: &[String],
-    val_ids: &[String],
-    settings: &DiscoverCampaignSettings,
-    k: usize,
-) -> Result<Identified, IdentifyError> {
-    let mut out = doc.clone();
-    out.method = Method::Discovery;
-    // Driven by the commanded τ and the measured attitude (see `augmented`).
-    out.inputs = forces
-        .iter()
-        .cloned()
-        .chain(Dof::ALL.iter().map(|d| pose_column(*d).to_string()))
-        .collect();
-    let lpv = out.lpv.as_mut().expect("checked: LPV");
-    let logged_controller = lpv.logged_controller.clone();
-    for p in points {
-        let Some(pt) = lpv
-            .points
-            .iter_mut()
-            .find(|q| (q.speed_mps - p.grid_speed_mps).abs() < 1e-9)
-        else {
-            continue;
-        };
-        let model = &p.report.model;
-        if model.terms.is_empty() && p.report.findings.is_empty() {
-            continue;
-        }
-        let m = DMatrix::from_fn(model.m.len(), model.m.len(), |i, j| model.m[i][j]);
-        let d = DMatrix::from_fn(model.d_bar.len(), model.d_bar.len(), |i, j| {
-            model.d_bar[i][j]
-        });
-        // Discovery fitted the model the logs see; the document keeps the
-        // vehicle's M and D̄ (the logged view is rebuilt when predicting).
-        let (m, d) = match &logged_controller {
-            Some(lc) => vehicle_from_logged(&m, &d, lc, &doc.dofs)
-                .ok_or_else(super::intersample::malformed_controller)?,
-            None => (m, d),
-        };
-        let m_inv = m.clone().try_inverse().ok_or_else(|| {
-            IdentifyError::invalid(
-                "document.lpv",
-                format!("augmented M at {} m/s is singular", p.grid_speed_mps),
-            )
-        })?;
-        pt.augmentation = Some(PointAugmentation {
-            m_ref: model.m_ref.clone(),
-            d_ref: model.d_ref.clone(),
-            terms: model.terms.clone(),
-        });
-        pt.a = to_rows(&(-&m_inv * &d));
-        pt.b = to_rows(&m_inv);
-        pt.m = to_rows(&m);
-        pt.d_bar = to_rows(&d);
-        // Every term's estimates as refitted here (carried terms' earlier
-        // rows at this speed are replaced).
-        let speed = p.grid_speed_mps;
-        out.parameters.retain(|r| {
-            !(r.group.starts_with("discovered: ")
-                && r.grid_speed_mps.is_some_and(|s| (s - speed).abs() < 1e-9))
-        });
-        for term in &model.terms {
-            out.parameters.extend(term_rows(term, speed));
-        }
-    }
-    out.notes.insert(
-        0,
-        "Augmented by missing-physics discovery; refitted rows of M, D̄ keep the baseline's standard deviations — the discovered terms carry their own.".into(),
-    );
-    out.notes.extend(summary.iter().cloned());
-    let mut validation = Vec::new();
-    for r in runs.iter().filter(|r| val_ids.contains(&r.run_id)) {
-        validation.push(RunValidation {
-            run_id: r.run_id.clone(),
-            run_name: r.name.clone(),
-            report: validate_on_run(&out, r, forces, k)?,
-        });
-    }
-    Ok(Identified {
-        document: out,
-        validation,
-        estimation_run_ids: est_ids.to_vec(),
-        validation_run_ids: val_ids.to_vec(),
-        settings_used: serde_json::to_value(settings).unwrap_or_default(),
-    })
-}
+mod assemble;
+mod keep;
 
-/// The parameter-table rows of one discovered term at `speed`: its
-/// coefficients, then its shape (lag, delay, level), each with its std.
-fn term_rows(term: &ModelTerm, speed: f64) -> Vec<ParameterRow> {
-    let group = format!("discovered: {}", term.effect.label());
-    let row = |symbol: String, value: f64, std: Option<f64>| ParameterRow {
-        group: group.clone(),
-        symbol,
-        grid_speed_mps: Some(speed),
-        value,
-        std,
-        unit: String::new(),
-    };
-    let mut rows: Vec<ParameterRow> = term
-        .coefficients
-        .iter()
-        .zip(term.effect.coefficient_names())
-        .enumerate()
-        .map(|(j, (v, name))| row(name, *v, term.coefficient_std(j)))
-        .collect();
-    if let (Some(v), Some(kind)) = (term.shape, term.effect.shape()) {
-        rows.push(row(kind.name().to_owned(), v, term.shape_std));
-    }
-    rows
-}
+use assemble::Assembly;
+use keep::keep_better;
 
 #[cfg(test)]
 mod tests;

@@ -14,13 +14,25 @@ use crate::validation::ChannelValidation;
 pub use crate::discrepancy::discover::FIT_NOISE;
 use crate::discrepancy::discover::fit_gain;
 
-/// Whether the augmented model is kept, and why, in a sentence.
+/// Whether the augmented model is kept, and why.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeldOutVerdict {
     /// Store it.
     pub keep: bool,
-    /// The reason, with the deciding numbers.
-    pub text: String,
+    /// The reason, with the deciding numbers (a clause: "on the held-out
+    /// runs it improves …").
+    pub reason: String,
+}
+
+impl HeldOutVerdict {
+    /// The verdict on a whole model, in a sentence.
+    pub fn text(&self) -> String {
+        format!(
+            "The augmented model was {}: {}.",
+            if self.keep { "stored" } else { "not stored" },
+            self.reason
+        )
+    }
 }
 
 /// One compared number: run, channel, metric, baseline, augmented.
@@ -90,16 +102,23 @@ pub fn inertia_verdict(doc: &ModelDocument) -> Option<HeldOutVerdict> {
     }
     (!bad.is_empty()).then(|| HeldOutVerdict {
         keep: false,
-        text: format!(
-            "The augmented model was not stored: its inertia M is not positive definite {}.",
-            bad.join(", ")
-        ),
+        reason: format!("its inertia M is not positive definite {}", bad.join(", ")),
     })
 }
 
 /// Compares the augmented model's held-out validation with the baseline's
 /// on the same runs (matched by run id and channel name).
 pub fn compare_held_out(baseline: &[RunValidation], augmented: &[RunValidation]) -> HeldOutVerdict {
+    compare_against(baseline, augmented, "the baseline")
+}
+
+/// [`compare_held_out`] against a reference model named `against` in the
+/// reason ("the baseline", "the model without it").
+pub fn compare_against(
+    baseline: &[RunValidation],
+    augmented: &[RunValidation],
+    against: &str,
+) -> HeldOutVerdict {
     let mut all = Vec::new();
     let mut diverged = Vec::new();
     for a in augmented {
@@ -122,16 +141,13 @@ pub fn compare_held_out(baseline: &[RunValidation], augmented: &[RunValidation])
     if all.is_empty() {
         return HeldOutVerdict {
             keep: false,
-            text: "The augmented model was not stored: there is no held-out run to show that it is better than the baseline.".into(),
+            reason: format!("there is no held-out run to show that it is better than {against}"),
         };
     }
     if !diverged.is_empty() {
         return HeldOutVerdict {
             keep: false,
-            text: format!(
-                "The augmented model was not stored: {} (the baseline's did not).",
-                diverged.join("; ")
-            ),
+            reason: format!("{} ({against} did not diverge)", diverged.join("; ")),
         };
     }
     let mut worse: Vec<&Change> = all.iter().filter(|c| c.gain() < -FIT_NOISE).collect();
@@ -140,8 +156,8 @@ pub fn compare_held_out(baseline: &[RunValidation], augmented: &[RunValidation])
         let shown: Vec<String> = worse.iter().take(3).map(|c| c.text()).collect();
         return HeldOutVerdict {
             keep: false,
-            text: format!(
-                "The augmented model was not stored: on the held-out runs it is worse than the baseline in {}{}.",
+            reason: format!(
+                "on the held-out runs it is worse than {against} in {}{}",
                 shown.join(", "),
                 if worse.len() > 3 {
                     format!(" and {} more", worse.len() - 3)
@@ -156,14 +172,14 @@ pub fn compare_held_out(baseline: &[RunValidation], augmented: &[RunValidation])
     match better.first() {
         None => HeldOutVerdict {
             keep: false,
-            text: format!(
-                "The augmented model was not stored: on the held-out runs no fit changes by more than {FIT_NOISE} from the baseline's."
+            reason: format!(
+                "on the held-out runs no fit differs by more than {FIT_NOISE} from {against}'s"
             ),
         },
         Some(best) => HeldOutVerdict {
             keep: true,
-            text: format!(
-                "The augmented model was stored: on the held-out runs it improves {} of {} fits by more than {FIT_NOISE} and worsens none (largest gain: {}).",
+            reason: format!(
+                "on the held-out runs it improves {} of {} fits over {against} by more than {FIT_NOISE} and worsens none (largest gain: {})",
                 better.len(),
                 all.len(),
                 best.text()
@@ -231,29 +247,29 @@ mod tests {
         assert!(!base.is_empty());
         let same = compare_held_out(&base, &base);
         assert!(
-            !same.keep && same.text.contains("no fit changes"),
+            !same.keep && same.text().contains("no fit differs"),
             "{}",
-            same.text
+            same.text()
         );
 
         let mut better = base.clone();
         shift(&mut better, "v", 0.05);
         let v = compare_held_out(&base, &better);
         assert!(
-            v.keep && v.text.contains("v on 'run-2' (1-step fit"),
+            v.keep && v.text().contains("v on 'run-2' (1-step fit"),
             "{}",
-            v.text
+            v.text()
         );
 
         let mut mixed = better.clone();
         shift(&mut mixed, "r", -0.02);
         let v = compare_held_out(&base, &mixed);
-        assert!(!v.keep, "{}", v.text);
+        assert!(!v.keep, "{}", v.text());
         assert!(
-            v.text
+            v.text()
                 .contains("worse than the baseline in r on 'run-2' (1-step fit"),
             "{}",
-            v.text
+            v.text()
         );
 
         let mut within_noise = better.clone();
@@ -278,10 +294,10 @@ mod tests {
         });
         let v = compare_held_out(&base, &worse);
         assert!(!v.keep);
-        assert!(v.text.contains("diverged at t = 42.0 s"), "{}", v.text);
+        assert!(v.text().contains("diverged at t = 42.0 s"), "{}", v.text());
         assert!(
             compare_held_out(&[], &base)
-                .text
+                .text()
                 .contains("no held-out run")
         );
     }
@@ -306,11 +322,11 @@ mod tests {
         let v = inertia_verdict(&bad).expect("refused");
         assert!(!v.keep);
         assert!(
-            v.text.contains(
+            v.text().contains(
                 "not positive definite at 1 m/s (smallest eigenvalue of ½(M + Mᵀ): −18.4)"
             ),
             "{}",
-            v.text
+            v.text()
         );
     }
 }

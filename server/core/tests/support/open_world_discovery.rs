@@ -128,6 +128,9 @@ pub struct DiscoveryCase {
     /// Effects across the grid in the report's order: label, grid speeds,
     /// and whether it names the concealed effect.
     pub named: Vec<(String, usize, Option<bool>)>,
+    /// Per named effect (same order): whether the stored model keeps it,
+    /// and the held-out verdict that decided it.
+    pub kept: Vec<(Option<bool>, Option<String>)>,
     pub grid_points: usize,
     pub stored: bool,
     /// The gate's sentence.
@@ -202,6 +205,12 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
             )
         })
         .collect();
+    let kept = out
+        .report
+        .effects
+        .iter()
+        .map(|e| (e.kept, e.held_out_verdict.clone()))
+        .collect();
     let val_run = campaign.validation_runs()[0];
     let truth = true_predictions(&vessel, &val_run.log);
     let report_of = |v: &[seatrial_core::identification::outcome::RunValidation]| {
@@ -235,6 +244,7 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         concealed,
         seed,
         named,
+        kept,
         grid_points: spec.grid_speeds.len(),
         stored: out.augmented.is_some(),
         verdict: out.report.summary.last().cloned().unwrap_or_default(),
@@ -291,6 +301,21 @@ pub fn format_cases(cases: &[DiscoveryCase]) -> String {
                 f(g.truth[1]),
                 pct(closed[1]),
             );
+        }
+        let kept: Vec<&str> = c
+            .named
+            .iter()
+            .zip(&c.kept)
+            .filter(|(_, k)| k.0 == Some(true))
+            .map(|(n, _)| n.0.as_str())
+            .collect();
+        if c.stored {
+            s += &format!("    kept: {}\n", kept.join("; "));
+        }
+        if let (Some((label, _, _)), Some((Some(false), Some(why)))) =
+            (c.named.first(), c.kept.first())
+        {
+            s += &format!("    first named, left out: {label}: {why}\n");
         }
         s += &format!("    {}\n", c.verdict);
     }

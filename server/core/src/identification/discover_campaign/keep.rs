@@ -1,0 +1,174 @@
+//! Only what is better is kept. The model with every grid speed's findings
+//! is kept if, on the held-out runs, it is better than the start model
+//! beyond noise in some fit and worse in none (1-step, k-step, 10 s
+//! restarted free run), simulates wherever that model did, and keeps M
+//! positive definite. Otherwise the grid speeds' augmentations are added
+//! one at a time, strongest evidence first, each staying only if the model
+//! with it passes the same test against the model without it and against
+//! the baseline (so losses within noise cannot add up).
+//!
+//! The unit is a grid speed's augmentation as discovery fitted it: its
+//! terms were fitted together with refitted rows of M and D̄, and a subset
+//! of them on those rows is a model nobody fitted (one term's row without
+//! its companion can diverge). The held-out runs decide which augmentations
+//! enter but never fit a coefficient: the terms were fitted on the
+//! estimation runs alone.
+
+use std::collections::BTreeSet;
+
+use super::super::discover_gate::{HeldOutVerdict, compare_against, inertia_verdict};
+use super::super::error::IdentifyError;
+use super::super::outcome::{Identified, RunValidation};
+use super::assemble::Assembly;
+use super::{EffectAcrossGrid, speeds_text};
+use crate::discrepancy::Verdict;
+use crate::estimation::Progress;
+
+/// The outcome of the gate.
+pub(super) struct Kept {
+    /// The model with every kept augmentation (`None` when none was kept).
+    pub model: Option<Identified>,
+    /// Per effect (in the order of `effects`): whether the model keeps it
+    /// and why.
+    pub verdicts: Vec<HeldOutVerdict>,
+    /// The verdict on the whole model against the start model.
+    pub overall: HeldOutVerdict,
+}
+
+/// The held-out evidence discovery gave a grid speed's findings: the
+/// cross-validated gains of its chosen hypotheses, summed.
+fn evidence(asm: &Assembly<'_>, i: usize) -> f64 {
+    asm.points[i]
+        .report
+        .hypotheses
+        .iter()
+        .filter(|h| h.verdict == Verdict::Chosen)
+        .filter_map(|h| h.cv_gain)
+        .filter(|g| g.is_finite())
+        .sum()
+}
+
+/// Runs the gate over the grid speeds with findings, between progress
+/// `from` and `to`.
+pub(super) fn keep_better(
+    asm: &Assembly<'_>,
+    effects: &[EffectAcrossGrid],
+    before: &[RunValidation],
+    progress: &mut dyn Progress,
+    (from, to): (f64, f64),
+) -> Result<Kept, IdentifyError> {
+    let mut order: Vec<usize> = (0..asm.points.len())
+        .filter(|&i| !asm.points[i].report.findings.is_empty())
+        .collect();
+    order.sort_by(|&a, &b| evidence(asm, b).total_cmp(&evidence(asm, a)));
+    let all: BTreeSet<usize> = order.iter().copied().collect();
+    progress.update(from, "held-out check of the model with every effect found")?;
+    let full = asm.model(&all)?;
+    let verdict = inertia_verdict(&full.document)
+        .unwrap_or_else(|| compare_against(before, &full.validation, "the baseline"));
+    if verdict.keep || order.len() == 1 {
+        return Ok(Kept {
+            model: verdict.keep.then_some(full),
+            verdicts: vec![verdict.clone(); effects.len()],
+            overall: verdict,
+        });
+    }
+    let step = (to - from) / (order.len() + 1) as f64;
+    let mut kept = BTreeSet::new();
+    let mut best: Option<Identified> = None;
+    // Per grid point tried: its verdict against the model without it.
+    let mut at: Vec<(usize, HeldOutVerdict)> = Vec::new();
+    for (n, &i) in order.iter().enumerate() {
+        let speed = asm.points[i].grid_speed_mps;
+        progress.update(
+            from + step * (n + 1) as f64,
+            &format!(
+                "held-out check of the findings at {speed:.2} m/s ({} of {})",
+                n + 1,
+                order.len()
+            ),
+        )?;
+        let mut trial = kept.clone();
+        trial.insert(i);
+        let candidate = asm.model(&trial)?;
+        let reference = best.as_ref().map_or(before, |b| b.validation.as_slice());
+        let against = if best.is_some() {
+            "the model without them"
+        } else {
+            "the baseline"
+        };
+        let mut v = inertia_verdict(&candidate.document)
+            .unwrap_or_else(|| compare_against(reference, &candidate.validation, against));
+        // Small losses within noise must not add up past the baseline.
+        if v.keep && best.is_some() {
+            let vb = compare_against(before, &candidate.validation, "the baseline");
+            if !vb.keep {
+                v = vb;
+            }
+        }
+        if v.keep {
+            kept = trial;
+            best = Some(candidate);
+        }
+        at.push((i, v));
+    }
+    let kept_speeds: Vec<f64> = kept.iter().map(|&i| asm.points[i].grid_speed_mps).collect();
+    let overall = match &best {
+        Some(b) => {
+            let mut v = compare_against(before, &b.validation, "the baseline");
+            v.reason = format!(
+                "with the findings at {} of {} grid speeds ({} m/s; the model with all of them was refused: {}), {}",
+                kept.len(),
+                order.len(),
+                speeds_text(&kept_speeds),
+                verdict.reason,
+                v.reason
+            );
+            v
+        }
+        None => HeldOutVerdict {
+            keep: false,
+            reason: format!(
+                "with every effect found, {}; added one grid speed at a time, none made a held-out fit better without making another worse",
+                verdict.reason
+            ),
+        },
+    };
+    let stored = best.is_some() && overall.keep;
+    // An effect is kept where a grid speed that chose it is kept; its
+    // reason is that speed's verdict (or the first speed's that chose it).
+    let verdicts = effects
+        .iter()
+        .map(|e| {
+            let chose = |i: usize| {
+                asm.points[i]
+                    .report
+                    .findings
+                    .iter()
+                    .any(|f| f.effect == e.effect)
+            };
+            let pick = at
+                .iter()
+                .find(|(i, v)| v.keep && stored && chose(*i))
+                .or_else(|| at.iter().find(|(i, _)| chose(*i)));
+            match pick {
+                Some((i, v)) => HeldOutVerdict {
+                    keep: v.keep && stored,
+                    reason: format!(
+                        "at {:.2} m/s with that speed's other findings, {}",
+                        asm.points[*i].grid_speed_mps, v.reason
+                    ),
+                },
+                None => HeldOutVerdict {
+                    keep: false,
+                    reason: verdict.reason.clone(),
+                },
+            }
+        })
+        .collect();
+    Ok(Kept {
+        model: best.filter(|_| overall.keep),
+        verdicts,
+        overall,
+    })
+}
