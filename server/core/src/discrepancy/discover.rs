@@ -337,12 +337,16 @@ pub fn discover_from(
             _ => prep.fit(&chosen, &all_rows, &runs, hac),
         };
         let fitted: Vec<&Record> = est.iter().collect();
-        let mut best: Option<(usize, (f64, f64))> = None;
+        // A variant whose M is not positive definite is not a vessel: it is
+        // taken only when no variant is.
+        let mut best: Option<(usize, (bool, f64, f64))> = None;
         for v in 0..3 {
             let Some(f) = fit_variant(v, false) else {
                 continue;
             };
-            let score = change_score(&base_model, &prep.model(&chosen, &f, &[]), &fitted, k);
+            let candidate = prep.model(&chosen, &f, &[]);
+            let (harm, gain) = change_score(&base_model, &candidate, &fitted, k);
+            let score = (candidate.inertia_positive(), harm, gain);
             if best.is_none_or(|(_, b)| score > b) {
                 best = Some((v, score));
             }

@@ -230,6 +230,14 @@ impl AugmentedModel {
         }
     }
 
+    /// Whether ½(M + Mᵀ) is positive definite: the kinetic energy ½νᵀMν
+    /// of the model is positive.
+    pub fn inertia_positive(&self) -> bool {
+        let sym = (&self.m + self.m.transpose()) * 0.5;
+        let low = sym.symmetric_eigenvalues().min();
+        low.is_finite() && low > 0.0
+    }
+
     /// Whether φ and θ are integrated from the model's own p, q, r (six
     /// DOFs in [`Dof::ALL`] order), as the vehicle does: driven by the
     /// measured attitude, roll and pitch would lose their restoring spring
