@@ -68,6 +68,12 @@ pub struct AugmentedModel {
     rate: f64,
 }
 
+/// The smallest eigenvalue of ½(M + Mᵀ): positive when the kinetic energy
+/// ½νᵀMν is (refitted rows leave M slightly asymmetric).
+pub fn inertia_floor(m: &DMatrix<f64>) -> f64 {
+    ((m + m.transpose()) * 0.5).symmetric_eigenvalues().min()
+}
+
 /// The input the vessel actually feels, per DOF: the held command after
 /// delay, saturation and dead zone, and the time constant of a lag after it.
 pub(crate) struct AppliedInput {
@@ -233,8 +239,7 @@ impl AugmentedModel {
     /// Whether ½(M + Mᵀ) is positive definite: the kinetic energy ½νᵀMν
     /// of the model is positive.
     pub fn inertia_positive(&self) -> bool {
-        let sym = (&self.m + self.m.transpose()) * 0.5;
-        let low = sym.symmetric_eigenvalues().min();
+        let low = inertia_floor(&self.m);
         low.is_finite() && low > 0.0
     }
 
@@ -347,39 +352,71 @@ impl AugmentedModel {
     /// Free-run simulation from the recorded ν(0) (thesis eq. 2.20–2.21),
     /// N × n.
     pub fn simulate(&self, rec: &Record) -> DMatrix<f64> {
-        let n = self.dofs.len();
-        let len = rec.len();
-        let mut out = DMatrix::zeros(len, n);
-        if len == 0 {
-            return out;
-        }
         let drive = self.drive(rec);
-        let mut x = self.measured_state(rec, 0);
-        out.row_mut(0).copy_from_slice(&x.nu);
-        for k in 0..len - 1 {
-            x = self.step(rec, &drive, k, &x);
-            out.row_mut(k + 1).copy_from_slice(&x.nu);
-        }
-        out
+        free_run(
+            rec,
+            self.dofs.len(),
+            |r, k| self.measured_state(r, k),
+            |k, x| self.step(rec, &drive, k, x),
+        )
     }
 
     /// k-step-ahead prediction ν̂(t | t−k) from the measured ν(t−k) (and
     /// attitude); rows t < k are NaN.
     pub fn predict_k_step(&self, rec: &Record, k: usize) -> DMatrix<f64> {
-        let n = self.dofs.len();
-        let len = rec.len();
-        let k = k.max(1);
         let drive = self.drive(rec);
-        let mut out = DMatrix::from_element(len, n, f64::NAN);
-        for t in k..len {
-            let mut x = self.measured_state(rec, t - k);
-            for s in t - k..t {
-                x = self.step(rec, &drive, s, &x);
-            }
-            out.row_mut(t).copy_from_slice(&x.nu);
-        }
-        out
+        k_step(
+            rec,
+            self.dofs.len(),
+            k,
+            |r, t| self.measured_state(r, t),
+            |s, x| self.step(rec, &drive, s, x),
+        )
     }
+}
+
+/// A free run over `rec` (N × n ν): from the measured state at 0, one
+/// `step(k, x)` per sample interval.
+pub(crate) fn free_run(
+    rec: &Record,
+    n: usize,
+    measured: impl Fn(&Record, usize) -> State,
+    mut step: impl FnMut(usize, &State) -> State,
+) -> DMatrix<f64> {
+    let len = rec.len();
+    let mut out = DMatrix::zeros(len, n);
+    if len == 0 {
+        return out;
+    }
+    let mut x = measured(rec, 0);
+    out.row_mut(0).copy_from_slice(&x.nu);
+    for k in 0..len - 1 {
+        x = step(k, &x);
+        out.row_mut(k + 1).copy_from_slice(&x.nu);
+    }
+    out
+}
+
+/// k-step predictions over `rec` (rows t < k NaN): from the measured state
+/// at t − k, k calls of `step`.
+pub(crate) fn k_step(
+    rec: &Record,
+    n: usize,
+    k: usize,
+    measured: impl Fn(&Record, usize) -> State,
+    mut step: impl FnMut(usize, &State) -> State,
+) -> DMatrix<f64> {
+    let len = rec.len();
+    let k = k.max(1);
+    let mut out = DMatrix::from_element(len, n, f64::NAN);
+    for t in k..len {
+        let mut x = measured(rec, t - k);
+        for s in t - k..t {
+            x = step(s, &x);
+        }
+        out.row_mut(t).copy_from_slice(&x.nu);
+    }
+    out
 }
 
 /// The actuator chain of one record as one model sees it.

@@ -8,7 +8,7 @@ use nalgebra::DMatrix;
 use super::document::{LpvPoint, ModelDocument, from_rows};
 use super::error::IdentifyError;
 use super::intersample::logged_equivalent;
-use crate::discrepancy::model::{Drive, State};
+use crate::discrepancy::model::{Drive, State, free_run, k_step};
 use crate::discrepancy::{AugmentedModel, Baseline, Record, Restoring};
 use crate::models::{LpvModel, Scheduling};
 use crate::planning::dof::Dof;
@@ -272,37 +272,32 @@ impl Predictor for AugmentedLpv {
     }
 
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {
-        let (len, n) = (rec.y.nrows(), self.n());
-        let mut out = DMatrix::from_element(len, n, f64::NAN);
         let Some(r) = self.record(rec) else {
-            return out;
+            return DMatrix::from_element(rec.y.nrows(), self.n(), f64::NAN);
         };
-        let k = k.max(1);
         let drives: Vec<Drive> = self.models.iter().map(|m| m.drive(&r)).collect();
-        for t in k..len {
-            let mut x = self.models[0].measured_state(&r, t - k);
-            for s in t - k..t {
-                x = self.step(&r, &drives, s, &x);
-            }
-            out.row_mut(t).copy_from_slice(&x.nu);
-        }
-        out
+        let first = &self.models[0];
+        k_step(
+            &r,
+            self.n(),
+            k,
+            |r, t| first.measured_state(r, t),
+            |s, x| self.step(&r, &drives, s, x),
+        )
     }
 
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
-        let (len, n) = (rec.y.nrows(), self.n());
-        let Some(r) = self.record(rec).filter(|_| len > 0) else {
-            return DMatrix::from_element(len, n, f64::NAN);
+        let Some(r) = self.record(rec) else {
+            return DMatrix::from_element(rec.y.nrows(), self.n(), f64::NAN);
         };
         let drives: Vec<Drive> = self.models.iter().map(|m| m.drive(&r)).collect();
-        let mut out = DMatrix::zeros(len, n);
-        let mut x = self.models[0].measured_state(&r, 0);
-        out.row_mut(0).copy_from_slice(&x.nu);
-        for k in 0..len - 1 {
-            x = self.step(&r, &drives, k, &x);
-            out.row_mut(k + 1).copy_from_slice(&x.nu);
-        }
-        out
+        let first = &self.models[0];
+        free_run(
+            &r,
+            self.n(),
+            |r, t| first.measured_state(r, t),
+            |k, x| self.step(&r, &drives, k, x),
+        )
     }
 }
 

@@ -13,6 +13,7 @@ use crate::validation::ChannelValidation;
 
 pub use crate::discrepancy::discover::FIT_NOISE;
 use crate::discrepancy::discover::fit_gain;
+use crate::discrepancy::model::inertia_floor;
 
 /// Whether the augmented model is kept, and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -90,8 +91,7 @@ pub fn inertia_verdict(doc: &ModelDocument) -> Option<HeldOutVerdict> {
         if p.m.iter().any(|r| r.len() != n) {
             continue;
         }
-        let m = DMatrix::from_fn(n, n, |i, j| 0.5 * (p.m[i][j] + p.m[j][i]));
-        let low = m.symmetric_eigenvalues().min();
+        let low = inertia_floor(&DMatrix::from_fn(n, n, |i, j| p.m[i][j]));
         if low.is_nan() || low <= 0.0 {
             bad.push(format!(
                 "at {} m/s (smallest eigenvalue of ½(M + Mᵀ): {})",
