@@ -21,6 +21,7 @@ use super::candidates::{Effect, TermContext};
 use super::data::{Baseline, Record};
 use super::model::{AugmentedModel, ModelTerm, actuate};
 use super::svf::{Svf, lag_zoh};
+use crate::planning::Dof;
 
 /// A hypothesis term with its shape parameter fixed (actuator effects).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -221,7 +222,10 @@ impl<'a> Prepared<'a> {
                 .collect();
             Rc::new(self.svf.foh(&raw))
         };
-        if matches!(effect, Effect::CoriolisFromM | Effect::Current) {
+        if effect == Effect::Current {
+            return self.current_regressor(pi, r, run, ctx);
+        }
+        if effect == Effect::CoriolisFromM {
             return compute();
         }
         let key = (effect, pi, r, run);
@@ -231,6 +235,56 @@ impl<'a> Prepared<'a> {
         let f = compute();
         self.regressors.borrow_mut().insert(key, Rc::clone(&f));
         f
+    }
+
+    /// The current's filtered regressor for coefficient `p` in row `r`.
+    /// It is −d_u cos ψ + d_v sin ψ + m_u r sin ψ + m_v r cos ψ (north) and
+    /// −d_v cos ψ − d_u sin ψ + m_v r sin ψ − m_u r cos ψ (east), with
+    /// d, m the row's surge and sway entries of D̄, M: linear in them, and
+    /// the λ filter is linear, so the four filtered data signals are kept
+    /// per run and only combined here (the fixed point on D̄, M refits
+    /// every hypothesis that carries a current several times).
+    fn current_regressor(
+        &self,
+        p: usize,
+        r: usize,
+        run: usize,
+        ctx: &TermContext<'_>,
+    ) -> Rc<Vec<f64>> {
+        let rec = &self.records[run];
+        let (Some(iu), Some(iv)) = (ctx.index(Dof::Surge), ctx.index(Dof::Sway)) else {
+            return Rc::new(vec![0.0; rec.len()]);
+        };
+        let yaw = ctx.index(Dof::Yaw);
+        let basis = |b: usize| {
+            let key = (Effect::Current, b, usize::MAX, run);
+            if let Some(f) = self.regressors.borrow().get(&key) {
+                return Rc::clone(f);
+            }
+            let raw: Vec<f64> = (0..rec.len())
+                .map(|k| {
+                    let (s, c) = rec.eta[(k, 5)].sin_cos();
+                    let rate = yaw.map_or(0.0, |j| rec.nu[(k, j)]);
+                    [c, s, rate * s, rate * c][b]
+                })
+                .collect();
+            let f = Rc::new(self.svf.foh(&raw));
+            self.regressors.borrow_mut().insert(key, Rc::clone(&f));
+            f
+        };
+        let (du, dv) = (ctx.d_ref[(r, iu)], ctx.d_ref[(r, iv)]);
+        let (mu, mv) = (ctx.m_ref[(r, iu)], ctx.m_ref[(r, iv)]);
+        let coef = if p == 0 {
+            [-du, dv, mu, mv]
+        } else {
+            [-dv, -du, mv, -mu]
+        };
+        let signals: Vec<Rc<Vec<f64>>> = (0..4).map(basis).collect();
+        Rc::new(
+            (0..rec.len())
+                .map(|k| (0..4).map(|b| coef[b] * signals[b][k]).sum())
+                .collect(),
+        )
     }
 
     /// Columns of row `r` a fit of `rows` frees: the baseline's free
@@ -959,4 +1013,83 @@ pub(crate) fn profile(
         sse: s0,
         n,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::discrepancy::candidates::TermContext;
+
+    #[test]
+    fn the_current_regressor_from_kept_signals_is_the_filtered_direct_one() {
+        // A turning run: ψ sweeps, r varies; a coupled D̄, M. The combined
+        // cached signals equal filtering the regressor sample by sample.
+        let dofs = Dof::ALL.to_vec();
+        let n = 400;
+        let h = 0.1;
+        let mut nu = DMatrix::zeros(n, 6);
+        let mut eta = DMatrix::zeros(n, 6);
+        for k in 0..n {
+            let t = k as f64 * h;
+            nu[(k, 0)] = 0.5 + 0.1 * (0.3 * t).sin();
+            nu[(k, 1)] = 0.05 * (0.7 * t).cos();
+            nu[(k, 5)] = 0.2 * (0.1 * t).sin();
+            eta[(k, 5)] = 2.0 * (1.0 - (0.1 * t).cos());
+        }
+        let rec = Record {
+            name: "turn".into(),
+            h,
+            tau: DMatrix::zeros(n, 6),
+            nu,
+            eta,
+        };
+        let m = DMatrix::from_fn(6, 6, |i, j| {
+            if i == j {
+                100.0 + i as f64
+            } else {
+                3.0 * (i + 2 * j) as f64
+            }
+        });
+        let d = DMatrix::from_fn(6, 6, |i, j| {
+            if i == j {
+                40.0
+            } else {
+                (i as f64 - j as f64) * 2.5
+            }
+        });
+        let baseline = Baseline {
+            dofs: dofs.clone(),
+            m: m.clone(),
+            d_bar: d.clone(),
+            restoring: Default::default(),
+        };
+        let records = [rec];
+        let prep = Prepared::new(&baseline, &records, 0.5, 10, 5).expect("prepared");
+        let ctx = TermContext {
+            dofs: &dofs,
+            m_ref: &m,
+            d_ref: &d,
+        };
+        for r in 0..6 {
+            for p in 0..2 {
+                let raw: Vec<f64> = (0..n)
+                    .map(|k| {
+                        let v: Vec<f64> = (0..6).map(|j| records[0].nu[(k, j)]).collect();
+                        Effect::Current.regressor(p, r, &ctx, &v, &records[0].eta_at(k))
+                    })
+                    .collect();
+                let direct = prep.svf.foh(&raw);
+                let kept = prep.filtered_regressor(Effect::Current, p, r, 0, &ctx);
+                let scale = direct.iter().fold(1e-12_f64, |a, x| a.max(x.abs()));
+                for k in 0..n {
+                    assert!(
+                        (kept[k] - direct[k]).abs() < 1e-9 * scale,
+                        "row {r}, coefficient {p}, sample {k}: {} vs {}",
+                        kept[k],
+                        direct[k]
+                    );
+                }
+            }
+        }
+    }
 }
