@@ -145,7 +145,10 @@ fn thrust_limits(vessel: &Vessel, env: &Envelope) -> Vector6<f64> {
     let g = vessel.restoring(&Vector6::new(0.0, 0.0, 0.0, tilt, tilt, 0.0));
     Vector6::from_fn(|i, _| {
         let accel = m[(i, i)] * speed(i) * BANDWIDTH[i];
-        2.0 * (worst[i] + accel + g[i].abs().max(vessel.w_minus_b.abs()) + vessel.tether[i].abs())
+        2.0 * (worst[i]
+            + accel
+            + g[i].abs().max(vessel.w_minus_b.abs())
+            + (vessel.tether[i].abs() + vessel.tether_ned.norm()))
     })
 }
 

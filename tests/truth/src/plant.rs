@@ -124,7 +124,9 @@ impl Plant {
             (x.nu, coriolis_force(&self.m, &x.nu))
         };
         let hydro = coriolis + v.damping_force(&nu_r) + restoring;
-        let mut nu_dot = self.m_inv * (tau + v.tether - hydro);
+        let pull = r.transpose() * v.tether_ned;
+        let tether = v.tether + Vector6::new(pull.x, pull.y, pull.z, 0.0, 0.0, 0.0);
+        let mut nu_dot = self.m_inv * (tau + tether - hydro);
         if self.has_current {
             let nu_c = x.nu - nu_r;
             let c1 = Vector3::new(nu_c[0], nu_c[1], nu_c[2]);
@@ -172,5 +174,37 @@ impl Plant {
     /// Kinetic energy ½ νᵀ M ν with M = M_RB + M_A (Fossen 2011, ch. 3).
     pub fn kinetic_energy(&self, nu: &Vector6<f64>) -> f64 {
         0.5 * nu.dot(&(self.m * nu))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tether_fixed_in_ned_turns_with_the_heading() {
+        // A 100 N pull to the north on a vessel at rest, neutral and level:
+        // heading north it is a surge force, heading east (ψ = π/2) a sway
+        // force to port (−y), so M ν̇ = (0, −100, 0, …).
+        let mut v = Vessel::surveyor_like();
+        v.w_minus_b = 0.0;
+        v.tether_ned = Vector3::new(100.0, 0.0, 0.0);
+        let plant = Plant::new(&v);
+        let m = v.m();
+        for (psi, want) in [
+            (0.0, [100.0, 0.0]),
+            (std::f64::consts::FRAC_PI_2, [0.0, -100.0]),
+        ] {
+            let x = State::new(
+                Vector6::new(0.0, 0.0, 10.0, 0.0, 0.0, psi),
+                Vector6::zeros(),
+            );
+            let f = m * plant.derivative(&x, &Vector6::zeros()).nu;
+            assert!(
+                (f[0] - want[0]).abs() < 1e-6 && (f[1] - want[1]).abs() < 1e-6,
+                "ψ = {psi}: {f}"
+            );
+            assert!(f.rows(2, 4).norm() < 1e-6, "ψ = {psi}: {f}");
+        }
     }
 }

@@ -52,6 +52,10 @@ pub struct Vessel {
     pub current_ned: Vector3<f64>,
     /// Constant tether force/moment in the body frame, added to τ (N, N·m).
     pub tether: Vector6<f64>,
+    /// A tether pull fixed in NED (N), acting at the body origin: the cable
+    /// leads to the ship, so in the body frame it turns with the heading,
+    /// τ_t = [R(Θ)ᵀ f_n; 0] (Fossen 2011, eq. 2.18 rotation).
+    pub tether_ned: Vector3<f64>,
     /// Actuator lag and limits; ideal by default.
     pub actuator: Actuator,
     /// Overall length, beam and height (m), for scaling amplitudes and limits.

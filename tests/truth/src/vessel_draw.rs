@@ -118,6 +118,7 @@ impl Vessel {
             gravity: GRAVITY,
             current_ned: Vector3::zeros(),
             tether: Vector6::zeros(),
+            tether_ned: Vector3::zeros(),
             actuator: Actuator::default(),
             size: Vector3::new(l, b, h),
         };
@@ -165,6 +166,7 @@ impl Vessel {
             gravity: GRAVITY,
             current_ned: Vector3::zeros(),
             tether: Vector6::zeros(),
+            tether_ned: Vector3::zeros(),
             actuator: Actuator::default(),
             size: Vector3::new(l, b, h),
         };

@@ -79,6 +79,12 @@ pub enum Effect {
     /// Ocean current: damping acts on ν − ν_c with ν_c = R(ψ)ᵀ[V_N V_E]ᵀ;
     /// two coefficients (north and east current, m/s) shared by all DOFs.
     Current,
+    /// A horizontal pull fixed in NED at the body origin — a tether leading
+    /// to the ship, a towed load: τ_t = R(Θ)ᵀ[F_N F_E 0]ᵀ in surge and
+    /// sway, turning with the heading in the body frame; two coefficients
+    /// (north and east pull, N). Unlike a current it does not scale with
+    /// the damping.
+    TetherPull,
     /// Coupling a diagonal baseline misses: M_ij ν̇_j + D̄_ij ν_j in DOF i.
     Coupling {
         /// The equation i.
@@ -130,6 +136,8 @@ pub enum Family {
     ConstantLoad,
     /// Ocean current.
     Current,
+    /// A pull fixed in NED (tether to the ship).
+    Tether,
     /// Missing off-diagonal M, D̄.
     Coupling,
     /// Actuator lag.
@@ -153,6 +161,7 @@ impl Family {
             Family::Restoring => "restoring force",
             Family::ConstantLoad => "constant load (tether)",
             Family::Current => "ocean current",
+            Family::Tether => "tether pull (fixed in NED)",
             Family::Coupling => "missing coupling",
             Family::ActuatorLag => "actuator lag",
             Family::InputDelay => "input delay",
@@ -218,6 +227,7 @@ impl Effect {
             Effect::Restoring { .. } => Family::Restoring,
             Effect::ConstantLoad { .. } => Family::ConstantLoad,
             Effect::Current => Family::Current,
+            Effect::TetherPull => Family::Tether,
             Effect::Coupling { .. } => Family::Coupling,
             Effect::ActuatorLag { .. } => Family::ActuatorLag,
             Effect::InputDelay { .. } | Effect::CommonInputDelay => Family::InputDelay,
@@ -240,7 +250,10 @@ impl Effect {
             | Effect::InputDelay { dof }
             | Effect::Saturation { dof }
             | Effect::DeadZone { dof } => Some(dof),
-            Effect::CoriolisFromM | Effect::Current | Effect::CommonInputDelay => None,
+            Effect::CoriolisFromM
+            | Effect::Current
+            | Effect::TetherPull
+            | Effect::CommonInputDelay => None,
         }
     }
 
@@ -264,7 +277,7 @@ impl Effect {
     /// Number of coefficients that enter linearly.
     pub fn n_linear(&self) -> usize {
         match self {
-            Effect::Current | Effect::Coupling { .. } => 2,
+            Effect::Current | Effect::TetherPull | Effect::Coupling { .. } => 2,
             e if e.shape().is_some() => 0,
             _ => 1,
         }
@@ -322,6 +335,7 @@ impl Effect {
                 vec![format!("constant {} load ({})", dof.name(), unit(dof))]
             }
             Effect::Current => vec!["V_N (m/s)".into(), "V_E (m/s)".into()],
+            Effect::TetherPull => vec!["F_N (N)".into(), "F_E (N)".into()],
             Effect::Coupling { dof, from } => vec![
                 format!("M_{}{}", dof.velocity_symbol(), from.velocity_symbol()),
                 format!("D̄_{}{}", dof.velocity_symbol(), from.velocity_symbol()),
@@ -370,6 +384,7 @@ impl Effect {
                 )
             }
             Effect::Current => "ocean current (relative velocity ν − ν_c)".into(),
+            Effect::TetherPull => "tether pull fixed in NED (turns with heading)".into(),
             Effect::Coupling { dof, from } => {
                 format!("missing coupling from {} into {}", from.name(), dof.name())
             }
@@ -390,6 +405,10 @@ impl Effect {
                 (Some(iu), Some(iv)) => (0..dofs.len())
                     .filter(|&i| d_ref[(i, iu)] != 0.0 || d_ref[(i, iv)] != 0.0)
                     .collect(),
+                _ => vec![],
+            },
+            Effect::TetherPull => match (idx(Dof::Surge), idx(Dof::Sway)) {
+                (Some(iu), Some(iv)) => vec![iu.min(iv), iu.max(iv)],
                 _ => vec![],
             },
             _ => self.dof().and_then(idx).into_iter().collect(),
@@ -445,6 +464,20 @@ impl Effect {
                 } else {
                     -(du * s + dv * c) - r * (mu * c - mv * s)
                 }
+            }
+            Effect::TetherPull => {
+                // Columns of R(Θ) = R_z(ψ)R_y(θ)R_x(φ) are the body axes in
+                // NED: the pull's body components are their dot products
+                // with [F_N F_E 0], moved to the left-hand side.
+                let (sp, cp) = eta[3].sin_cos();
+                let (st, ct) = eta[4].sin_cos();
+                let (ss, cs) = eta[5].sin_cos();
+                let axis = match row_dof {
+                    Dof::Surge => [cs * ct, ss * ct],
+                    Dof::Sway => [cs * st * sp - ss * cp, ss * st * sp + cs * cp],
+                    _ => return 0.0,
+                };
+                -axis[p.min(1)]
             }
             _ => 0.0,
         }
@@ -529,6 +562,8 @@ pub struct LibrarySettings {
     pub constant_load: bool,
     /// Ocean current (needs surge and sway).
     pub current: bool,
+    /// A tether pull fixed in NED (needs surge and sway).
+    pub tether_pull: bool,
     /// Off-diagonal M, D̄ entries the baseline lacks.
     pub coupling: bool,
     /// Actuator lag per DOF.
@@ -551,6 +586,7 @@ impl Default for LibrarySettings {
             restoring: true,
             constant_load: true,
             current: true,
+            tether_pull: true,
             coupling: true,
             actuator_lag: true,
             input_delay: true,
@@ -628,6 +664,9 @@ pub fn library(
     if s.current && has(Dof::Surge) && has(Dof::Sway) {
         out.push(Effect::Current);
     }
+    if s.tether_pull && has(Dof::Surge) && has(Dof::Sway) {
+        out.push(Effect::TetherPull);
+    }
     if s.coupling {
         for (i, &dof) in dofs.iter().enumerate() {
             for (j, &from) in dofs.iter().enumerate() {
@@ -661,6 +700,45 @@ mod tests {
     }
 
     #[test]
+    fn a_tether_pull_is_the_ned_force_seen_in_the_body_frame() {
+        // f_b = R(Θ)ᵀ f_n with R from nalgebra's roll–pitch–yaw (z-y-x)
+        // rotation; the regressor is the left-hand side, −f_b per newton.
+        let dofs = Dof::ALL.to_vec();
+        let z = DMatrix::zeros(6, 6);
+        let ctx = TermContext {
+            dofs: &dofs,
+            m_ref: &z,
+            d_ref: &z,
+        };
+        let f_n = nalgebra::Vector3::new(120.0, -45.0, 0.0);
+        for eta in [
+            [0.0, 0.0, 10.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 10.0, 0.2, -0.15, 2.4],
+            [0.0, 0.0, 10.0, -0.1, 0.3, -1.1],
+        ] {
+            let r = nalgebra::Rotation3::from_euler_angles(eta[3], eta[4], eta[5]);
+            let f_b = r.transpose() * f_n;
+            for (row, want) in [(0, f_b.x), (1, f_b.y)] {
+                let got: f64 = (0..2)
+                    .map(|p| Effect::TetherPull.regressor(p, row, &ctx, &[0.0; 6], &eta) * f_n[p])
+                    .sum();
+                assert!(
+                    (got + want).abs() < 1e-9,
+                    "row {row} at {eta:?}: {got} vs −{want}"
+                );
+            }
+            for row in 2..6 {
+                assert_eq!(
+                    Effect::TetherPull.regressor(0, row, &ctx, &[0.0; 6], &eta),
+                    0.0
+                );
+            }
+        }
+        assert_eq!(Effect::TetherPull.rows(&dofs, &z), vec![0, 1]);
+        assert_eq!(Effect::TetherPull.family(), Family::Tether);
+    }
+
+    #[test]
     fn library_lists_coupling_only_where_the_baseline_has_none() {
         let dofs = vec![Dof::Surge, Dof::Sway, Dof::Yaw];
         let mut m = DMatrix::identity(3, 3);
@@ -676,6 +754,7 @@ mod tests {
             from: Dof::Sway
         }));
         assert!(lib.contains(&Effect::Current));
+        assert!(lib.contains(&Effect::TetherPull));
         assert!(lib.contains(&Effect::CoriolisProduct {
             dof: Dof::Yaw,
             a: Dof::Surge,

@@ -110,6 +110,17 @@ pub(crate) fn effect_text(t: &ModelTerm, h: f64) -> String {
                 pm(e, std_of(t, 1))
             )
         }
+        Effect::TetherPull => {
+            let (n, e) = (c(0), c(1));
+            let to = e.atan2(n).to_degrees().rem_euclid(360.0);
+            format!(
+                "A pull of {} N fixed in NED towards {:.0}° (north {}, east {} N) acts on the hull, as a tether leading to the ship does.",
+                sig(n.hypot(e)),
+                to,
+                pm(n, std_of(t, 0)),
+                pm(e, std_of(t, 1))
+            )
+        }
         Effect::Coupling { dof, from } => format!(
             "{} couples into {}: M_{i}{j} = {}, D̄_{i}{j} = {}.",
             super::locate::capital(from.name()),
@@ -260,7 +271,13 @@ pub(crate) fn separating_evidence(
         }
         (Effect::Current, _) => {
             out.push(format!(
-                "The runs cover {:.0} % of the compass; the fitted load turns with heading in the body frame, which a tether or bias cannot.",
+                "The runs cover {:.0} % of the compass; the fitted load turns with heading in the body frame, which a bias cannot, and scales with the damping, which a tether's pull does not.",
+                100.0 * heading_coverage(runs)
+            ));
+        }
+        (Effect::TetherPull, _) => {
+            out.push(format!(
+                "The runs cover {:.0} % of the compass; the fitted pull turns with heading in the body frame, which a bias cannot, and does not scale with the damping, which a current would.",
                 100.0 * heading_coverage(runs)
             ));
         }

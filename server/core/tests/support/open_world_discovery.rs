@@ -15,6 +15,7 @@ use seatrial_core::identification::LambdaCampaignSettings;
 use seatrial_core::identification::discover_campaign::{
     DiscoverCampaignSettings, discover_campaign,
 };
+use seatrial_core::numbers::sig3;
 use seatrial_core::planning::dof::Dof;
 use seatrial_core::validation::nrmse_fit;
 use seatrial_truth::{Campaign, CampaignSpec, Vessel, fly_campaign, true_predictions};
@@ -28,8 +29,10 @@ pub enum Concealed {
     Clean,
     /// A steady current of 0.25 m/s north, 0.15 m/s east.
     Current,
-    /// A constant sway force of 0.05 N per kg of the vessel's mass (250 N
-    /// on a 5 t ROV), as a tether pulls.
+    /// A tether pull fixed in NED (it leads to the ship), of 30 % of the
+    /// clean campaign's RMS sway command, towards a bearing drawn from the
+    /// seed: in the body frame it turns with the heading, which the
+    /// baseline's constant loads cannot follow.
     Tether,
     /// Thrusters following the command through a 0.4 s first-order lag in
     /// every DOF.
@@ -63,16 +66,50 @@ impl Concealed {
     }
 
     /// Whether `e` names this effect (`Some(true)`), a look-alike at the
-    /// right place (`Some(false)`: lag ↔ delay), or something else (`None`).
+    /// right place (`Some(false)`: lag ↔ delay, a body-fixed load for the
+    /// tether's pull, cubic for quadratic drag in the same DOF), or
+    /// something else (`None`).
     pub fn names(self, e: &Effect) -> Option<bool> {
         match (self, e) {
             (Concealed::Current, Effect::Current) => Some(true),
-            (Concealed::Tether, Effect::ConstantLoad { dof: Dof::Sway }) => Some(true),
+            (Concealed::Tether, Effect::TetherPull) => Some(true),
+            (
+                Concealed::Tether,
+                Effect::ConstantLoad {
+                    dof: Dof::Surge | Dof::Sway,
+                },
+            ) => Some(false),
             (Concealed::Lag, Effect::ActuatorLag { .. }) => Some(true),
             (Concealed::Lag, Effect::InputDelay { .. } | Effect::CommonInputDelay) => Some(false),
             (Concealed::Saturation, Effect::Saturation { dof: Dof::Heave }) => Some(true),
             (Concealed::QuadraticSway, Effect::QuadraticDamping { dof: Dof::Sway }) => Some(true),
+            (Concealed::QuadraticSway, Effect::CubicDamping { dof: Dof::Sway }) => Some(false),
             _ => None,
+        }
+    }
+
+    /// The concealed effect's true size in the units discovery reports.
+    fn truth_text(self, vessel: &Vessel) -> String {
+        match self {
+            Concealed::Clean => "none concealed".into(),
+            Concealed::Current => format!(
+                "V_N {:.3}, V_E {:.3} m/s",
+                vessel.current_ned.x, vessel.current_ned.y
+            ),
+            Concealed::Tether => format!(
+                "F_N {:.1}, F_E {:.1} N",
+                vessel.tether_ned.x, vessel.tether_ned.y
+            ),
+            Concealed::Lag => "T_a 0.4 s in every DOF".into(),
+            Concealed::Saturation => format!(
+                "heave τ_max {:.1} N",
+                vessel.actuator.limits.map_or(f64::NAN, |l| l[2])
+            ),
+            Concealed::QuadraticSway => format!(
+                "d_v|v| {:.1} N·s²/m² (drawn {:.1})",
+                vessel.damping_quadratic[1],
+                vessel.damping_quadratic[1] / 4.0
+            ),
         }
     }
 
@@ -81,7 +118,15 @@ impl Concealed {
         match self {
             Concealed::Clean => {}
             Concealed::Current => vessel.current_ned = Vector3::new(0.25, 0.15, 0.0),
-            Concealed::Tether => vessel.tether[1] = 0.05 * vessel.mass,
+            Concealed::Tether => {
+                let (sum, n) = clean.runs.iter().fold((0.0, 0usize), |(s, n), r| {
+                    let c = r.log.tau.column(1);
+                    (s + c.iter().map(|x| x * x).sum::<f64>(), n + c.len())
+                });
+                let size = 0.3 * (sum / n.max(1) as f64).sqrt();
+                let bearing = (seed_bearing(vessel.mass)).to_radians();
+                vessel.tether_ned = Vector3::new(size * bearing.cos(), size * bearing.sin(), 0.0);
+            }
             Concealed::Lag => vessel.actuator.lag_s = Some(Vector6::repeat(0.4)),
             Concealed::Saturation => {
                 let peak = clean
@@ -95,6 +140,59 @@ impl Concealed {
             }
             Concealed::QuadraticSway => vessel.damping_quadratic[1] *= 4.0,
         }
+    }
+}
+
+/// A bearing (°) from the drawn vessel, so each seed pulls its own way.
+fn seed_bearing(mass: f64) -> f64 {
+    (mass * 137.508).rem_euclid(360.0)
+}
+
+/// Whether the truth has `e` as physics of its own, beyond the concealed
+/// effect: quadratic damping in every DOF (a cubic term approximates it),
+/// linear damping growing with |u| (cross-flow |u|ν_i), C(ν)ν from M, g(η),
+/// the heave load W − B, and the couplings z_G puts in M_RB. Naming one of
+/// these is not a false label, though it is not the concealed effect.
+pub fn in_truth(vessel: &Vessel, e: &Effect) -> bool {
+    let i = |d: Dof| d.index();
+    match *e {
+        Effect::QuadraticDamping { dof } | Effect::CubicDamping { dof } => {
+            vessel.damping_quadratic[i(dof)] > 0.0
+        }
+        Effect::CrossDamping {
+            dof,
+            from: Dof::Surge,
+        } => vessel.damping_linear_per_speed[i(dof)] > 0.0,
+        Effect::CoriolisFromM | Effect::CoriolisProduct { .. } | Effect::Restoring { .. } => true,
+        Effect::ConstantLoad { dof: Dof::Heave } => vessel.w_minus_b != 0.0,
+        Effect::Coupling { dof, from } => {
+            let m = vessel.m();
+            m[(i(dof), i(from))] != 0.0
+        }
+        _ => false,
+    }
+}
+
+/// The truth's own value of a coefficient discovery reports for physics
+/// the truth has: a Coriolis product's coefficient (the mixed term of the
+/// quadratic C(ν)ν, Fossen 2011 eq. 6.43, from the truth's M) or a
+/// quadratic damping coefficient.
+pub fn truth_coefficient(vessel: &Vessel, e: &Effect) -> Option<f64> {
+    match *e {
+        Effect::CoriolisProduct { dof, a, b } if a != b => {
+            let m = vessel.m();
+            let f = |i: Option<usize>, j: Option<usize>| {
+                let mut nu = Vector6::zeros();
+                for k in [i, j].into_iter().flatten() {
+                    nu[k] = 1.0;
+                }
+                seatrial_truth::forces::coriolis_force(&m, &nu)[dof.index()]
+            };
+            let (ia, ib) = (Some(a.index()), Some(b.index()));
+            Some(f(ia, ib) - f(ia, None) - f(None, ib) + f(None, None))
+        }
+        Effect::QuadraticDamping { dof } => Some(vessel.damping_quadratic[dof.index()]),
+        _ => None,
     }
 }
 
@@ -128,6 +226,17 @@ pub struct DiscoveryCase {
     /// Effects across the grid in the report's order: label, grid speeds,
     /// and whether it names the concealed effect.
     pub named: Vec<(String, usize, Option<bool>)>,
+    /// Per named effect (same order): physics the truth has anyway
+    /// ([`in_truth`]).
+    pub in_truth: Vec<bool>,
+    /// Per named effect (same order): its estimates at each grid speed
+    /// that chose it, "speed: name value ± std, …".
+    pub estimates: Vec<Vec<String>>,
+    /// The concealed effect's true size.
+    pub truth_size: String,
+    /// The first-named effect's values (coefficients, then shape) at each
+    /// grid speed that chose it.
+    pub first_values: Vec<Vec<f64>>,
     /// Per named effect (same order): whether the stored model keeps it,
     /// and the held-out verdict that decided it.
     pub kept: Vec<(Option<bool>, Option<String>)>,
@@ -136,21 +245,53 @@ pub struct DiscoveryCase {
     /// The gate's sentence.
     pub verdict: String,
     pub gaps: Vec<GapRow>,
+    /// Per named effect (same order): the truth's value of its first
+    /// coefficient where the truth has it ([`truth_coefficient`]).
+    pub truth_values: Vec<Option<f64>>,
+    /// The true vessel, effect switched on.
+    pub vessel: Vessel,
     /// Seconds spent flying the truth, identifying, discovering.
     pub secs: [f64; 3],
 }
 
 impl DiscoveryCase {
     /// hit: the concealed effect named first; partial: its look-alike
-    /// first; false: a physical label on the clean case; miss otherwise.
+    /// first; on the clean case, "clean ✓" when nothing is named, "truth ✓"
+    /// when all that is named is physics the truth has ([`in_truth`]), and
+    /// false otherwise; miss otherwise.
     pub fn score(&self) -> &'static str {
         match (self.concealed, self.named.first()) {
             (Concealed::Clean, None) => "clean ✓",
+            (Concealed::Clean, Some(_)) if self.false_labels().is_empty() => "truth ✓",
             (Concealed::Clean, Some(_)) => "false",
             (_, Some((_, _, Some(true)))) => "hit",
             (_, Some((_, _, Some(false)))) => "partial",
             _ => "miss",
         }
+    }
+
+    /// Named effects that are neither the concealed one (or its
+    /// look-alike) nor physics the truth has.
+    pub fn false_labels(&self) -> Vec<&str> {
+        self.named
+            .iter()
+            .zip(&self.in_truth)
+            .filter(|((_, _, hit), t)| hit.is_none() && !**t)
+            .map(|((l, _, _), _)| l.as_str())
+            .collect()
+    }
+
+    /// False labels the stored model keeps.
+    pub fn false_kept(&self) -> Vec<&str> {
+        self.named
+            .iter()
+            .zip(&self.in_truth)
+            .zip(&self.kept)
+            .filter(|(((_, _, hit), t), k)| {
+                hit.is_none() && !**t && k.0 == Some(true) && self.stored
+            })
+            .map(|(((l, _, _), _), _)| l.as_str())
+            .collect()
     }
 }
 
@@ -205,6 +346,55 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
             )
         })
         .collect();
+    let in_truth = out
+        .report
+        .effects
+        .iter()
+        .map(|e| in_truth(&vessel, &e.effect))
+        .collect();
+    let estimates = out
+        .report
+        .effects
+        .iter()
+        .map(|e| {
+            out.report
+                .points
+                .iter()
+                .filter_map(|p| {
+                    let f = p.report.findings.iter().find(|f| f.effect == e.effect)?;
+                    let est: Vec<String> = f
+                        .coefficients
+                        .iter()
+                        .chain(&f.shape)
+                        .map(|c| {
+                            let std = c.std.map_or(String::new(), |s| format!(" ± {}", sig3(s)));
+                            format!("{} {}{std}", c.name, sig3(c.value))
+                        })
+                        .collect();
+                    Some(format!("{:.2} m/s: {}", p.grid_speed_mps, est.join(", ")))
+                })
+                .collect()
+        })
+        .collect();
+    let first_values = out
+        .report
+        .effects
+        .first()
+        .map(|e| {
+            out.report
+                .points
+                .iter()
+                .filter_map(|p| p.report.findings.iter().find(|f| f.effect == e.effect))
+                .map(|f| {
+                    f.coefficients
+                        .iter()
+                        .chain(&f.shape)
+                        .map(|c| c.value)
+                        .collect()
+                })
+                .collect()
+        })
+        .unwrap_or_default();
     let kept = out
         .report
         .effects
@@ -244,6 +434,17 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         concealed,
         seed,
         named,
+        in_truth,
+        estimates,
+        truth_size: concealed.truth_text(&vessel),
+        first_values,
+        truth_values: out
+            .report
+            .effects
+            .iter()
+            .map(|e| truth_coefficient(&vessel, &e.effect))
+            .collect(),
+        vessel: vessel.clone(),
         kept,
         grid_points: spec.grid_speeds.len(),
         stored: out.augmented.is_some(),
@@ -311,6 +512,39 @@ pub fn format_cases(cases: &[DiscoveryCase]) -> String {
             .collect();
         if c.stored {
             s += &format!("    kept: {}\n", kept.join("; "));
+        }
+        if let (Some((label, _, _)), Some(est)) = (c.named.first(), c.estimates.first()) {
+            s += &format!(
+                "    first named, {label}: {} — truth: {}\n",
+                est.join("; "),
+                c.truth_size
+            );
+        }
+        if std::env::var_os("ESTIMATES").is_some() {
+            for ((label, _, _), est) in c.named.iter().zip(&c.estimates).skip(1) {
+                s += &format!("    also {label}: {}\n", est.join("; "));
+            }
+        }
+        for (((label, _, _), est), t) in c.named.iter().zip(&c.estimates).zip(&c.truth_values) {
+            if let Some(t) = t {
+                s += &format!(
+                    "    in the truth, {label}: {} — truth {}\n",
+                    est.join("; "),
+                    sig3(*t)
+                );
+            }
+        }
+        let false_named = c.false_labels();
+        if !false_named.is_empty() {
+            s += &format!(
+                "    named, absent from the truth: {} (kept: {})\n",
+                false_named.join("; "),
+                if c.false_kept().is_empty() {
+                    "none".to_string()
+                } else {
+                    c.false_kept().join("; ")
+                }
+            );
         }
         if let (Some((label, _, _)), Some((Some(false), Some(why)))) =
             (c.named.first(), c.kept.first())

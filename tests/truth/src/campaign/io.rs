@@ -145,6 +145,7 @@ impl Campaign {
             ("gravity", Json::Num(v.gravity)),
             ("current_ned", v3(&v.current_ned)),
             ("tether", v6(&v.tether)),
+            ("tether_ned", v3(&v.tether_ned)),
             (
                 "actuator_lag_s",
                 v.actuator.lag_s.as_ref().map_or(Json::Null, v6),
