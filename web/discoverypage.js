@@ -49,9 +49,9 @@ function locationSection(loc) {
 
 function hypothesesSection(hyps) {
   return h('div', { class: 'card', 'data-testid': 'hypotheses' },
-    h('h4', null, 'Hypotheses, ranked ', h('span', { class: 'hint' }, 'ΔBIC < 0 favours the term; z its significance; gain the held-out free-run fit it adds')),
+    h('h4', null, 'Hypotheses, ranked ', h('span', { class: 'hint' }, 'ΔBIC < 0 favours the term; z its significance; size its force against the command in its DOF (RMS); gain the held-out free-run fit it adds')),
     h('div', { class: 'table-x' }, h('table', { class: 'grid-table compact' },
-      h('thead', null, h('tr', null, h('th', null, '#'), h('th', null, 'Hypothesis'), h('th', null, 'Verdict'), h('th', { class: 'num' }, 'ΔBIC'), h('th', { class: 'num' }, 'z'), h('th', { class: 'num' }, 'held-out gain'), h('th', null, 'Estimates'))),
+      h('thead', null, h('tr', null, h('th', null, '#'), h('th', null, 'Hypothesis'), h('th', null, 'Verdict'), h('th', { class: 'num' }, 'ΔBIC'), h('th', { class: 'num' }, 'z'), h('th', { class: 'num', title: 'RMS of its force over RMS of the command in its DOF' }, 'size'), h('th', { class: 'num' }, 'held-out gain'), h('th', null, 'Estimates'))),
       h('tbody', null, hyps.map((x, i) => {
         const [cls, text] = VERDICT[x.verdict] || ['neutral', x.verdict];
         return h('tr', { 'data-testid': 'hypothesis-row', 'data-verdict': x.verdict },
@@ -60,6 +60,7 @@ function hypothesesSection(hyps) {
           h('td', null, h('span', { class: `badge ${cls}` }, text)),
           h('td', { class: 'num mono' }, fmt(x.delta_bic, 1)),
           h('td', { class: 'num mono' }, fmt(x.z, 1)),
+          h('td', { class: 'num mono', 'data-testid': 'hypothesis-size' }, x.force_share == null ? '–' : `${fmt(100 * x.force_share, 2)} %`),
           h('td', { class: 'num mono' }, x.cv_gain == null ? '–' : fmt(x.cv_gain, 3)),
           h('td', { class: 'mono small' }, [...(x.coefficients || []), ...(x.shape ? [x.shape] : [])].map(estimateText).join('; ')));
       })))));

@@ -74,6 +74,9 @@ test('discover the demo ROV\'s missing restoring from the model page and read th
     assert.ok(await point.evaluate((d) => d.open));
     assert.ok(await point.locator(tid('location-row')).count() === 6);
     assert.ok(await point.locator(tid('hypothesis-row')).count() > 1);
+    // Each hypothesis shows the size of its force against the command, in %.
+    const sizes = await point.locator(tid('hypothesis-size')).allTextContents();
+    assert.ok(sizes.length > 1 && sizes.every((t) => /^[0-9.e\u2212-]+ %$/.test(t)), sizes.join(', '));
     const labels = await point.locator(tid('finding-label')).allTextContents();
     assert.ok(labels.some((l) => /roll/.test(l)), labels.join(', '));
     assert.match(await point.locator(tid('finding-estimates')).first().textContent(), /±/);

@@ -118,7 +118,7 @@ impl ControllerConfig {
 /// Twice the largest |C(ν)ν + D(ν)ν|ᵢ over the envelope's corners (u_max plus
 /// one excited DOF at 1.5× its amplitude, attitude DOFs at their rate), plus
 /// Mᵢᵢ·speed·bandwidth for acceleration, the restoring force at 1.5× the
-/// attitude amplitude and the tether.
+/// attitude amplitude, the tether and the disturbance's amplitude.
 fn thrust_limits(vessel: &Vessel, env: &Envelope) -> Vector6<f64> {
     let m = vessel.m();
     let speed = |j: usize| {
@@ -145,10 +145,15 @@ fn thrust_limits(vessel: &Vessel, env: &Envelope) -> Vector6<f64> {
     let g = vessel.restoring(&Vector6::new(0.0, 0.0, 0.0, tilt, tilt, 0.0));
     Vector6::from_fn(|i, _| {
         let accel = m[(i, i)] * speed(i) * BANDWIDTH[i];
-        2.0 * (worst[i]
-            + accel
-            + g[i].abs().max(vessel.w_minus_b.abs())
-            + (vessel.tether[i].abs() + vessel.tether_ned.norm()))
+        let limit = 2.0
+            * (worst[i]
+                + accel
+                + g[i].abs().max(vessel.w_minus_b.abs())
+                + (vessel.tether[i].abs() + vessel.tether_ned.norm()));
+        match &vessel.disturbance {
+            Some(d) => limit + 2.0 * d.amplitude[i].abs(),
+            None => limit,
+        }
     })
 }
 

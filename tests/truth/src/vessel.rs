@@ -11,13 +11,109 @@ use crate::kinematics::skew;
 pub const GRAVITY: f64 = 9.81;
 
 /// Optional actuator effects between the command τ_cmd and the force τ that
-/// acts on the hull. Default: ideal (τ = τ_cmd).
+/// acts on the hull, in the order command → transport delay → dead zone →
+/// limits → lag → hull. Default: ideal (τ = τ_cmd).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Actuator {
     /// First-order lag time constants T_a per DOF (s): τ̇ = (τ_cmd − τ)/T_a.
     pub lag_s: Option<Vector6<f64>>,
     /// Thrust limits per DOF (N, N·m): τ_cmd is clipped to ±limit.
     pub limits: Option<Vector6<f64>>,
+    /// A pure transport delay d (s) of the command, the same in every DOF:
+    /// the hull sees τ_cmd(t − d). The plant has no memory of past
+    /// commands; whoever holds the command (the flyer,
+    /// [`crate::plant::DelayLine`]) delays it before it reaches
+    /// [`crate::plant::Plant`].
+    pub delay_s: Option<f64>,
+    /// Dead-zone half-widths δ per DOF (N, N·m): no thrust for
+    /// |τ_cmd| < δ, τ_cmd − sign(τ_cmd)·δ beyond (0: none).
+    pub dead_zone: Option<Vector6<f64>>,
+}
+
+impl Actuator {
+    /// The static part of the actuator map: the dead zone, then the limits.
+    pub fn shape(&self, tau_cmd: &Vector6<f64>) -> Vector6<f64> {
+        let after_dead_zone = match &self.dead_zone {
+            Some(d) => Vector6::from_fn(|i, _| dead_zone(tau_cmd[i], d[i])),
+            None => *tau_cmd,
+        };
+        match &self.limits {
+            Some(l) => Vector6::from_fn(|i, _| after_dead_zone[i].clamp(-l[i], l[i])),
+            None => after_dead_zone,
+        }
+    }
+}
+
+/// The dead-zone map of half-width `delta` ≥ 0: 0 for |x| < δ (and at
+/// |x| = δ), x − sign(x)·δ beyond; continuous, slope 1 outside the zone.
+pub fn dead_zone(x: f64, delta: f64) -> f64 {
+    if x > delta {
+        x - delta
+    } else if x < -delta {
+        x + delta
+    } else {
+        0.0
+    }
+}
+
+/// A current that drifts about its mean `Vessel::current_ned`, one slow
+/// sinusoid per NED axis:
+///   V_c(t) = V̄_c + Σ_k a_k sin(2π t / T_k + φ_k) e_k,
+///   V̇_c(t) = Σ_k a_k (2π / T_k) cos(2π t / T_k + φ_k) e_k,
+/// t on the control clock (s). Both its direction and its speed wander.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurrentDrift {
+    /// Amplitudes a_k per NED axis (m/s); 0 leaves the axis constant.
+    pub amplitude: Vector3<f64>,
+    /// Periods T_k (s), > 0 where the amplitude is not 0.
+    pub period_s: Vector3<f64>,
+    /// Phases φ_k (rad).
+    pub phase: Vector3<f64>,
+}
+
+impl CurrentDrift {
+    /// The drift V_c(t) − V̄_c (m/s).
+    pub fn offset(&self, t: f64) -> Vector3<f64> {
+        Vector3::from_fn(|k, _| {
+            let a = self.amplitude[k];
+            if a == 0.0 {
+                return 0.0;
+            }
+            a * (std::f64::consts::TAU * t / self.period_s[k] + self.phase[k]).sin()
+        })
+    }
+
+    /// Its rate V̇_c(t) (m/s²).
+    pub fn rate(&self, t: f64) -> Vector3<f64> {
+        Vector3::from_fn(|k, _| {
+            let a = self.amplitude[k];
+            if a == 0.0 {
+                return 0.0;
+            }
+            let w = std::f64::consts::TAU / self.period_s[k];
+            a * w * (w * t + self.phase[k]).cos()
+        })
+    }
+}
+
+/// A narrow-band disturbance fixed in the body frame, outside any library
+/// of hull physics (waves on a vehicle near the surface, a vortex-shedding
+/// tether, a pump): τ_d(t) = a sin(2π f t + φ), t on the control clock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Disturbance {
+    /// Amplitudes per DOF (N, N·m), body frame.
+    pub amplitude: Vector6<f64>,
+    /// Frequency f (Hz).
+    pub frequency_hz: f64,
+    /// Phase φ (rad).
+    pub phase: f64,
+}
+
+impl Disturbance {
+    /// τ_d(t) (N, N·m).
+    pub fn force(&self, t: f64) -> Vector6<f64> {
+        self.amplitude * (std::f64::consts::TAU * self.frequency_hz * t + self.phase).sin()
+    }
 }
 
 /// True parameters of a 6-DOF ROV.
@@ -48,8 +144,13 @@ pub struct Vessel {
     pub w_minus_b: f64,
     /// Gravity g (m/s²), W = m g.
     pub gravity: f64,
-    /// Constant ocean current in NED, V_c (m/s); zero by default.
+    /// Ocean current in NED, V_c (m/s), irrotational; zero by default.
+    /// Constant, or the mean of [`Vessel::current_drift`].
     pub current_ned: Vector3<f64>,
+    /// A slow drift of the current about `current_ned`; None: constant.
+    pub current_drift: Option<CurrentDrift>,
+    /// A narrow-band force in the body frame, added to τ; None: none.
+    pub disturbance: Option<Disturbance>,
     /// Constant tether force/moment in the body frame, added to τ (N, N·m).
     pub tether: Vector6<f64>,
     /// A tether pull fixed in NED (N), acting at the body origin: the cable
@@ -76,6 +177,33 @@ impl Vessel {
     /// z_G W − z_B B (N·m), the metacentric restoring moment coefficient.
     pub fn zg_w_minus_zb_b(&self) -> f64 {
         self.z_g * self.weight() - self.z_b * self.buoyancy()
+    }
+
+    /// The current V_c(t) in NED (m/s) at control-clock time `t`.
+    pub fn current_at(&self, t: f64) -> Vector3<f64> {
+        match &self.current_drift {
+            Some(d) => self.current_ned + d.offset(t),
+            None => self.current_ned,
+        }
+    }
+
+    /// Its rate V̇_c(t) in NED (m/s²): zero for a constant current.
+    pub fn current_rate_at(&self, t: f64) -> Vector3<f64> {
+        self.current_drift
+            .as_ref()
+            .map_or_else(Vector3::zeros, |d| d.rate(t))
+    }
+
+    /// Whether the plant sees a current at all.
+    pub fn has_current(&self) -> bool {
+        self.current_ned != Vector3::zeros() || self.current_drift.is_some()
+    }
+
+    /// The body-frame disturbance τ_d(t) (N, N·m) at control-clock time `t`.
+    pub fn disturbance_at(&self, t: f64) -> Vector6<f64> {
+        self.disturbance
+            .as_ref()
+            .map_or_else(Vector6::zeros, |d| d.force(t))
     }
 
     /// r_G = (0, 0, z_G).
@@ -125,5 +253,87 @@ impl Vessel {
             damping_quadratic: Vector6::zeros(),
             ..self.clone()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_dead_zone_removes_delta_and_then_the_limits_clip() {
+        // δ = 10: 0 inside, τ ∓ 10 outside, continuous at ±δ
+        for (x, want) in [
+            (0.0, 0.0),
+            (9.99, 0.0),
+            (-10.0, 0.0),
+            (10.0, 0.0),
+            (10.5, 0.5),
+            (30.0, 20.0),
+            (-30.0, -20.0),
+        ] {
+            assert_eq!(dead_zone(x, 10.0), want, "x = {x}");
+        }
+        let a = Actuator {
+            dead_zone: Some(Vector6::new(0.0, 0.0, 10.0, 0.0, 0.0, 0.0)),
+            limits: Some(Vector6::repeat(15.0)),
+            ..Actuator::default()
+        };
+        let out = a.shape(&Vector6::new(12.0, -3.0, 30.0, 0.0, 0.0, -40.0));
+        // heave: 30 − 10 = 20, then clipped at 15; other DOFs only clipped
+        assert_eq!(out, Vector6::new(12.0, -3.0, 15.0, 0.0, 0.0, -15.0));
+        let ideal = Actuator::default();
+        let tau = Vector6::new(1.0, -2.0, 3.0, -4.0, 5.0, -6.0);
+        assert_eq!(ideal.shape(&tau), tau);
+    }
+
+    #[test]
+    fn the_disturbance_is_a_sinusoid_of_the_clock() {
+        let d = Disturbance {
+            amplitude: Vector6::new(0.0, 40.0, 0.0, 0.0, 0.0, 0.0),
+            frequency_hz: 0.1,
+            phase: 0.5,
+        };
+        // 40 sin(2π·0.1·t + 0.5): t = 0 → 40 sin 0.5; t = 2.5 s (a quarter
+        // period) → 40 cos 0.5; t = 10 s (a period) → 40 sin 0.5 again
+        for (t, want) in [
+            (0.0, 40.0 * 0.5f64.sin()),
+            (2.5, 40.0 * 0.5f64.cos()),
+            (10.0, 40.0 * 0.5f64.sin()),
+            (5.0, -40.0 * 0.5f64.sin()),
+        ] {
+            let f = d.force(t);
+            assert!((f[1] - want).abs() < 1e-12, "t = {t}: {}", f[1]);
+            assert_eq!(f[0], 0.0);
+            assert_eq!(f.rows(2, 4).norm(), 0.0);
+        }
+    }
+
+    #[test]
+    fn the_drift_rate_is_the_derivative_of_the_drift() {
+        let d = CurrentDrift {
+            amplitude: Vector3::new(0.1, 0.08, 0.0),
+            period_s: Vector3::new(400.0, 333.0, 0.0),
+            phase: Vector3::new(0.3, -2.0, 1.0),
+        };
+        let mut v = Vessel::surveyor_like();
+        v.current_ned = Vector3::new(0.25, 0.15, 0.0);
+        v.current_drift = Some(d);
+        assert!(v.has_current());
+        let dt = 1e-3;
+        for t in [0.0, 123.4, 777.7, 2000.0] {
+            let fd = (v.current_at(t + dt) - v.current_at(t - dt)) / (2.0 * dt);
+            let rate = v.current_rate_at(t);
+            assert!((fd - rate).norm() < 1e-10, "t = {t}: {fd} vs {rate}");
+            // within the mean ± amplitude, D axis untouched
+            let c = v.current_at(t);
+            assert!((c.x - 0.25).abs() <= 0.1 && (c.y - 0.15).abs() <= 0.08);
+            assert_eq!(c.z, 0.0);
+        }
+        // a zero amplitude needs no period
+        assert_eq!(v.current_rate_at(5.0).z, 0.0);
+        v.current_drift = None;
+        assert_eq!(v.current_rate_at(5.0), Vector3::zeros());
+        assert_eq!(v.current_at(5.0), v.current_ned);
     }
 }

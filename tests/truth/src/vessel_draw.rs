@@ -74,7 +74,7 @@ impl Vessel {
     ///   speed-scheduled fraction β ∈ [0.1, 0.4], raised in sway, heave,
     ///   pitch and yaw for directional stability (module notes);
     /// - z_G ∈ [0.03, 0.15] m, z_B = 0, W − B ∈ [−40, 80] N;
-    /// - no current, no tether, ideal actuators.
+    /// - no current, no tether, no disturbance, ideal actuators.
     pub fn draw(seed: u64) -> Vessel {
         let mut rng = Rng::new(derive_seed(seed, 0x5E55E1));
         let mass = rng.range(120.0, 600.0);
@@ -117,6 +117,8 @@ impl Vessel {
             w_minus_b,
             gravity: GRAVITY,
             current_ned: Vector3::zeros(),
+            current_drift: None,
+            disturbance: None,
             tether: Vector6::zeros(),
             tether_ned: Vector3::zeros(),
             actuator: Actuator::default(),
@@ -165,6 +167,8 @@ impl Vessel {
             w_minus_b: 150.0,
             gravity: GRAVITY,
             current_ned: Vector3::zeros(),
+            current_drift: None,
+            disturbance: None,
             tether: Vector6::zeros(),
             tether_ned: Vector3::zeros(),
             actuator: Actuator::default(),

@@ -35,6 +35,10 @@ pub struct DiscoverySettings {
     pub max_delta_bic: f64,
     /// Least held-out free-run fit gain (summed over channels) to accept a term.
     pub min_cv_gain: f64,
+    /// Least size of a term's force against the command in its DOF (RMS
+    /// over RMS, λ-filtered, on the estimation runs): below it a term is
+    /// too small to matter, however significant.
+    pub min_force_share: f64,
     /// A look-alike whose held-out gain reaches this share of the winner's is
     /// reported as ambiguous.
     pub ambiguity_ratio: f64,
@@ -67,6 +71,7 @@ impl Default for DiscoverySettings {
             min_z: 4.0,
             max_delta_bic: -10.0,
             min_cv_gain: 0.01,
+            min_force_share: 0.02,
             ambiguity_ratio: 0.8,
             max_terms: 4,
             cv_candidates: 5,
@@ -101,6 +106,12 @@ impl DiscoverySettings {
         pos("segment_s", self.segment_s)?;
         pos("drift_window_s", self.drift_window_s)?;
         pos("ambiguity_ratio", self.ambiguity_ratio)?;
+        if !(self.min_force_share.is_finite() && (0.0..1.0).contains(&self.min_force_share)) {
+            return Err(DiscoveryError::invalid(
+                "settings.min_force_share",
+                "must be in [0, 1)",
+            ));
+        }
         if !(self.min_cv_gain.is_finite() && self.max_delta_bic.is_finite()) {
             return Err(DiscoveryError::invalid(
                 "settings.min_cv_gain",
@@ -270,6 +281,7 @@ pub fn discover_from(
         min_z: settings.min_z,
         max_delta_bic: settings.max_delta_bic,
         min_cv_gain: settings.min_cv_gain,
+        min_force_share: settings.min_force_share,
         cv_candidates: settings.cv_candidates,
         max_lag_s: settings.max_lag_s,
         max_delay_samples: ((settings.max_delay_s / h).round() as usize).max(1),
@@ -337,6 +349,8 @@ pub fn discover_from(
             _ => prep.fit(&chosen, &all_rows, &runs, hac),
         };
         let fitted: Vec<&Record> = est.iter().collect();
+        let base_on_fitted: Vec<Predictions> =
+            fitted.iter().map(|r| predict(&base_model, r, k)).collect();
         // A variant whose M is not positive definite is not a vessel: it is
         // taken only when no variant is.
         let mut best: Option<(usize, (bool, f64, f64))> = None;
@@ -345,7 +359,7 @@ pub fn discover_from(
                 continue;
             };
             let candidate = prep.model(&chosen, &f, &[]);
-            let (harm, gain) = change_score(&base_model, &candidate, &fitted, k);
+            let (harm, gain) = change_score(&base_on_fitted, &candidate, &fitted, k);
             let score = (candidate.inertia_positive(), harm, gain);
             if best.is_none_or(|(_, b)| score > b) {
                 best = Some((v, score));
@@ -572,25 +586,22 @@ pub fn fit_gain(before: Option<f64>, after: Option<f64>) -> f64 {
 }
 
 /// How a model changes the channels' fits (1-step, k-step, free run; fits
-/// below 0 count as 0) from `base` on `runs`: (the worst loss beyond
+/// below 0 count as 0) from the base model's predictions `before` on `runs`:
+/// (the worst loss beyond
 /// noise, 0 if none; the summed change). The kept model is the one of its
 /// two fits (couplings free or held, see `Prepared::fit_for_model`) that
 /// harms the untouched channels least, then gains most — judged on the
 /// estimation runs, so the held-out runs stay an independent test.
 fn change_score(
-    base: &AugmentedModel,
+    before: &[Predictions],
     model: &AugmentedModel,
     runs: &[&Record],
     k: usize,
 ) -> (f64, f64) {
-    let before: Vec<Predictions> = runs.iter().map(|r| predict(base, r, k)).collect();
     let after: Vec<Predictions> = runs.iter().map(|r| predict(model, r, k)).collect();
     let (mut worst, mut total) = (0.0_f64, 0.0);
-    for i in 0..base.dofs.len() {
-        let (b, a) = (
-            channel_fits(runs, &before, i),
-            channel_fits(runs, &after, i),
-        );
+    for i in 0..model.dofs.len() {
+        let (b, a) = (channel_fits(runs, before, i), channel_fits(runs, &after, i));
         for (x, y) in [
             (b.one_step, a.one_step),
             (b.k_step, a.k_step),

@@ -90,6 +90,8 @@ pub(crate) struct FitOut {
     pub cov: Option<DMatrix<f64>>,
     /// Weighted residuals per (row, run) block.
     pub resid: Vec<Vec<f64>>,
+    /// The row of each block of `resid`.
+    pub block_rows: Vec<usize>,
     /// D̄ the current's regressors were built with.
     pub d_ref: DMatrix<f64>,
     /// M the C(ν)ν regressors were built with.
@@ -287,6 +289,60 @@ impl<'a> Prepared<'a> {
         )
     }
 
+    /// How much a term changes the model's account of the forces: per row,
+    /// the RMS of the change of the (weighted) equation error from the fit
+    /// without it (`null`) to the fit with it (`with`), over the RMS of the
+    /// row's (weighted, λ-filtered) command on `runs`; the largest over
+    /// `rows`. A term that only trades against refitted entries of M and D̄
+    /// (a product collinear with a velocity at the grid speed) changes
+    /// nothing, however large its coefficient. With tens of thousands of
+    /// samples a term can be significant and still too small to matter to
+    /// anyone designing a controller: this says how much it matters.
+    /// `None` when the two fits do not cover the same blocks.
+    pub fn force_share(
+        &self,
+        null: &FitOut,
+        with: &FitOut,
+        rows: &[usize],
+        runs: &[usize],
+    ) -> Option<f64> {
+        if null.block_rows != with.block_rows
+            || null
+                .resid
+                .iter()
+                .zip(&with.resid)
+                .any(|(a, b)| a.len() != b.len())
+        {
+            return None;
+        }
+        let mut share = 0.0_f64;
+        for &r in rows {
+            let num: f64 = null
+                .resid
+                .iter()
+                .zip(&with.resid)
+                .zip(&null.block_rows)
+                .filter(|(_, row)| **row == r)
+                .map(|((a, b), _)| a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>())
+                .sum();
+            let w = self.weights[r];
+            let den: f64 = runs
+                .iter()
+                .filter(|&&run| self.records[run].len() > self.skip + 1)
+                .map(|&run| {
+                    self.runs[run].lam_tau[r][self.skip..]
+                        .iter()
+                        .map(|x| (w * x).powi(2))
+                        .sum::<f64>()
+                })
+                .sum();
+            if den > 0.0 && num.is_finite() {
+                share = share.max((num / den).sqrt());
+            }
+        }
+        Some(share)
+    }
+
     /// Columns of row `r` a fit of `rows` frees: the baseline's free
     /// entries, or with `hold` only those in the columns of the refitted
     /// rows (an entry coupling `r` to a DOF whose row is not refitted then
@@ -432,6 +488,7 @@ impl<'a> Prepared<'a> {
         let mut hmat = DMatrix::<f64>::zeros(p, p);
         let mut bvec = vec![0.0; p];
         let mut blocks: Vec<Block> = Vec::new();
+        let mut block_rows: Vec<usize> = Vec::new();
         let mut n_tot = 0;
         for &run in runs {
             let rec = &self.records[run];
@@ -512,6 +569,7 @@ impl<'a> Prepared<'a> {
                 }
                 n_tot += y.len();
                 blocks.push((idx, cols, y));
+                block_rows.push(r);
             }
         }
         if n_tot <= p {
@@ -606,6 +664,7 @@ impl<'a> Prepared<'a> {
             n: n_tot,
             cov,
             resid,
+            block_rows,
             d_ref: d_ref.clone(),
             m_ref: m_ref.clone(),
         })
@@ -1016,80 +1075,4 @@ pub(crate) fn profile(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::discrepancy::candidates::TermContext;
-
-    #[test]
-    fn the_current_regressor_from_kept_signals_is_the_filtered_direct_one() {
-        // A turning run: ψ sweeps, r varies; a coupled D̄, M. The combined
-        // cached signals equal filtering the regressor sample by sample.
-        let dofs = Dof::ALL.to_vec();
-        let n = 400;
-        let h = 0.1;
-        let mut nu = DMatrix::zeros(n, 6);
-        let mut eta = DMatrix::zeros(n, 6);
-        for k in 0..n {
-            let t = k as f64 * h;
-            nu[(k, 0)] = 0.5 + 0.1 * (0.3 * t).sin();
-            nu[(k, 1)] = 0.05 * (0.7 * t).cos();
-            nu[(k, 5)] = 0.2 * (0.1 * t).sin();
-            eta[(k, 5)] = 2.0 * (1.0 - (0.1 * t).cos());
-        }
-        let rec = Record {
-            name: "turn".into(),
-            h,
-            tau: DMatrix::zeros(n, 6),
-            nu,
-            eta,
-        };
-        let m = DMatrix::from_fn(6, 6, |i, j| {
-            if i == j {
-                100.0 + i as f64
-            } else {
-                3.0 * (i + 2 * j) as f64
-            }
-        });
-        let d = DMatrix::from_fn(6, 6, |i, j| {
-            if i == j {
-                40.0
-            } else {
-                (i as f64 - j as f64) * 2.5
-            }
-        });
-        let baseline = Baseline {
-            dofs: dofs.clone(),
-            m: m.clone(),
-            d_bar: d.clone(),
-            restoring: Default::default(),
-        };
-        let records = [rec];
-        let prep = Prepared::new(&baseline, &records, 0.5, 10, 5).expect("prepared");
-        let ctx = TermContext {
-            dofs: &dofs,
-            m_ref: &m,
-            d_ref: &d,
-        };
-        for r in 0..6 {
-            for p in 0..2 {
-                let raw: Vec<f64> = (0..n)
-                    .map(|k| {
-                        let v: Vec<f64> = (0..6).map(|j| records[0].nu[(k, j)]).collect();
-                        Effect::Current.regressor(p, r, &ctx, &v, &records[0].eta_at(k))
-                    })
-                    .collect();
-                let direct = prep.svf.foh(&raw);
-                let kept = prep.filtered_regressor(Effect::Current, p, r, 0, &ctx);
-                let scale = direct.iter().fold(1e-12_f64, |a, x| a.max(x.abs()));
-                for k in 0..n {
-                    assert!(
-                        (kept[k] - direct[k]).abs() < 1e-9 * scale,
-                        "row {r}, coefficient {p}, sample {k}: {} vs {}",
-                        kept[k],
-                        direct[k]
-                    );
-                }
-            }
-        }
-    }
-}
+mod tests;

@@ -207,28 +207,26 @@ impl AugmentedModel {
     fn nu_dot(&self, nu: &[f64], tau_a: &[f64], g: &[f64], eta: &[f64; 6], out: &mut [f64]) {
         let n = self.dofs.len();
         let ctx = self.ctx();
-        let mut f: Vec<f64> = (0..n)
-            .map(|i| {
-                let damping: f64 = nu
-                    .iter()
-                    .enumerate()
-                    .map(|(j, v)| self.d_bar[(i, j)] * v)
-                    .sum();
-                tau_a[i] - g[i] - damping
-            })
-            .collect();
+        // The terms' left-hand-side forces, then γ − D̄ν minus them.
+        let mut lhs = [0.0; 6];
         for t in &self.terms {
             if matches!(t.effect, Effect::Coupling { .. }) || t.coefficients.is_empty() {
                 continue;
             }
-            for (i, fi) in f.iter_mut().enumerate() {
-                for (p, c) in t.coefficients.iter().enumerate() {
-                    *fi -= c * t.effect.regressor(p, i, &ctx, nu, eta);
-                }
-            }
+            t.effect
+                .add_force(&t.coefficients, &ctx, nu, eta, &mut lhs[..n]);
+        }
+        let mut f = [0.0; 6];
+        for i in 0..n {
+            let damping: f64 = nu
+                .iter()
+                .enumerate()
+                .map(|(j, v)| self.d_bar[(i, j)] * v)
+                .sum();
+            f[i] = tau_a[i] - g[i] - damping - lhs[i];
         }
         for (i, o) in out.iter_mut().enumerate().take(n) {
-            *o = f
+            *o = f[..n]
                 .iter()
                 .enumerate()
                 .map(|(j, fj)| self.m_inv[(i, j)] * fj)

@@ -58,6 +58,7 @@ pub(super) fn hypothesis(
         delta_bic: s.delta_bic,
         z: s.z,
         cv_gain: s.cv_gain,
+        force_share: s.force_share.filter(|x| x.is_finite()),
         verdict,
     }
 }

@@ -61,6 +61,10 @@ pub struct HypothesisReport {
     pub z: f64,
     /// Held-out free-run fit gained, summed over channels (if evaluated).
     pub cv_gain: Option<f64>,
+    /// Size of its force: RMS over the RMS of the command in its DOF
+    /// (λ-filtered, estimation runs; the largest over the DOFs it enters).
+    #[serde(default)]
+    pub force_share: Option<f64>,
     /// Outcome.
     pub verdict: Verdict,
 }

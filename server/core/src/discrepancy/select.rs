@@ -25,6 +25,7 @@ pub(crate) struct Criteria {
     pub min_z: f64,
     pub max_delta_bic: f64,
     pub min_cv_gain: f64,
+    pub min_force_share: f64,
     pub cv_candidates: usize,
     pub max_lag_s: f64,
     pub max_delay_samples: usize,
@@ -40,6 +41,10 @@ pub(crate) struct Scored {
     pub delta_bic: f64,
     pub z: f64,
     pub cv_gain: Option<f64>,
+    /// RMS of the force it explains over RMS of the command in its DOF
+    /// (the largest over its rows; [`Prepared::force_share`]; `None` when
+    /// not measured).
+    pub force_share: Option<f64>,
 }
 
 impl Scored {
@@ -48,9 +53,14 @@ impl Scored {
         self.fit.theta.len() - 1
     }
 
-    /// Passes the equation-error screen.
+    /// Passes the equation-error screen and is large enough to matter.
     pub fn significant(&self, c: &Criteria) -> bool {
-        self.z >= c.min_z && self.delta_bic <= c.max_delta_bic
+        self.z >= c.min_z && self.delta_bic <= c.max_delta_bic && self.large_enough(c)
+    }
+
+    /// The force it explains is at least `min_force_share` of the command.
+    pub fn large_enough(&self, c: &Criteria) -> bool {
+        self.force_share.is_none_or(|s| s >= c.min_force_share)
     }
 }
 
@@ -133,16 +143,19 @@ pub(crate) fn score(
         let (lo, hi) = (grid[0], grid[grid.len() - 1]);
         let at_edge = p.value >= hi * (1.0 - 1e-9) || (continuous && p.value <= lo * (1.0 + 1e-9));
         let lr = if at_edge { 0.0 } else { lr };
+        let spec = Spec {
+            effect,
+            shape: Some(p.value),
+        };
+        let force_share = prep.force_share(&null, &p.fit, &rows, runs);
         return Some(Scored {
-            spec: Spec {
-                effect,
-                shape: Some(p.value),
-            },
+            spec,
             fit: p.fit,
             shape_std: p.std,
             delta_bic: -lr + n_eff.ln(),
             z: lr.max(0.0).sqrt(),
             cv_gain: None,
+            force_share,
         });
     }
     let spec = Spec {
@@ -177,6 +190,7 @@ pub(crate) fn score(
         .last()
         .is_some_and(|t| t.iter().all(|x| *x >= 0.0));
     let z = if dissipative { z } else { 0.0 };
+    let force_share = prep.force_share(&null, &fit, &rows, runs);
     Some(Scored {
         spec,
         fit,
@@ -184,6 +198,7 @@ pub(crate) fn score(
         delta_bic,
         z,
         cv_gain: None,
+        force_share,
     })
 }
 

@@ -9,192 +9,20 @@
 #![allow(dead_code)]
 
 use nalgebra::{DMatrix, Vector3, Vector6};
-use seatrial_core::discrepancy::Effect;
 use seatrial_core::estimation::NoProgress;
 use seatrial_core::identification::LambdaCampaignSettings;
 use seatrial_core::identification::discover_campaign::{
     DiscoverCampaignSettings, discover_campaign,
 };
 use seatrial_core::numbers::sig3;
-use seatrial_core::planning::dof::Dof;
 use seatrial_core::validation::nrmse_fit;
-use seatrial_truth::{Campaign, CampaignSpec, Vessel, fly_campaign, true_predictions};
+use seatrial_truth::plant::DelayLine;
+use seatrial_truth::{
+    Campaign, CampaignSpec, Log, Plant, State, Vessel, fly_campaign, true_predictions,
+};
 
+pub use super::concealed::{Concealed, in_truth, truth_coefficient};
 use super::open_world::{Identification, identify};
-
-/// The effect concealed from the λ model.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Concealed {
-    /// The drawn vessel as it is.
-    Clean,
-    /// A steady current of 0.25 m/s north, 0.15 m/s east.
-    Current,
-    /// A tether pull fixed in NED (it leads to the ship), of 30 % of the
-    /// clean campaign's RMS sway command, towards a bearing drawn from the
-    /// seed: in the body frame it turns with the heading, which the
-    /// baseline's constant loads cannot follow.
-    Tether,
-    /// Thrusters following the command through a 0.4 s first-order lag in
-    /// every DOF.
-    Lag,
-    /// Heave thrust clipped at 60 % of the clean campaign's largest heave
-    /// command.
-    Saturation,
-    /// Quadratic sway damping four times the drawn one.
-    QuadraticSway,
-}
-
-impl Concealed {
-    pub const ALL: [Concealed; 6] = [
-        Concealed::Clean,
-        Concealed::Current,
-        Concealed::Tether,
-        Concealed::Lag,
-        Concealed::Saturation,
-        Concealed::QuadraticSway,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Concealed::Clean => "clean",
-            Concealed::Current => "current",
-            Concealed::Tether => "tether",
-            Concealed::Lag => "actuator lag",
-            Concealed::Saturation => "saturation",
-            Concealed::QuadraticSway => "quadratic sway damping",
-        }
-    }
-
-    /// Whether `e` names this effect (`Some(true)`), a look-alike at the
-    /// right place (`Some(false)`: lag ↔ delay, a body-fixed load for the
-    /// tether's pull, cubic for quadratic drag in the same DOF), or
-    /// something else (`None`).
-    pub fn names(self, e: &Effect) -> Option<bool> {
-        match (self, e) {
-            (Concealed::Current, Effect::Current) => Some(true),
-            (Concealed::Tether, Effect::TetherPull) => Some(true),
-            (
-                Concealed::Tether,
-                Effect::ConstantLoad {
-                    dof: Dof::Surge | Dof::Sway,
-                },
-            ) => Some(false),
-            (Concealed::Lag, Effect::ActuatorLag { .. }) => Some(true),
-            (Concealed::Lag, Effect::InputDelay { .. } | Effect::CommonInputDelay) => Some(false),
-            (Concealed::Saturation, Effect::Saturation { dof: Dof::Heave }) => Some(true),
-            (Concealed::QuadraticSway, Effect::QuadraticDamping { dof: Dof::Sway }) => Some(true),
-            (Concealed::QuadraticSway, Effect::CubicDamping { dof: Dof::Sway }) => Some(false),
-            _ => None,
-        }
-    }
-
-    /// The concealed effect's true size in the units discovery reports.
-    fn truth_text(self, vessel: &Vessel) -> String {
-        match self {
-            Concealed::Clean => "none concealed".into(),
-            Concealed::Current => format!(
-                "V_N {:.3}, V_E {:.3} m/s",
-                vessel.current_ned.x, vessel.current_ned.y
-            ),
-            Concealed::Tether => format!(
-                "F_N {:.1}, F_E {:.1} N",
-                vessel.tether_ned.x, vessel.tether_ned.y
-            ),
-            Concealed::Lag => "T_a 0.4 s in every DOF".into(),
-            Concealed::Saturation => format!(
-                "heave τ_max {:.1} N",
-                vessel.actuator.limits.map_or(f64::NAN, |l| l[2])
-            ),
-            Concealed::QuadraticSway => format!(
-                "d_v|v| {:.1} N·s²/m² (drawn {:.1})",
-                vessel.damping_quadratic[1],
-                vessel.damping_quadratic[1] / 4.0
-            ),
-        }
-    }
-
-    /// The vessel with the effect switched on.
-    fn apply(self, vessel: &mut Vessel, clean: &Campaign) {
-        match self {
-            Concealed::Clean => {}
-            Concealed::Current => vessel.current_ned = Vector3::new(0.25, 0.15, 0.0),
-            Concealed::Tether => {
-                let (sum, n) = clean.runs.iter().fold((0.0, 0usize), |(s, n), r| {
-                    let c = r.log.tau.column(1);
-                    (s + c.iter().map(|x| x * x).sum::<f64>(), n + c.len())
-                });
-                let size = 0.3 * (sum / n.max(1) as f64).sqrt();
-                let bearing = (seed_bearing(vessel.mass)).to_radians();
-                vessel.tether_ned = Vector3::new(size * bearing.cos(), size * bearing.sin(), 0.0);
-            }
-            Concealed::Lag => vessel.actuator.lag_s = Some(Vector6::repeat(0.4)),
-            Concealed::Saturation => {
-                let peak = clean
-                    .runs
-                    .iter()
-                    .map(|r| r.log.tau.column(2).amax())
-                    .fold(0.0, f64::max);
-                let mut lim = Vector6::repeat(f64::INFINITY);
-                lim[2] = 0.6 * peak;
-                vessel.actuator.limits = Some(lim);
-            }
-            Concealed::QuadraticSway => vessel.damping_quadratic[1] *= 4.0,
-        }
-    }
-}
-
-/// A bearing (°) from the drawn vessel, so each seed pulls its own way.
-fn seed_bearing(mass: f64) -> f64 {
-    (mass * 137.508).rem_euclid(360.0)
-}
-
-/// Whether the truth has `e` as physics of its own, beyond the concealed
-/// effect: quadratic damping in every DOF (a cubic term approximates it),
-/// linear damping growing with |u| (cross-flow |u|ν_i), C(ν)ν from M, g(η),
-/// the heave load W − B, and the couplings z_G puts in M_RB. Naming one of
-/// these is not a false label, though it is not the concealed effect.
-pub fn in_truth(vessel: &Vessel, e: &Effect) -> bool {
-    let i = |d: Dof| d.index();
-    match *e {
-        Effect::QuadraticDamping { dof } | Effect::CubicDamping { dof } => {
-            vessel.damping_quadratic[i(dof)] > 0.0
-        }
-        Effect::CrossDamping {
-            dof,
-            from: Dof::Surge,
-        } => vessel.damping_linear_per_speed[i(dof)] > 0.0,
-        Effect::CoriolisFromM | Effect::CoriolisProduct { .. } | Effect::Restoring { .. } => true,
-        Effect::ConstantLoad { dof: Dof::Heave } => vessel.w_minus_b != 0.0,
-        Effect::Coupling { dof, from } => {
-            let m = vessel.m();
-            m[(i(dof), i(from))] != 0.0
-        }
-        _ => false,
-    }
-}
-
-/// The truth's own value of a coefficient discovery reports for physics
-/// the truth has: a Coriolis product's coefficient (the mixed term of the
-/// quadratic C(ν)ν, Fossen 2011 eq. 6.43, from the truth's M) or a
-/// quadratic damping coefficient.
-pub fn truth_coefficient(vessel: &Vessel, e: &Effect) -> Option<f64> {
-    match *e {
-        Effect::CoriolisProduct { dof, a, b } if a != b => {
-            let m = vessel.m();
-            let f = |i: Option<usize>, j: Option<usize>| {
-                let mut nu = Vector6::zeros();
-                for k in [i, j].into_iter().flatten() {
-                    nu[k] = 1.0;
-                }
-                seatrial_truth::forces::coriolis_force(&m, &nu)[dof.index()]
-            };
-            let (ia, ib) = (Some(a.index()), Some(b.index()));
-            Some(f(ia, ib) - f(ia, None) - f(None, ib) + f(None, None))
-        }
-        Effect::QuadraticDamping { dof } => Some(vessel.damping_quadratic[dof.index()]),
-        _ => None,
-    }
-}
 
 /// One channel of the held-out run: baseline, augmented (if stored) and
 /// true model, 1-step and 10 s restarted free run (NRMSE fits).
@@ -252,18 +80,26 @@ pub struct DiscoveryCase {
     pub vessel: Vessel,
     /// Seconds spent flying the truth, identifying, discovering.
     pub secs: [f64; 3],
+    /// Structure left unexplained, per grid speed: "speed: DOF band
+    /// (excess, peak)".
+    pub unexplained: Vec<String>,
+    /// The window test of a chosen current, per grid speed that ran it.
+    pub current_drift: Vec<String>,
 }
 
 impl DiscoveryCase {
     /// hit: the concealed effect named first; partial: its look-alike
     /// first; on the clean case, "clean ✓" when nothing is named, "truth ✓"
     /// when all that is named is physics the truth has ([`in_truth`]), and
-    /// false otherwise; miss otherwise.
+    /// false otherwise; the sway disturbance (nothing in the library names
+    /// it) alike, with "unexplained ✓" when nothing is named; miss
+    /// otherwise.
     pub fn score(&self) -> &'static str {
         match (self.concealed, self.named.first()) {
             (Concealed::Clean, None) => "clean ✓",
-            (Concealed::Clean, Some(_)) if self.false_labels().is_empty() => "truth ✓",
-            (Concealed::Clean, Some(_)) => "false",
+            (Concealed::Disturbance, None) => "unexplained ✓",
+            (c, Some(_)) if c.nothing_to_name() && self.false_labels().is_empty() => "truth ✓",
+            (c, Some(_)) if c.nothing_to_name() => "false",
             (_, Some((_, _, Some(true)))) => "hit",
             (_, Some((_, _, Some(false)))) => "partial",
             _ => "miss",
@@ -401,8 +237,40 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         .iter()
         .map(|e| (e.kept, e.held_out_verdict.clone()))
         .collect();
+    let unexplained = out
+        .report
+        .points
+        .iter()
+        .flat_map(|p| {
+            p.report.unexplained.iter().map(|u| {
+                format!(
+                    "{:.2} m/s: {} {:.3}–{:.3} Hz +{:.0} dB (peak {:.3} Hz)",
+                    p.grid_speed_mps,
+                    u.dof.name(),
+                    u.band.f_lo_hz,
+                    u.band.f_hi_hz,
+                    u.band.excess_db,
+                    u.band.peak_hz
+                )
+            })
+        })
+        .collect();
+    let current_drift = out
+        .report
+        .points
+        .iter()
+        .filter_map(|p| {
+            let d = p.report.current_drift.as_ref()?;
+            Some(format!("{:.2} m/s: {}", p.grid_speed_mps, d.text))
+        })
+        .collect();
     let val_run = campaign.validation_runs()[0];
-    let truth = true_predictions(&vessel, &val_run.log);
+    let truth = if needs_the_clock(&vessel) {
+        timed_true_predictions(&vessel, &val_run.log)
+    } else {
+        let t = true_predictions(&vessel, &val_run.log);
+        [t.one_step, t.restarted_10s]
+    };
     let report_of = |v: &[seatrial_core::identification::outcome::RunValidation]| {
         v.iter()
             .find(|r| r.run_id == val_run.meta.name)
@@ -425,8 +293,8 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
                 [ca.fit_one_step, ca.fit_restarted]
             }),
             truth: [
-                fit(&val_run.log.nu, &truth.one_step, j, 1),
-                fit(&val_run.log.nu, &truth.restarted_10s, j, 0),
+                fit(&val_run.log.nu, &truth[0], j, 1),
+                fit(&val_run.log.nu, &truth[1], j, 0),
             ],
         })
         .collect();
@@ -436,7 +304,14 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         named,
         in_truth,
         estimates,
-        truth_size: concealed.truth_text(&vessel),
+        truth_size: match concealed {
+            Concealed::DriftingCurrent => format!(
+                "{}; {}",
+                concealed.truth_text(&vessel),
+                current_over_runs(&vessel, &campaign)
+            ),
+            _ => concealed.truth_text(&vessel),
+        },
         first_values,
         truth_values: out
             .report
@@ -451,7 +326,100 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         verdict: out.report.summary.last().cloned().unwrap_or_default(),
         gaps,
         secs: [t_flown, t_identified - t_flown, discovery_s],
+        unexplained,
+        current_drift,
     }
+}
+
+/// The true current (V_N, V_E) averaged over the log rows of each grid
+/// speed's static and dynamic runs and of the held-out run: what a constant
+/// current fitted there can match.
+fn current_over_runs(vessel: &Vessel, campaign: &Campaign) -> String {
+    let mean = |runs: &[&seatrial_truth::Run]| {
+        let (sum, n) = runs
+            .iter()
+            .flat_map(|r| r.log.t.iter())
+            .fold((Vector3::zeros(), 0usize), |(s, n), &t| {
+                (s + vessel.current_at(t), n + 1)
+            });
+        let m = sum / n.max(1) as f64;
+        format!("({:.3}, {:.3})", m.x, m.y)
+    };
+    let mut parts: Vec<String> = campaign
+        .spec
+        .grid_speeds
+        .iter()
+        .map(|&u0| {
+            let mut runs = campaign.runs_at(u0, seatrial_truth::Role::Static);
+            runs.extend(campaign.runs_at(u0, seatrial_truth::Role::Dynamic));
+            format!("{u0:.2} m/s {}", mean(&runs))
+        })
+        .collect();
+    parts.push(format!(
+        "held-out run {}",
+        mean(&campaign.validation_runs()[..1])
+    ));
+    format!("mean over the runs at {}", parts.join(", "))
+}
+
+/// Whether the true plant needs the clock or past commands to predict: a
+/// drifting current, a disturbance, a transport delay.
+fn needs_the_clock(vessel: &Vessel) -> bool {
+    vessel.current_drift.is_some()
+        || vessel.disturbance.is_some()
+        || vessel.actuator.delay_s.is_some()
+}
+
+/// The true plant's 1-step and 10 s restarted free-run predictions on
+/// `log`, as [`true_predictions`] makes them (measured starts, the logged
+/// τ held over each log interval, 200 Hz RK4, lag state at the logged τ),
+/// but on the control clock (a drifting current, a disturbance) and with
+/// the logged τ through the transport delay (before the first row: the
+/// first row's τ).
+pub fn timed_true_predictions(vessel: &Vessel, log: &Log) -> [DMatrix<f64>; 2] {
+    const H_MAX: f64 = 0.005;
+    let plant = Plant::new(vessel);
+    let n = log.t.len();
+    let row = |m: &DMatrix<f64>, i: usize| Vector6::from_fn(|j, _| m[(i, j)]);
+    let start = |i: usize| State {
+        eta: row(&log.eta, i),
+        nu: row(&log.nu, i),
+        tau_act: row(&log.tau, i),
+    };
+    let mut line = DelayLine::new(
+        vessel.actuator.delay_s.unwrap_or(0.0),
+        if n > 0 {
+            row(&log.tau, 0)
+        } else {
+            Vector6::zeros()
+        },
+    );
+    for i in 0..n {
+        line.push(log.t[i], row(&log.tau, i));
+    }
+    let interval = |x: &State, i: usize| {
+        plant.advance_with(log.t[i], x, |t| line.at(t), log.t[i + 1] - log.t[i], H_MAX)
+    };
+    let mut one_step = log.nu.clone();
+    for j in 1..n {
+        let x = interval(&start(j - 1), j - 1);
+        one_step.row_mut(j).copy_from(&x.nu.transpose());
+    }
+    let mut restarted = log.nu.clone();
+    if n > 0 {
+        let mut x = start(0);
+        let mut t_restart = log.t[0];
+        for i in 0..n - 1 {
+            x = interval(&x, i);
+            if log.t[i + 1] - t_restart >= 10.0 - 1e-9 {
+                x = start(i + 1);
+                t_restart = log.t[i + 1];
+            } else {
+                restarted.row_mut(i + 1).copy_from(&x.nu.transpose());
+            }
+        }
+    }
+    [one_step, restarted]
 }
 
 /// The table of cases: one line each, then the gap rows of channels with a
@@ -485,7 +453,7 @@ pub fn format_cases(cases: &[DiscoveryCase]) -> String {
         );
         for g in &c.gaps {
             let closed = g.closed();
-            if closed.iter().all(Option::is_none) {
+            if closed.iter().all(Option::is_none) && std::env::var_os("ESTIMATES").is_none() {
                 continue;
             }
             let f = |v: Option<f64>| v.map_or("—".into(), |x| format!("{x:.3}"));
@@ -532,6 +500,21 @@ pub fn format_cases(cases: &[DiscoveryCase]) -> String {
                     est.join("; "),
                     sig3(*t)
                 );
+            }
+        }
+        if c.concealed == Concealed::Disturbance || std::env::var_os("ESTIMATES").is_some() {
+            s += &format!(
+                "    unexplained: {}\n",
+                if c.unexplained.is_empty() {
+                    "none reported".to_string()
+                } else {
+                    c.unexplained.join("; ")
+                }
+            );
+        }
+        if c.concealed == Concealed::DriftingCurrent {
+            for d in &c.current_drift {
+                s += &format!("    current drift test, {d}\n");
             }
         }
         let false_named = c.false_labels();

@@ -8,7 +8,7 @@ use super::plan::{RunPlan, plan_campaign};
 use super::{Campaign, CampaignSpec, Log, NavLog, NoiseSpec, Run, RunMeta, TruthRecord};
 use crate::controller::{CONTROL_DT, Controller, ControllerConfig};
 use crate::kinematics::wrap_pi;
-use crate::plant::{Plant, State};
+use crate::plant::{DelayLine, Plant, State};
 use crate::rng::{Rng, derive_seed};
 use crate::vessel::Vessel;
 
@@ -99,6 +99,9 @@ impl<'a> Flight<'a> {
             - v.tether;
         ctrl.preset(&trim);
         x.tau_act = trim + self.cfg.nominal_restoring(0.0, 0.0);
+        // A transport delay: the commands issued so far, the trim force
+        // before the first one.
+        let mut delay_line = v.actuator.delay_s.map(|d| DelayLine::new(d, x.tau_act));
 
         let rows = (plan.duration_s * 10.0).round() as i64;
         let ticks = rows * LOG_EVERY;
@@ -129,6 +132,15 @@ impl<'a> Flight<'a> {
                     sat[i] = false;
                 }
             }
+            if let Some(line) = delay_line.as_mut() {
+                line.push(tick_time(j), tau);
+            }
+            // The command reaching the hull over the RK4 step from `ts`:
+            // the delayed one at the step's midpoint (see DelayLine).
+            let hull = |ts: f64| match &delay_line {
+                Some(line) => line.at(ts + 0.5 * h),
+                None => tau,
+            };
             if j >= 0 {
                 saturated += usize::from(sat.iter().any(|s| *s));
                 cmd20.push(tau);
@@ -140,11 +152,12 @@ impl<'a> Flight<'a> {
                     log_eta.push(y_eta);
                     true_nu.push(x.nu);
                     true_eta.push(x.eta);
-                    applied.push(self.plant.applied_force(&x, &tau));
+                    applied.push(self.plant.applied_force(&x, &hull(tick_time(j))));
                 }
             }
             for s in 0..substeps {
                 let ts = tick_time(j) + s as f64 * h;
+                let cmd = hull(ts);
                 if j >= 0 {
                     // nav instants inside [ts, ts + h): a partial RK4 step
                     while n_nav <= n_last {
@@ -152,7 +165,7 @@ impl<'a> Flight<'a> {
                         if tc >= ts + h {
                             break;
                         }
-                        let xn = self.plant.rk4_step(&x, &tau, (tc - ts).max(0.0));
+                        let xn = self.plant.rk4_step_at(ts, &x, &cmd, (tc - ts).max(0.0));
                         let (m_nu, m_eta) = measure(&xn, &self.nav_noise, &mut nav_rng);
                         nav_t.push(n_nav as f64 / rate);
                         nav_nu.push(m_nu);
@@ -160,7 +173,7 @@ impl<'a> Flight<'a> {
                         n_nav += 1;
                     }
                 }
-                x = self.plant.rk4_step(&x, &tau, h);
+                x = self.plant.rk4_step_at(ts, &x, &cmd, h);
             }
         }
 
@@ -271,5 +284,39 @@ pub fn fly_campaign(vessel: &Vessel, spec: &CampaignSpec, seed: u64) -> Campaign
         clock_offset_s: offset,
         controller: cfg,
         runs,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_delayed_vehicle_feels_the_command_issued_six_ticks_earlier() {
+        // d = 0.3 s = 6 controller ticks: the force on the hull at each log
+        // row is the 20 Hz command of 6 ticks before, exactly (ideal
+        // thrusters otherwise). 0.285 s lands on the same tick at the log
+        // instants (the step from t holds τ_cmd(t + 2.5 ms − d)).
+        for d in [0.3, 0.285] {
+            let mut v = Vessel::draw(5);
+            v.actuator.delay_s = Some(d);
+            let c = fly_campaign(&v, &CampaignSpec::default(), 5);
+            let mut checked = 0;
+            for r in c.runs.iter().take(3) {
+                let tr = &r.truth;
+                for i in 3..tr.tau_applied.nrows() {
+                    let applied = tr.tau_applied.row(i);
+                    let issued = tr.tau_cmd_20hz.row(2 * i - 6);
+                    assert_eq!(applied, issued, "d {d}, {} row {i}", r.meta.name);
+                    checked += 1;
+                }
+                // and not the command of the same instant
+                let same = (3..tr.tau_applied.nrows())
+                    .filter(|&i| tr.tau_applied.row(i) == tr.tau_cmd_20hz.row(2 * i))
+                    .count();
+                assert!(same * 10 < tr.tau_applied.nrows(), "{same}");
+            }
+            assert!(checked > 1000);
+        }
     }
 }

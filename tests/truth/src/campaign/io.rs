@@ -154,6 +154,31 @@ impl Campaign {
                 "actuator_limits",
                 v.actuator.limits.as_ref().map_or(Json::Null, v6),
             ),
+            ("actuator_delay_s", opt(v.actuator.delay_s)),
+            (
+                "actuator_dead_zone",
+                v.actuator.dead_zone.as_ref().map_or(Json::Null, v6),
+            ),
+            (
+                "current_drift",
+                v.current_drift.as_ref().map_or(Json::Null, |d| {
+                    Json::obj([
+                        ("amplitude_ned", v3(&d.amplitude)),
+                        ("period_s", v3(&d.period_s)),
+                        ("phase_rad", v3(&d.phase)),
+                    ])
+                }),
+            ),
+            (
+                "disturbance",
+                v.disturbance.as_ref().map_or(Json::Null, |d| {
+                    Json::obj([
+                        ("amplitude", v6(&d.amplitude)),
+                        ("frequency_hz", Json::Num(d.frequency_hz)),
+                        ("phase_rad", Json::Num(d.phase)),
+                    ])
+                }),
+            ),
             ("size_lbh", v3(&v.size)),
             ("M", m6(&v.m())),
         ]);

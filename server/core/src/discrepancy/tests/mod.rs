@@ -63,6 +63,7 @@ fn a_damping_term_that_would_inject_energy_is_not_significant() {
         min_z: 4.0,
         max_delta_bic: -10.0,
         min_cv_gain: 0.01,
+        min_force_share: 0.02,
         cv_candidates: 5,
         max_lag_s: 3.0,
         max_delay_samples: 10,
