@@ -189,7 +189,12 @@ pub(crate) fn score(
         .theta
         .last()
         .is_some_and(|t| t.iter().all(|x| *x >= 0.0));
-    let z = if dissipative { z } else { 0.0 };
+    let plausible = !matches!(effect, Effect::CoriolisProduct { .. })
+        || fit
+            .theta
+            .last()
+            .is_some_and(|t| coriolis_product_plausible(t[0], &prep.baseline.m));
+    let z = if dissipative && plausible { z } else { 0.0 };
     let force_share = prep.force_share(&null, &fit, &rows, runs);
     Some(Scored {
         spec,
@@ -200,6 +205,16 @@ pub(crate) fn score(
         cv_gain: None,
         force_share,
     })
+}
+
+/// Whether a Coriolis product's coefficient can be one: the coefficients
+/// of C(ν)ν (Fossen 2011, eq. 6.43) are sums and differences of two entries
+/// of M, so |θ| ≤ 2·max|M_ij|. A larger one is the fit leaning on a product
+/// nearly collinear with a velocity at the grid speed (u·q ≈ u₀·q), not a
+/// Coriolis force.
+pub(crate) fn coriolis_product_plausible(theta: f64, m: &nalgebra::DMatrix<f64>) -> bool {
+    let largest = m.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    theta.is_finite() && theta.abs() <= 2.0 * largest
 }
 
 /// Free-run NRMSE fits of `model` on `rec` for the channels `rows`. A run
@@ -319,4 +334,41 @@ fn conflicts(e: &Effect, taken: &[Effect]) -> bool {
         | (Effect::InputDelay { .. }, Effect::CommonInputDelay) => true,
         _ => t.shape().is_some() && e.shape() == t.shape() && t.dof() == e.dof(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::coriolis_product_plausible;
+    use crate::discrepancy::candidates::coriolis_force;
+    use crate::planning::Dof;
+    use nalgebra::DMatrix;
+
+    #[test]
+    fn a_coriolis_product_is_plausible_up_to_twice_the_largest_inertia() {
+        // The v·r coefficient in surge of a coupled M is −M_22 (plus
+        // couplings): within the bound; a hundredfold one is not.
+        let dofs = Dof::ALL.to_vec();
+        let m = DMatrix::from_fn(6, 6, |i, j| {
+            if i == j {
+                [300.0, 450.0, 500.0, 40.0, 60.0, 80.0][i]
+            } else if (i, j) == (0, 4) || (i, j) == (4, 0) {
+                25.0
+            } else {
+                0.0
+            }
+        });
+        let f = |nu: [f64; 6]| coriolis_force(&dofs, &m, &nu)[0];
+        let mut vr = [0.0; 6];
+        vr[1] = 1.0;
+        vr[5] = 1.0;
+        let (mut v, mut r) = ([0.0; 6], [0.0; 6]);
+        v[1] = 1.0;
+        r[5] = 1.0;
+        let coef = f(vr) - f(v) - f(r);
+        assert!((coef + 450.0).abs() < 1e-9, "{coef}");
+        assert!(coriolis_product_plausible(coef, &m));
+        assert!(coriolis_product_plausible(-1000.0, &m));
+        assert!(!coriolis_product_plausible(30_477.0, &m));
+        assert!(!coriolis_product_plausible(f64::NAN, &m));
+    }
 }
