@@ -24,6 +24,21 @@ fn reports() -> &'static [SeedReport] {
     })
 }
 
+/// The same with M fitted symmetric (`symmetric_inertia`).
+fn symmetric_reports() -> &'static [SeedReport] {
+    static REPORTS: std::sync::OnceLock<Vec<SeedReport>> = std::sync::OnceLock::new();
+    REPORTS.get_or_init(|| {
+        let settings = LambdaCampaignSettings {
+            symmetric_inertia: true,
+            ..LambdaCampaignSettings::default()
+        };
+        SEEDS
+            .iter()
+            .map(|&s| evaluate(s, true, &settings))
+            .collect()
+    })
+}
+
 /// g(η) comes from ordinary runs (no attitude holds were flown) and the
 /// controller's nominal feed-forward is not mistaken for it: W − B and
 /// z_G·W − z_B·B within 3σ or 1 % of the truth on every vessel.
@@ -101,19 +116,60 @@ fn one_step_fits_beat_the_affine_baseline_and_approach_the_truth() {
 
 /// Reported σ are honest enough to bet on: with the 20 Hz controller's
 /// unlogged commands corrected and σ of M inflated by its spread across the
-/// grid, at least 80 % of the parameters lie within ±3σ of the truth's
-/// best linear fit on every vessel (85–96 % measured; 69–79 % before).
+/// grid, at least 85 % of the parameters (a symmetric pair of M counted
+/// once) lie within ±3σ of the truth's best linear fit on every vessel
+/// (87–99 % measured); with M fitted symmetric and σ scaled by the rows'
+/// disagreement with M = Mᵀ, at least 90 % (92–100 % measured).
 #[test]
 fn most_parameters_lie_within_three_reported_sigma() {
-    for r in reports() {
-        let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
+    for (floor, reports) in [(0.85, reports()), (0.9, symmetric_reports())] {
+        for r in reports {
+            let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
+            assert!(
+                within as f64 >= floor * r.z.len() as f64,
+                "seed {}: {within}/{} within ±3σ (floor {floor})",
+                r.seed,
+                r.z.len()
+            );
+        }
+    }
+}
+
+/// Fitting M symmetric (the rows re-estimated under M = Mᵀ over their joint
+/// posterior, D̄ moving with M) against fitting the rows freely and storing
+/// the nearest symmetric M with D̄ unchanged: the whole-run free runs on the
+/// held-out staircase gain +0.86 summed over the five vessels' 30 channels
+/// (vessel 5 pitch 0.54 → 0.79), no channel loses more than 0.01, and the
+/// share within ±3σ rises on every vessel. Its sub-models are physical.
+#[test]
+fn fitting_m_symmetric_beats_projecting_it() {
+    let within = |r: &SeedReport| {
+        r.z.iter().filter(|z| z.z().abs() <= 3.0).count() as f64 / r.z.len() as f64
+    };
+    let mut gain = 0.0;
+    for (r, p) in symmetric_reports().iter().zip(reports()) {
+        for (speed, ok, why) in &r.physical {
+            assert!(ok, "seed {} at {speed:.2} m/s: {why}", r.seed);
+        }
+        for (a, b) in r.fits.iter().zip(&p.fits) {
+            let (fa, fb) = (a.free_run.unwrap(), b.free_run.unwrap());
+            assert!(
+                fa >= fb - 0.02,
+                "seed {} {}: free run {fa:.3} fitted symmetric, {fb:.3} projected",
+                r.seed,
+                a.channel
+            );
+            gain += fa - fb;
+        }
         assert!(
-            within as f64 >= 0.8 * r.z.len() as f64,
-            "seed {}: {within}/{} within ±3σ",
+            within(r) >= within(p),
+            "seed {}: {:.3} within ±3σ fitted symmetric, {:.3} projected",
             r.seed,
-            r.z.len()
+            within(r),
+            within(p)
         );
     }
+    assert!(gain > 0.5, "summed free-run gain {gain:.3}");
 }
 
 /// Free runs keep the restoring spring (g(η) of the simulated attitude),
@@ -193,7 +249,7 @@ fn the_extension_below_the_grid_improves_free_runs() {
 /// section): ≥ 95 % of parameters within ±3σ, 1-step within 0.02 and free
 /// run within 0.05 of the true model in every channel.
 #[test]
-#[ignore = "known gap: 85–96 % within ±3σ; free runs up to 0.40 below the true model's (vessel 5 roll; the 2.25 m/s leg beyond the grid, cross-flow damping under excitation), where the oracle linear LPV model falls short too"]
+#[ignore = "known gap: 87–99 % within ±3σ (92–100 % with M fitted symmetric; vessel 4: its M diagonal 1–3 % off at every speed, the closed loop feeding measurement noise back into τ); free runs up to 0.38 below the true model (vessel 5 roll, where the oracle linear LPV model falls as short), 0.04–0.08 in surge"]
 fn the_issue_criteria_on_five_vessels() {
     for r in reports() {
         let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();

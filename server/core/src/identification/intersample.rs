@@ -180,26 +180,57 @@ pub fn corrected(
     (m, d)
 }
 
-/// M and D̄ of every sub-model corrected for a controller `ratio` times
-/// faster than the log (see the module docs); said in `notes`.
-pub(crate) fn correct_estimates(
-    estimates: Vec<(f64, LambdaEstimate)>,
+/// The controller's gains read from the log and c, when it runs faster than
+/// the log at `rate_hz`; `Err` with the note to give when they can't be read.
+pub(crate) fn logged_gains(
     segments: &[&Segment],
     dofs: &[Dof],
     with_attitude: bool,
     rate_hz: f64,
-    notes: &mut Vec<String>,
-) -> (Vec<(f64, LambdaEstimate)>, Option<LoggedController>) {
+) -> Result<Option<(ControllerGains, f64)>, String> {
     let h = segments.first().map_or(0.0, |s| s.h);
     let ratio = rate_hz * h;
     if ratio < 1.0 + 1e-6 {
-        return (estimates, None);
+        return Ok(None);
     }
     let Some(gains) = controller_gains(segments, dofs, with_attitude) else {
-        notes.push("the controller's gains could not be read from the log (too few samples): M and D̄ are not corrected for its faster rate".into());
-        return (estimates, None);
+        return Err("the controller's gains could not be read from the log (too few samples): M and D̄ are not corrected for its faster rate".into());
     };
-    let c = hidden_share(h, ratio);
+    Ok(Some((gains, hidden_share(h, ratio))))
+}
+
+/// c·K_ν over the force DOFs that are corrected: the part of the vehicle's
+/// M that a fit to the logged τ misses (M̂ = M − c K_ν), so M̂ + c K_ν is
+/// what must be symmetric.
+pub(crate) fn inertia_offset(gains: &ControllerGains, c: f64) -> DMatrix<f64> {
+    DMatrix::from_fn(gains.k_nu.nrows(), gains.k_nu.ncols(), |i, j| {
+        if gains.r2[i] >= MIN_R2 {
+            c * gains.k_nu[(i, j)]
+        } else {
+            0.0
+        }
+    })
+}
+
+/// M and D̄ of every sub-model corrected for a controller faster than the
+/// log (see the module docs), from [`logged_gains`]; said in `notes`.
+pub(crate) fn correct_estimates(
+    estimates: Vec<(f64, LambdaEstimate)>,
+    gains: Result<Option<(ControllerGains, f64)>, String>,
+    h: f64,
+    rate_hz: f64,
+    dofs: &[Dof],
+    notes: &mut Vec<String>,
+) -> (Vec<(f64, LambdaEstimate)>, Option<LoggedController>) {
+    let (gains, c) = match gains {
+        Ok(Some(g)) => g,
+        Ok(None) => return (estimates, None),
+        Err(note) => {
+            notes.push(note);
+            return (estimates, None);
+        }
+    };
+    let ratio = rate_hz * h;
     let diag: Vec<String> = dofs
         .iter()
         .enumerate()
@@ -236,7 +267,18 @@ pub(crate) fn correct_estimates(
         .map(|(speed, mut est)| {
             // D̄ as a whole is what the data determine (its C(ν) part from M
             // included), so only c·K_η J moves it.
-            let (m, d) = corrected(&est.m, &est.d_bar, &gains, dofs, c);
+            let (mut m, d) = corrected(&est.m, &est.d_bar, &gains, dofs, c);
+            // A fit under M + c K_ν = (M + c K_ν)ᵀ: couplings the structure
+            // keeps apart stay zero in M (a cross gain read from noisy logs
+            // is no inertia), so the corrected M is symmetric.
+            if est.symmetry.is_some() {
+                let blocks = est.mask.blocks();
+                for ((x, &keep), &orig) in m.iter_mut().zip(blocks.iter()).zip(est.m.iter()) {
+                    if !keep {
+                        *x = orig;
+                    }
+                }
+            }
             est.m = m;
             est.d_bar = d;
             (speed, est)

@@ -7,15 +7,16 @@ use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 
 use super::attitude_loop::AttitudeLoop;
+use super::dataset::Segment;
 use super::dataset::{RunInput, segments};
 use super::document::{
     LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, SpeedExtension,
     to_rows,
 };
 use super::error::IdentifyError;
-use super::intersample::{correct_estimates, logged_equivalent};
+use super::intersample::{correct_estimates, inertia_offset, logged_equivalent, logged_gains};
 use super::joint_restoring::{Functions, PooledRestoring, load, specification};
-use super::lambda_consistency::inflate_inertia_std;
+use super::lambda_consistency::{inflate_inertia_std, symmetry_note};
 use super::lambda_coriolis::fit_points;
 use super::lambda_data::{experiment, per_point, regression_columns, static_holds};
 use super::lambda_extension::{BELOW, choose_extension, speed_coverage_notes};
@@ -122,6 +123,13 @@ pub struct LambdaCampaignSettings {
     /// above the grid the highest sub-model is held.
     #[serde(default = "default_true")]
     pub extend_below_grid: bool,
+    /// Fit M symmetric: the rows of each sub-model re-estimated under
+    /// M = Mᵀ by least squares over their joint uncertainty, with σ scaled
+    /// by how far the unconstrained rows were from it. Off by default (the
+    /// rows fitted freely, the nearest symmetric M stored with D̄ unchanged)
+    /// until discovery's refit of touched rows works from such a model.
+    #[serde(default)]
+    pub symmetric_inertia: bool,
 }
 
 fn default_threshold() -> f64 {
@@ -149,6 +157,7 @@ impl Default for LambdaCampaignSettings {
             coriolis_from_m: true,
             controller_rate_hz: None,
             extend_below_grid: true,
+            symmetric_inertia: false,
         }
     }
 }
@@ -306,6 +315,20 @@ pub fn identify_lambda_campaign(
         chosen.structure.clone(),
         Prior::from_profile(profile, &dofs),
     );
+    lambda_settings.symmetric_inertia = settings.symmetric_inertia;
+    // A controller faster than the log: the fit returns M − c K_ν, and
+    // M itself is what must be symmetric.
+    let logged: Vec<&Segment> = data.segments.iter().flatten().collect();
+    let h_log = logged.first().map_or(0.0, |s| s.h);
+    let rate_hz = settings
+        .controller_rate_hz
+        .unwrap_or(profile.controller_rate_hz);
+    let gains = logged_gains(&logged, &dofs, with_restoring, rate_hz);
+    lambda_settings.inertia_offset = gains
+        .as_ref()
+        .ok()
+        .and_then(|g| g.as_ref())
+        .map(|(g, c)| inertia_offset(g, *c));
 
     // 1. g(η) jointly with M, D̄ and constant loads, pooled over the grid.
     let mut restoring: Option<(RestoringParams, RestoringDoc)> = None;
@@ -360,16 +383,9 @@ pub fn identify_lambda_campaign(
         .map_err(lambda_error)?
     };
 
-    let (mut estimates, logged_controller) = correct_estimates(
-        estimates,
-        &data.segments.iter().flatten().collect::<Vec<_>>(),
-        &dofs,
-        with_restoring,
-        settings
-            .controller_rate_hz
-            .unwrap_or(profile.controller_rate_hz),
-        &mut notes,
-    );
+    let (mut estimates, logged_controller) =
+        correct_estimates(estimates, gains, h_log, rate_hz, &dofs, &mut notes);
+    symmetry_note(&estimates, &mut notes);
     inflate_inertia_std(&mut estimates, &dofs, &mut notes);
 
     // 3. Sub-models, physical structure enforced, parameters.

@@ -67,6 +67,36 @@ pub(crate) fn inflate_inertia_std(
     }
 }
 
+/// Says that M was estimated under M = Mᵀ and how far the unconstrained
+/// rows were from it, per grid speed (χ² per constrained pair: about 1 when
+/// the asymmetry is noise, far above when the rows are biased).
+pub(crate) fn symmetry_note(estimates: &[(f64, LambdaEstimate)], notes: &mut Vec<String>) {
+    let parts: Vec<String> = estimates
+        .iter()
+        .filter_map(|(speed, e)| {
+            e.symmetry.map(|s| {
+                let r = s.inflation();
+                let scaled = if r > 1.0 {
+                    format!(" (σ ×{})", sig3(r))
+                } else {
+                    String::new()
+                };
+                format!(
+                    "{speed:.2} m/s {} on {}{scaled}",
+                    sig3(s.chi2 / s.constraints as f64),
+                    s.constraints
+                )
+            })
+        })
+        .collect();
+    if !parts.is_empty() {
+        notes.push(format!(
+            "M was estimated symmetric: the rows were re-fitted under M = Mᵀ by least squares over their joint uncertainty, so each coupling comes from the row that determines it best and D̄ moves with it; the unconstrained rows' asymmetry in χ² per pair: {}; where it exceeds 1 the σ at that speed understate the error and are scaled by its square root",
+            parts.join(", ")
+        ));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

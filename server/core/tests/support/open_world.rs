@@ -286,6 +286,10 @@ pub fn evaluate_with(
                         lin.d_bar[(i, j)],
                     ),
                 ] {
+                    // M is symmetric: its pair (i, j), (j, i) is one parameter.
+                    if g == "M" && j < i {
+                        continue;
+                    }
                     if std > 0.0 && std.is_finite() {
                         z.push(ZScore {
                             name: name(g, i, j),

@@ -70,4 +70,7 @@ pub struct LambdaEstimate {
     pub n_samples: usize,
     /// Runs used.
     pub n_runs: usize,
+    /// The symmetric-M constraint's effect (`None`: not applied, or no
+    /// coupled pair to constrain).
+    pub symmetry: Option<super::symmetric::SymmetryFit>,
 }

@@ -16,8 +16,9 @@ use super::robust::{LAG_IN_T, long_run_score_covariance};
 use super::settings::{LambdaSettings, MIN_T_OVER_H};
 use super::statistics::RegressionStats;
 use super::structure::CouplingMask;
+use super::symmetric::constrain_symmetric;
 use super::transform::{physical, state_space, to_lambda};
-use super::uncertainty::delta_method;
+use super::uncertainty::{Stacked, delta_method_cov};
 use crate::estimation::{NoProgress, Progress};
 
 /// Identifies M ν̇ + D̄ ν = γ from a multi-experiment set of runs at one
@@ -246,10 +247,29 @@ pub fn identify_with_progress(
     }
     progress.update(0.9, "mapping to M, D̄")?;
 
-    let a_lambda = DMatrix::from_fn(n, n, |i, j| rows[i].theta[j]);
-    let b_lambda = DMatrix::from_fn(n, n, |i, j| rows[i].theta[n + j]);
-    let k_lambda = DMatrix::from_fn(n, q, |i, j| rows[i].theta[2 * n + j]);
     let blocks = mask.blocks();
+    let mut theta = DMatrix::from_fn(n, p, |i, j| rows[i].theta[j]);
+    let stacked = Stacked::new(&free);
+    let mut cov = stacked.block_covariance(&rows);
+    let symmetry = if settings.symmetric_inertia {
+        constrain_symmetric(
+            &mut theta,
+            &stacked,
+            &mut cov,
+            settings.inertia_offset.as_ref(),
+            &f,
+            settings.inversion,
+            &blocks,
+        )
+    } else {
+        None
+    };
+    if let Some(s) = symmetry {
+        cov *= s.inflation().powi(2);
+    }
+    let a_lambda = theta.columns(0, n).into_owned();
+    let b_lambda = theta.columns(n, n).into_owned();
+    let k_lambda = theta.columns(2 * n, q).into_owned();
     let [a, b, m, d_bar, _, force] = physical(
         &a_lambda,
         &b_lambda,
@@ -259,7 +279,21 @@ pub fn identify_with_progress(
         &blocks,
     )?;
     let [std_a, std_b, std_m, std_d_bar, _, std_force] =
-        delta_method(&rows, &free, &f, settings.inversion, &blocks);
+        delta_method_cov(&theta, &stacked, &cov, &f, settings.inversion, &blocks);
+    // Each row's block of the (possibly constrained) joint covariance.
+    let param_cov: Vec<DMatrix<f64>> = (0..n)
+        .map(|i| {
+            let mut c = DMatrix::zeros(p, p);
+            for (a, &(ia, ja)) in stacked.index.iter().enumerate() {
+                for (b, &(ib, jb)) in stacked.index.iter().enumerate() {
+                    if ia == i && ib == i {
+                        c[(ja, jb)] = cov[(a, b)];
+                    }
+                }
+            }
+            c
+        })
+        .collect();
     progress.update(1.0, "done")?;
     Ok(LambdaEstimate {
         dofs: settings.dofs.clone(),
@@ -273,7 +307,7 @@ pub fn identify_with_progress(
         b,
         m,
         d_bar,
-        param_cov: rows.iter().map(|r| r.cov.clone()).collect(),
+        param_cov,
         std_a,
         std_b,
         std_m,
@@ -290,6 +324,7 @@ pub fn identify_with_progress(
         noise_variance: rows.iter().map(|r| r.noise_variance).collect(),
         n_samples: stats.n_samples,
         n_runs: runs.len(),
+        symmetry,
     })
 }
 

@@ -32,6 +32,7 @@ mod robust;
 mod settings;
 mod statistics;
 mod structure;
+mod symmetric;
 pub mod transform;
 mod uncertainty;
 
@@ -51,4 +52,5 @@ pub use lpv::identify_lpv;
 pub use predict::ZohModel;
 pub use settings::{Exogenous, LambdaSettings, MIN_T_OVER_H, Prior};
 pub use structure::{CouplingMask, Structure};
+pub use symmetric::SymmetryFit;
 pub use transform::{Inversion, mass_damping, zoh};

@@ -107,12 +107,19 @@ pub struct LambdaSettings {
     pub robust_covariance: bool,
     /// Exogenous functions estimated with M and D̄ (none by default).
     pub exogenous: Option<Exogenous>,
+    /// Re-estimate the rows under M = Mᵀ (generalized least squares over
+    /// their joint posterior, see `symmetric`); off by default.
+    pub symmetric_inertia: bool,
+    /// S (n × n) such that M + S, not the fitted M, is the symmetric one:
+    /// a fit to logged commands that miss a faster controller's c·K_ν ν̇
+    /// returns M − c K_ν (see `identification::intersample`).
+    pub inertia_offset: Option<DMatrix<f64>>,
 }
 
 impl LambdaSettings {
     /// Settings with the defaults: noise estimated, constant parameters,
     /// exact inversion, filters started at the first sample, transients
-    /// estimated, robust covariance.
+    /// estimated, robust covariance, rows fitted freely (M not constrained).
     pub fn new(dofs: Vec<Dof>, t_lambda: f64, structure: Structure, prior: Prior) -> Self {
         LambdaSettings {
             dofs,
@@ -126,6 +133,8 @@ impl LambdaSettings {
             estimate_transient: true,
             robust_covariance: true,
             exogenous: None,
+            symmetric_inertia: false,
+            inertia_offset: None,
         }
     }
 }

@@ -1,11 +1,11 @@
 //! Standard deviations of A, B, M, D̄ (and K, F of the exogenous terms) by
-//! the delta method: the posterior covariance of each row of
-//! [A_λ B_λ K_λ] (rows independent) pushed through the Jacobian of the map
+//! the delta method: the posterior covariance of the free entries of
+//! [A_λ B_λ K_λ] pushed through the Jacobian of the map
 //! (A_λ, B_λ, K_λ) → (A, B, M, D̄, K, F), taken by central
 //! differences of the exact map at steps small against each parameter's
 //! own standard deviation (so the linearization is the local one).
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 use super::filter::LambdaFilter;
 use super::posterior::RowPosterior;
@@ -14,73 +14,138 @@ use super::transform::{Inversion, physical};
 /// Central-difference step as a fraction of a parameter's posterior std.
 const STEP_OF_STD: f64 = 1e-3;
 
-/// Stds of (A, B, M, D̄); entries whose perturbed map fails are NaN.
-pub(crate) fn delta_method(
-    rows: &[RowPosterior],
-    free: &[Vec<usize>],
+/// The free entries of [A_λ B_λ K_λ] stacked row after row: entry c is
+/// (row i, column j) of θ (n × (2n + q)).
+#[derive(Debug, Clone)]
+pub(crate) struct Stacked {
+    pub index: Vec<(usize, usize)>,
+}
+
+impl Stacked {
+    pub fn new(free: &[Vec<usize>]) -> Self {
+        Stacked {
+            index: free
+                .iter()
+                .enumerate()
+                .flat_map(|(i, f)| f.iter().map(move |&j| (i, j)))
+                .collect(),
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.index.len()
+    }
+
+    pub fn gather(&self, theta: &DMatrix<f64>) -> DVector<f64> {
+        DVector::from_iterator(self.len(), self.index.iter().map(|&(i, j)| theta[(i, j)]))
+    }
+
+    pub fn scatter(&self, x: &DVector<f64>, theta: &mut DMatrix<f64>) {
+        for (c, &(i, j)) in self.index.iter().enumerate() {
+            theta[(i, j)] = x[c];
+        }
+    }
+
+    /// The block-diagonal covariance of independent rows.
+    pub fn block_covariance(&self, rows: &[RowPosterior]) -> DMatrix<f64> {
+        let k = self.len();
+        DMatrix::from_fn(k, k, |a, b| {
+            let (ia, ja) = self.index[a];
+            let (ib, jb) = self.index[b];
+            if ia == ib {
+                rows[ia].cov[(ja, jb)]
+            } else {
+                0.0
+            }
+        })
+    }
+}
+
+/// The map's outputs (A, B, M, D̄, K, F) of θ (n × (2n + q)).
+pub(crate) fn outputs(
+    theta: &DMatrix<f64>,
+    f: &LambdaFilter,
+    inversion: Inversion,
+    blocks: &DMatrix<bool>,
+) -> Option<[DMatrix<f64>; 6]> {
+    let n = theta.nrows();
+    let q = theta.ncols() - 2 * n;
+    let al = theta.columns(0, n).into_owned();
+    let bl = theta.columns(n, n).into_owned();
+    let kl = theta.columns(2 * n, q).into_owned();
+    physical(&al, &bl, &kl, f, inversion, blocks).ok()
+}
+
+/// Row offset of each output's entries (column-major) in the Jacobian, and
+/// the number of Jacobian rows.
+pub(crate) fn output_offsets(n: usize, q: usize) -> ([usize; 6], usize) {
+    let shapes = [n, n, n, n, q, q];
+    let mut offsets = [0; 6];
+    let mut acc = 0;
+    for (o, c) in shapes.iter().enumerate() {
+        offsets[o] = acc;
+        acc += n * c;
+    }
+    (offsets, acc)
+}
+
+/// ∂(A, B, M, D̄, K, F)/∂x at θ, one column per stacked free entry, by
+/// central differences with steps `STEP_OF_STD`·σ (σ from `cov`'s
+/// diagonal); `None` when the map fails at a perturbed point.
+pub(crate) fn jacobian(
+    theta: &DMatrix<f64>,
+    stacked: &Stacked,
+    cov: &DMatrix<f64>,
+    f: &LambdaFilter,
+    inversion: Inversion,
+    blocks: &DMatrix<bool>,
+) -> Option<DMatrix<f64>> {
+    let n = theta.nrows();
+    let q = theta.ncols() - 2 * n;
+    let (offsets, rows) = output_offsets(n, q);
+    let mut jac = DMatrix::zeros(rows, stacked.len());
+    for (c, &(i, j)) in stacked.index.iter().enumerate() {
+        let sd = cov[(c, c)].max(0.0).sqrt();
+        let step = (STEP_OF_STD * sd).max(1e-12 * theta[(i, j)].abs().max(f64::MIN_POSITIVE));
+        let mut plus = theta.clone();
+        plus[(i, j)] += step;
+        let mut minus = theta.clone();
+        minus[(i, j)] -= step;
+        let (pl, mi) = (
+            outputs(&plus, f, inversion, blocks)?,
+            outputs(&minus, f, inversion, blocks)?,
+        );
+        for o in 0..6 {
+            for (e, (x, y)) in pl[o].iter().zip(mi[o].iter()).enumerate() {
+                jac[(offsets[o] + e, c)] = (x - y) / (2.0 * step);
+            }
+        }
+    }
+    Some(jac)
+}
+
+/// Stds of (A, B, M, D̄, K, F) from the covariance `cov` of the stacked
+/// free entries; all NaN when the map fails at a perturbed point.
+pub(crate) fn delta_method_cov(
+    theta: &DMatrix<f64>,
+    stacked: &Stacked,
+    cov: &DMatrix<f64>,
     f: &LambdaFilter,
     inversion: Inversion,
     blocks: &DMatrix<bool>,
 ) -> [DMatrix<f64>; 6] {
-    let n = rows.len();
-    let p = rows.first().map_or(2 * n, |r| r.theta.len());
-    let q = p - 2 * n;
-    let theta = DMatrix::from_fn(n, p, |i, j| rows[i].theta[j]);
-    let eval = |th: &DMatrix<f64>| {
-        let al = th.columns(0, n).into_owned();
-        let bl = th.columns(n, n).into_owned();
-        let kl = th.columns(2 * n, q).into_owned();
-        physical(&al, &bl, &kl, f, inversion, blocks).ok()
-    };
+    let n = theta.nrows();
+    let q = theta.ncols() - 2 * n;
     let shapes = [n, n, n, n, q, q];
-    let offsets: Vec<usize> = shapes
-        .iter()
-        .scan(0, |acc, &c| {
-            let o = *acc;
-            *acc += n * c;
-            Some(o)
+    let (offsets, _) = output_offsets(n, q);
+    let Some(jac) = jacobian(theta, stacked, cov, f, inversion, blocks) else {
+        return std::array::from_fn(|o| DMatrix::from_element(n, shapes[o], f64::NAN));
+    };
+    let jc = &jac * cov;
+    std::array::from_fn(|o| {
+        DMatrix::from_fn(n, shapes[o], |r, c| {
+            let row = offsets[o] + c * n + r;
+            jc.row(row).dot(&jac.row(row)).max(0.0).sqrt()
         })
-        .collect();
-    let outputs = n * shapes.iter().sum::<usize>();
-    let mut var: [DMatrix<f64>; 6] = std::array::from_fn(|o| DMatrix::zeros(n, shapes[o]));
-    for (i, row) in rows.iter().enumerate() {
-        // J_i: one column per free parameter of row i, one row per entry of
-        // (A, B, M, D̄, K, F).
-        let k = free[i].len();
-        let mut jac = DMatrix::zeros(outputs, k);
-        let mut ok = true;
-        for (c, &j) in free[i].iter().enumerate() {
-            let sd = row.cov[(j, j)].sqrt();
-            let step = (STEP_OF_STD * sd).max(1e-12 * theta[(i, j)].abs().max(f64::MIN_POSITIVE));
-            let mut plus = theta.clone();
-            plus[(i, j)] += step;
-            let mut minus = theta.clone();
-            minus[(i, j)] -= step;
-            match (eval(&plus), eval(&minus)) {
-                (Some(pl), Some(mi)) => {
-                    for o in 0..6 {
-                        for (e, (x, y)) in pl[o].iter().zip(mi[o].iter()).enumerate() {
-                            jac[(offsets[o] + e, c)] = (x - y) / (2.0 * step);
-                        }
-                    }
-                }
-                _ => ok = false,
-            }
-        }
-        if !ok {
-            for v in var.iter_mut() {
-                v.fill(f64::NAN);
-            }
-            continue;
-        }
-        let cov = DMatrix::from_fn(k, k, |a, b| row.cov[(free[i][a], free[i][b])]);
-        let jc = &jac * cov;
-        for (o, v) in var.iter_mut().enumerate() {
-            for (e, x) in v.iter_mut().enumerate() {
-                let r = offsets[o] + e;
-                *x += jc.row(r).dot(&jac.row(r));
-            }
-        }
-    }
-    var.map(|v| v.map(|x| x.max(0.0).sqrt()))
+    })
 }
