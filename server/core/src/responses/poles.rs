@@ -15,6 +15,9 @@ use super::{LinearModel, LinearModels};
 /// rounding (the cancelled leading terms of the zero polynomial).
 const COEFF_REL_TOL: f64 = 1e-9;
 
+/// |Re s| (s⁻¹) at or below which a root lies on the imaginary axis.
+const AXIS_TOL: f64 = 1e-9;
+
 /// A pole or zero with what it means in time.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
@@ -30,7 +33,9 @@ pub struct PlaneRoot {
     /// Damping ratio ζ = −Re s / |s|; absent at s = 0 and z = 0.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub damping: Option<f64>,
-    /// Time constant 1 / |Re s| (s); absent when Re s = 0.
+    /// Time constant 1 / |Re s| (s); absent when Re s = 0 to working
+    /// precision (|Re s| ≤ 1e-9 s⁻¹: a root on the imaginary axis or at the
+    /// origin, whose round-off would read as a time constant of centuries).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_constant_s: Option<f64>,
 }
@@ -49,7 +54,9 @@ impl PlaneRoot {
             im: z.im,
             natural_frequency_rad_s: wn,
             damping: s.zip(wn).filter(|(_, w)| *w > 0.0).map(|(s, w)| -s.re / w),
-            time_constant_s: s.filter(|s| s.re != 0.0).map(|s| 1.0 / s.re.abs()),
+            time_constant_s: s
+                .filter(|s| s.re.abs() > AXIS_TOL)
+                .map(|s| 1.0 / s.re.abs()),
         }
     }
 }
@@ -225,6 +232,21 @@ mod tests {
         assert_eq!(
             PlaneRoot::of(Complex::new(0.0, 0.0), 0.1).natural_frequency_rad_s,
             None
+        );
+        // A continuous root at 4e-16 (round-off of an integrator's zero)
+        // has no time constant, not one of 2.5e15 s; 1e-8 s⁻¹ still has one.
+        assert_eq!(
+            PlaneRoot::of(Complex::new(4e-16, 0.0), 0.0).time_constant_s,
+            None
+        );
+        assert_eq!(
+            PlaneRoot::of(Complex::new(1.0 + 1e-17, 0.0), 0.1).time_constant_s,
+            None
+        );
+        assert!(
+            PlaneRoot::of(Complex::new(-1e-8, 0.0), 0.0)
+                .time_constant_s
+                .is_some()
         );
     }
 
