@@ -22,7 +22,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::filter::LambdaFilter;
 use super::transform::Inversion;
-use super::uncertainty::{Stacked, jacobian, output_offsets, outputs};
+use super::uncertainty::{Layout, Stacked, jacobian, outputs};
 
 /// Gauss–Newton iterations at most.
 const MAX_ITER: usize = 8;
@@ -72,13 +72,11 @@ pub(crate) fn constrain_symmetric(
     blocks: &DMatrix<bool>,
 ) -> Option<SymmetryFit> {
     let pairs = pairs(blocks);
-    let n = theta.nrows();
-    let q = theta.ncols() - 2 * n;
     if pairs.is_empty() || stacked.len() == 0 {
         return None;
     }
-    let (offsets, _) = output_offsets(n, q);
-    let m_row = |i: usize, j: usize| offsets[2] + j * n + i;
+    let layout = Layout::of(theta);
+    let m_row = |i: usize, j: usize| layout.row(2, i, j);
     let x_hat = stacked.gather(theta);
     let mut x = x_hat.clone();
     let mut th = theta.clone();

@@ -76,17 +76,42 @@ pub(crate) fn outputs(
     physical(&al, &bl, &kl, f, inversion, blocks).ok()
 }
 
-/// Row offset of each output's entries (column-major) in the Jacobian, and
-/// the number of Jacobian rows.
-pub(crate) fn output_offsets(n: usize, q: usize) -> ([usize; 6], usize) {
-    let shapes = [n, n, n, n, q, q];
-    let mut offsets = [0; 6];
-    let mut acc = 0;
-    for (o, c) in shapes.iter().enumerate() {
-        offsets[o] = acc;
-        acc += n * c;
+/// Where each output of the map (A, B, M, D̄, K, F) sits among the
+/// Jacobian's rows (entries column-major), for θ of n rows and q exogenous
+/// columns.
+pub(crate) struct Layout {
+    pub n: usize,
+    /// Columns of each output.
+    pub shapes: [usize; 6],
+    /// First Jacobian row of each output.
+    pub offsets: [usize; 6],
+    /// Jacobian rows in all.
+    pub rows: usize,
+}
+
+impl Layout {
+    pub fn of(theta: &DMatrix<f64>) -> Self {
+        let n = theta.nrows();
+        let q = theta.ncols() - 2 * n;
+        let shapes = [n, n, n, n, q, q];
+        let mut offsets = [0; 6];
+        let mut rows = 0;
+        for (o, c) in shapes.iter().enumerate() {
+            offsets[o] = rows;
+            rows += n * c;
+        }
+        Layout {
+            n,
+            shapes,
+            offsets,
+            rows,
+        }
     }
-    (offsets, acc)
+
+    /// The Jacobian row of entry (r, c) of output `o`.
+    pub fn row(&self, o: usize, r: usize, c: usize) -> usize {
+        self.offsets[o] + c * self.n + r
+    }
 }
 
 /// ∂(A, B, M, D̄, K, F)/∂x at θ, one column per stacked free entry, by
@@ -100,10 +125,8 @@ pub(crate) fn jacobian(
     inversion: Inversion,
     blocks: &DMatrix<bool>,
 ) -> Option<DMatrix<f64>> {
-    let n = theta.nrows();
-    let q = theta.ncols() - 2 * n;
-    let (offsets, rows) = output_offsets(n, q);
-    let mut jac = DMatrix::zeros(rows, stacked.len());
+    let layout = Layout::of(theta);
+    let mut jac = DMatrix::zeros(layout.rows, stacked.len());
     for (c, &(i, j)) in stacked.index.iter().enumerate() {
         let sd = cov[(c, c)].max(0.0).sqrt();
         let step = (STEP_OF_STD * sd).max(1e-12 * theta[(i, j)].abs().max(f64::MIN_POSITIVE));
@@ -117,7 +140,7 @@ pub(crate) fn jacobian(
         );
         for o in 0..6 {
             for (e, (x, y)) in pl[o].iter().zip(mi[o].iter()).enumerate() {
-                jac[(offsets[o] + e, c)] = (x - y) / (2.0 * step);
+                jac[(layout.offsets[o] + e, c)] = (x - y) / (2.0 * step);
             }
         }
     }
@@ -134,17 +157,16 @@ pub(crate) fn delta_method_cov(
     inversion: Inversion,
     blocks: &DMatrix<bool>,
 ) -> [DMatrix<f64>; 6] {
-    let n = theta.nrows();
-    let q = theta.ncols() - 2 * n;
-    let shapes = [n, n, n, n, q, q];
-    let (offsets, _) = output_offsets(n, q);
+    let layout = Layout::of(theta);
     let Some(jac) = jacobian(theta, stacked, cov, f, inversion, blocks) else {
-        return std::array::from_fn(|o| DMatrix::from_element(n, shapes[o], f64::NAN));
+        return std::array::from_fn(|o| {
+            DMatrix::from_element(layout.n, layout.shapes[o], f64::NAN)
+        });
     };
     let jc = &jac * cov;
     std::array::from_fn(|o| {
-        DMatrix::from_fn(n, shapes[o], |r, c| {
-            let row = offsets[o] + c * n + r;
+        DMatrix::from_fn(layout.n, layout.shapes[o], |r, c| {
+            let row = layout.row(o, r, c);
             jc.row(row).dot(&jac.row(row)).max(0.0).sqrt()
         })
     })
