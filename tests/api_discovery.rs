@@ -19,11 +19,12 @@ async fn app() -> TestApp {
 }
 
 /// Identifies campaign `cid` by `method`; the stored model's id. A λ model
-/// is fitted without g(η) and constant loads, so the restoring, tether and
-/// load effects the cases conceal are missing from the baseline.
+/// is fitted without g(η), constant loads and C(δ)δ, so the restoring,
+/// tether, load and Coriolis effects the cases conceal are missing from
+/// the baseline.
 async fn identified(app: &TestApp, cid: &str, method: &str) -> String {
     let settings = if method == "lambda_kf" {
-        json!({ "estimate_restoring": false, "constant_loads": false })
+        json!({ "estimate_restoring": false, "constant_loads": false, "coriolis_second_order": false })
     } else {
         json!({})
     };

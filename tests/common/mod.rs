@@ -385,6 +385,7 @@ pub async fn stored_model(
             }],
             logged_controller: None,
             extension: None,
+            coriolis_second_order: false,
         }),
         dp_ship: None,
         state_space: None,

@@ -552,41 +552,7 @@ impl TermContext<'_> {
     }
 }
 
-/// C(ν)ν over the modeled DOFs for a symmetric M (Fossen 1994):
-/// C(ν) = [[0, −S(M₁₁ν₁+M₁₂ν₂)], [−S(M₁₁ν₁+M₁₂ν₂), −S(M₂₁ν₁+M₂₂ν₂)]];
-/// unmodeled velocities are zero.
-pub fn coriolis_force(dofs: &[Dof], m: &DMatrix<f64>, nu: &[f64]) -> Vec<f64> {
-    let mut m6 = [[0.0; 6]; 6];
-    let mut v6 = [0.0; 6];
-    for (i, di) in dofs.iter().enumerate() {
-        v6[di.index()] = nu[i];
-        for (j, dj) in dofs.iter().enumerate() {
-            m6[di.index()][dj.index()] = 0.5 * (m[(i, j)] + m[(j, i)]);
-        }
-    }
-    let a: [f64; 6] = std::array::from_fn(|i| (0..6).map(|j| m6[i][j] * v6[j]).sum());
-    let cross = |x: [f64; 3], y: [f64; 3]| {
-        [
-            x[1] * y[2] - x[2] * y[1],
-            x[2] * y[0] - x[0] * y[2],
-            x[0] * y[1] - x[1] * y[0],
-        ]
-    };
-    let (n1, n2) = ([v6[0], v6[1], v6[2]], [v6[3], v6[4], v6[5]]);
-    let (a1, a2) = ([a[0], a[1], a[2]], [a[3], a[4], a[5]]);
-    let lin = cross(n2, a1);
-    let ang1 = cross(n1, a1);
-    let ang2 = cross(n2, a2);
-    let f6 = [
-        lin[0],
-        lin[1],
-        lin[2],
-        ang1[0] + ang2[0],
-        ang1[1] + ang2[1],
-        ang1[2] + ang2[2],
-    ];
-    dofs.iter().map(|d| f6[d.index()]).collect()
-}
+pub use crate::models::coriolis::coriolis_force;
 
 /// Which candidate families to try.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -56,6 +56,10 @@ pub struct Baseline {
     pub d_bar: DMatrix<f64>,
     /// g(η) of the baseline.
     pub restoring: Restoring,
+    /// The vehicle's M of the second-order Coriolis–centripetal force
+    /// C(δ)δ the baseline carries (see
+    /// [`crate::models::coriolis::second_order_force`]); `None`: linear.
+    pub coriolis: Option<DMatrix<f64>>,
 }
 
 impl Baseline {
@@ -68,7 +72,28 @@ impl Baseline {
             m: model.m().clone(),
             d_bar: model.d_bar().clone(),
             restoring,
+            coriolis: None,
         }
+    }
+
+    /// The forces the baseline knows beside M ν̇ + D̄ ν at pose `eta` and
+    /// velocity `nu` (modelled DOFs): g(η) with its constant loads, plus
+    /// C(δ)δ when the baseline carries it.
+    pub fn known_force(&self, eta: &[f64; 6], nu: &[f64]) -> Vec<f64> {
+        let mut f = self.g(eta);
+        if let Some(r) = self.second_order(nu) {
+            f.iter_mut().zip(r).for_each(|(a, b)| *a += b);
+        }
+        f
+    }
+
+    /// C(δ)δ at `nu` when the baseline carries it (and models surge).
+    pub fn second_order(&self, nu: &[f64]) -> Option<Vec<f64>> {
+        let m = self.coriolis.as_ref()?;
+        let surge = self.index_of(Dof::Surge)?;
+        Some(crate::models::coriolis::second_order_force(
+            &self.dofs, m, nu, surge,
+        ))
     }
 
     /// Number of modeled DOFs.

@@ -131,8 +131,14 @@ impl<'a> Prepared<'a> {
                     lam_tau: vec![],
                     lam_g: vec![],
                 };
-                let gs: Vec<Vec<f64>> =
-                    (0..rec.len()).map(|k| baseline.g(&rec.eta_at(k))).collect();
+                // g(η) and, when the baseline carries it, C(δ)δ at the
+                // measured ν: the forces the baseline already explains.
+                let gs: Vec<Vec<f64>> = (0..rec.len())
+                    .map(|k| {
+                        let nu: Vec<f64> = rec.nu.row(k).iter().copied().collect();
+                        baseline.known_force(&rec.eta_at(k), &nu)
+                    })
+                    .collect();
                 for i in 0..n {
                     let nu = rec.nu.column(i);
                     let l = svf.foh(nu.as_slice());
@@ -558,6 +564,7 @@ impl<'a> Prepared<'a> {
             f.d_ref.clone(),
             terms,
         )
+        .with_coriolis(b.coriolis.clone())
     }
 
     /// (M_rr, D̄_rr) of row `r` (the `ri`-th of `f`) after the fit, where

@@ -62,6 +62,8 @@ pub struct AugmentedModel {
     pub d_ref: DMatrix<f64>,
     /// The added terms.
     pub terms: Vec<ModelTerm>,
+    /// The vehicle's M of the baseline's C(δ)δ, if it carries one.
+    pub coriolis: Option<DMatrix<f64>>,
     m_inv: DMatrix<f64>,
     /// ‖M⁻¹D̄‖∞ (1/s), a bound on the fastest linear mode: a step of h is
     /// split so that h·rate ≤ 2, inside RK4's stability interval (−2.78, 0].
@@ -129,6 +131,7 @@ impl AugmentedModel {
             m: self.m.clone(),
             d_bar: self.d_bar.clone(),
             restoring: self.restoring,
+            coriolis: self.coriolis.clone(),
         }
     }
 
@@ -143,6 +146,14 @@ impl AugmentedModel {
             b.d_bar.clone(),
             vec![],
         )
+        .with_coriolis(b.coriolis.clone())
+    }
+
+    /// The same model carrying the second-order Coriolis force C(δ)δ of
+    /// the vehicle's inertia `m` (`None`: without it).
+    pub fn with_coriolis(mut self, m: Option<DMatrix<f64>>) -> Self {
+        self.coriolis = m;
+        self
     }
 
     /// A model from its parts (M must be invertible; a singular M is
@@ -173,6 +184,7 @@ impl AugmentedModel {
             terms,
             m_inv,
             rate: if rate.is_finite() { rate } else { 0.0 },
+            coriolis: None,
         }
     }
 
@@ -224,6 +236,15 @@ impl AugmentedModel {
                 .map(|(j, v)| self.d_bar[(i, j)] * v)
                 .sum();
             f[i] = tau_a[i] - g[i] - damping - lhs[i];
+        }
+        if let (Some(m), Some(s)) = (
+            &self.coriolis,
+            self.dofs.iter().position(|d| *d == Dof::Surge),
+        ) {
+            let c = crate::models::coriolis::second_order_force(&self.dofs, m, &nu[..n], s);
+            for i in 0..n {
+                f[i] -= c[i];
+            }
         }
         for (i, o) in out.iter_mut().enumerate().take(n) {
             *o = f[..n]
@@ -522,6 +543,7 @@ mod tests {
             m: DMatrix::from_element(1, 1, m),
             d_bar: DMatrix::from_element(1, 1, d),
             restoring: Restoring::default(),
+            coriolis: None,
         };
         let rec = Record {
             name: "step".into(),

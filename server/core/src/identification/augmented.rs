@@ -72,12 +72,19 @@ pub fn baseline_at(doc: &ModelDocument, point: &LpvPoint) -> Result<Baseline, Id
     for (i, d) in doc.dofs.iter().enumerate() {
         restoring.constant[d.index()] = load_of(doc, point)[i];
     }
-    let (m, d_bar) = logged_view(doc, matrix(&point.m, "M")?, matrix(&point.d_bar, "D̄")?)?;
+    let vehicle_m = matrix(&point.m, "M")?;
+    let coriolis = doc
+        .lpv
+        .as_ref()
+        .is_some_and(|l| l.coriolis_second_order)
+        .then(|| vehicle_m.clone());
+    let (m, d_bar) = logged_view(doc, vehicle_m, matrix(&point.d_bar, "D̄")?)?;
     Ok(Baseline {
         dofs: doc.dofs.clone(),
         m,
         d_bar,
         restoring,
+        coriolis,
     })
 }
 
@@ -97,7 +104,8 @@ pub fn augmented_at(
             matrix(&a.m_ref, "augmentation.m_ref")?,
             matrix(&a.d_ref, "augmentation.d_ref")?,
             a.terms.clone(),
-        ),
+        )
+        .with_coriolis(b.coriolis),
     })
 }
 
@@ -241,7 +249,8 @@ fn beyond(base: &LpvModel, end: &AugmentedModel, s: f64) -> Result<AugmentedMode
         end.m_ref.clone(),
         end.d_ref.clone(),
         end.terms.clone(),
-    ))
+    )
+    .with_coriolis(end.coriolis.clone()))
 }
 
 /// Maximal stretches [start, end) over which the forward speed `u`,

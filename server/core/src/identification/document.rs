@@ -179,6 +179,12 @@ pub struct LpvDoc {
     /// (thesis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extension: Option<SpeedExtension>,
+    /// The sub-models are driven by γ − C(δ)δ: the second-order Coriolis–
+    /// centripetal force of each point's M, with δ = ν except the forward
+    /// speed u the model is scheduled on (C(ν) of Fossen 2011, eq. 6.43).
+    /// Absent or false: the linear sub-models alone (thesis).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub coriolis_second_order: bool,
 }
 
 /// Speeds (m/s) an LPV model extends to beyond its grid.

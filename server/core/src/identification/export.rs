@@ -167,15 +167,19 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
             {
                 notes.push(e.describe(lo.speed_mps, hi.speed_mps));
             }
+            if lpv.coriolis_second_order {
+                notes.push("Second-order Coriolis–centripetal force: add C(δ)δ to the left-hand side, C(ν) from the point's M (Fossen 2011, eq. 6.43) at δ = ν with the forward speed u set to zero — the turning, heaving and rolling forces about straight-ahead motion; the linear part about U is in D and b.".into());
+            }
             if augmented {
                 notes.push("Discovered physics: each point's `terms` add to the left-hand side (their coefficients times the regressor named in `label`), or shape τ before it acts (lag, delay, saturation, dead zone); M and D are then the refitted ones.".into());
             }
             Ok(FossenParameterSet {
                 format: "seatrial-fossen/1".into(),
-                equation: if augmented {
-                    "M·ν̇ + D·ν + b + Σ terms(ν, η) + g(η) = τ_applied (per forward speed U)".into()
-                } else {
-                    "M·ν̇ + D·ν + b + g(η) = τ (per forward speed U; C(ν) from M)".into()
+                equation: match (augmented, lpv.coriolis_second_order) {
+                    (true, false) => "M·ν̇ + D·ν + b + Σ terms(ν, η) + g(η) = τ_applied (per forward speed U)".into(),
+                    (true, true) => "M·ν̇ + D·ν + b + C(δ)δ + Σ terms(ν, η) + g(η) = τ_applied (per forward speed U)".into(),
+                    (false, true) => "M·ν̇ + D·ν + b + C(δ)δ + g(η) = τ (per forward speed U; C(δ) from M, δ = ν with u = 0)".into(),
+                    (false, false) => "M·ν̇ + D·ν + b + g(η) = τ (per forward speed U; C(ν) from M)".into(),
                 },
                 dofs,
                 units: "SI (kg, kg·m, kg·m², kg/s, N, N·m)".into(),
@@ -267,6 +271,7 @@ mod tests {
                 }],
                 logged_controller: None,
                 extension: None,
+                coriolis_second_order: false,
             }),
             dp_ship: None,
             state_space: None,

@@ -122,6 +122,25 @@ pub fn matlab_script(doc: &ModelDocument, name: &str, version: i64) -> String {
             w,
             "% (nu_dot = A nu + B (tau - g(eta) - b)); between grid points interpolate or take the nearest."
         );
+        if l.coriolis_second_order {
+            let _ = writeln!(
+                w,
+                "% Second-order Coriolis: add C(d)*d to the left-hand side, with d = nu but u = 0 and C from M(:,:,i) (Fossen 2011, eq. 6.43):"
+            );
+            let _ = writeln!(
+                w,
+                "% C = [zeros(3), -S(M11*d1 + M12*d2); -S(M11*d1 + M12*d2), -S(M21*d1 + M22*d2)], S(a)*b = cross(a, b), d1 = d(1:3), d2 = d(4:6)."
+            );
+        }
+        let _ = writeln!(
+            w,
+            "model.lpv.coriolis_second_order = {};",
+            if l.coriolis_second_order {
+                "true"
+            } else {
+                "false"
+            }
+        );
         let _ = writeln!(w, "model.lpv.t_lambda_s = {};", number(l.t_lambda_s));
         let _ = writeln!(w, "model.lpv.structure = {};", string(&l.structure));
         let speeds: Vec<f64> = l.points.iter().map(|p| p.speed_mps).collect();

@@ -6,7 +6,6 @@
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 
-use super::attitude_loop::AttitudeLoop;
 use super::dataset::Segment;
 use super::dataset::{RunInput, segments};
 use super::document::{
@@ -23,7 +22,8 @@ use super::lambda_extension::{BELOW, choose_extension, speed_coverage_notes};
 use super::lambda_information::default_t_lambda;
 use super::lambda_physical::enforce;
 use super::lambda_structure::choose_structure;
-use super::outcome::{Identified, RunValidation};
+use super::lambda_validation::{HeldOut, choose_second_order};
+use super::outcome::Identified;
 use super::roles::assign_roles;
 use crate::estimation::lambda::{Experiment, LambdaEstimate, LambdaSettings, MIN_T_OVER_H, Prior};
 use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
@@ -31,7 +31,7 @@ use crate::estimation::{Progress, SubProgress};
 use crate::models::{LinearVesselModel, LpvModel, Scheduling};
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
-use crate::validation::{ValidationRecord, ValidationSettings, validate};
+use crate::validation::ValidationSettings;
 
 /// The coupling structure to identify.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -130,6 +130,13 @@ pub struct LambdaCampaignSettings {
     /// until discovery's refit of touched rows works from such a model.
     #[serde(default)]
     pub symmetric_inertia: bool,
+    /// Carry the second-order Coriolis–centripetal force C(δ)δ of the
+    /// estimated M in the model (δ = ν about straight-ahead motion at the
+    /// scheduled speed): the centripetal forces of turning, heaving and
+    /// rolling that no linear sub-model holds, with no parameter added
+    /// (models with a surge DOF).
+    #[serde(default = "default_true")]
+    pub coriolis_second_order: bool,
 }
 
 fn default_threshold() -> f64 {
@@ -158,6 +165,7 @@ impl Default for LambdaCampaignSettings {
             controller_rate_hz: None,
             extend_below_grid: true,
             symmetric_inertia: false,
+            coriolis_second_order: true,
         }
     }
 }
@@ -479,9 +487,17 @@ pub fn identify_lambda_campaign(
         SchedulingChoice::Interpolate => Scheduling::Interpolate,
     };
     let speeds: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
+    let second_order = settings.coriolis_second_order && dofs.contains(&Dof::Surge);
+    let vehicle_m: Vec<_> = vehicle.iter().map(|v| v.m().clone()).collect();
     let lpv = LpvModel::new(speeds.clone(), models)
         .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
         .with_scheduling(scheduling);
+    let lpv = if second_order {
+        lpv.with_second_order_coriolis(vehicle_m)
+            .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
+    } else {
+        lpv
+    };
     // Beyond the grid: extended as far as the vehicle's model stays physical.
     let extension = (settings.extend_below_grid && scheduling == Scheduling::Interpolate)
         .then(|| LpvModel::new(speeds, vehicle).ok())
@@ -507,51 +523,28 @@ pub fn identify_lambda_campaign(
         input_names: input_names.clone(),
         ..ValidationSettings::default()
     };
-    let attitude_loop = g.and_then(|g| AttitudeLoop::new(lpv.clone(), *g));
-    let loop_settings = ValidationSettings {
-        input_names: AttitudeLoop::input_names(&cols[..n]),
-        ..vsettings.clone()
+    let held_out = HeldOut {
+        runs: &roles.validation,
+        cols: &cols,
+        outputs: &outputs,
+        n,
+        restoring: g,
+        settings: &vsettings,
     };
-    let mut validation = Vec::new();
-    for r in &roles.validation {
-        let segs = segments(r, &cols, &outputs, 50)
-            .map_err(|e| IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string()))?;
-        let longest = segs
-            .iter()
-            .max_by_key(|s| s.y.nrows())
-            .expect("segments is non-empty");
-        let report = match &attitude_loop {
-            // g(η) of the simulated attitude in the loop: record [τ | η].
-            Some(model) => validate(
-                model,
-                &ValidationRecord {
-                    h: longest.h,
-                    u: &longest.u.columns(0, 12).into_owned(),
-                    y: &longest.y,
-                },
-                &loop_settings,
-            ),
-            None => {
-                let e = experiment(longest, n, g, None)?;
-                let rec = ValidationRecord {
-                    h: longest.h,
-                    u: &e.gamma,
-                    y: &e.nu,
-                };
-                validate(&lpv, &rec, &vsettings)
+    let validate_with = |lpv: &LpvModel| held_out.validate(lpv);
+    let validation = validate_with(&lpv)?;
+    let (lpv, validation, second_order) =
+        choose_second_order(lpv, validation, second_order, &validate_with, &mut notes)?;
+    if let Some(j) = dofs.iter().position(|d| *d == Dof::Surge) {
+        for r in &roles.validation {
+            if let Ok(segs) = segments(r, &cols, &outputs, 50)
+                && let Some(longest) = segs.iter().max_by_key(|s| s.y.nrows())
+            {
+                let u: Vec<f64> = longest.y.column(j).iter().copied().collect();
+                let grid: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
+                notes.extend(speed_coverage_notes(&r.name, &u, &grid, lpv.extension()));
             }
         }
-        .map_err(|e| IdentifyError::invalid(format!("runs[{}]", r.run_id), e.to_string()))?;
-        if let Some(j) = dofs.iter().position(|d| *d == Dof::Surge) {
-            let u: Vec<f64> = longest.y.column(j).iter().copied().collect();
-            let grid: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
-            notes.extend(speed_coverage_notes(&r.name, &u, &grid, lpv.extension()));
-        }
-        validation.push(RunValidation {
-            run_id: r.run_id.clone(),
-            run_name: r.name.clone(),
-            report,
-        });
     }
     progress.update(1.0, "done")?;
 
@@ -572,6 +565,7 @@ pub fn identify_lambda_campaign(
             points: lpv_points,
             logged_controller,
             extension: extension.map(|(e, _)| SpeedExtension::from(e)),
+            coriolis_second_order: second_order,
         }),
         dp_ship: None,
         state_space: None,

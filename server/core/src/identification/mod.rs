@@ -56,6 +56,7 @@ mod lambda_extension;
 pub mod lambda_information;
 mod lambda_physical;
 mod lambda_structure;
+mod lambda_validation;
 pub mod mat;
 pub mod n4sid_campaign;
 pub mod npz;

@@ -91,8 +91,10 @@ pub(crate) fn baseline_lpv(doc: &ModelDocument) -> Result<LpvModel, IdentifyErro
         .as_ref()
         .ok_or_else(|| IdentifyError::invalid("document.lpv", "missing"))?;
     let mut models = Vec::new();
+    let mut vehicle_m = Vec::new();
     for p in &lpv.points {
         let (m, d_bar) = (matrix(&p.m, "M")?, matrix(&p.d_bar, "D̄")?);
+        vehicle_m.push(m.clone());
         // Predictions on logs of a controller faster than the log add its
         // unlogged commands back.
         let (m, d_bar) = match &lpv.logged_controller {
@@ -109,6 +111,13 @@ pub(crate) fn baseline_lpv(doc: &ModelDocument) -> Result<LpvModel, IdentifyErro
     let speeds = lpv.points.iter().map(|p| p.speed_mps).collect();
     let model = LpvModel::new(speeds, models)
         .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?;
+    let model = if lpv.coriolis_second_order {
+        model.with_second_order_coriolis(vehicle_m).map_err(|e| {
+            IdentifyError::invalid("document.lpv.coriolis_second_order", e.to_string())
+        })?
+    } else {
+        model
+    };
     match lpv.extension {
         Some(e) => model
             .with_extension(e.into())

@@ -367,6 +367,7 @@ pub(crate) fn lpv_doc(
             points,
             logged_controller: None,
             extension: None,
+            coriolis_second_order: false,
         }),
         dp_ship: None,
         state_space: None,

@@ -13,6 +13,7 @@
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
 
 use super::error::{ModelError, check_finite};
+use crate::planning::dof::Dof;
 
 /// Skew-symmetric cross-product matrix S(a): S(a)b = a × b.
 pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
@@ -85,9 +86,108 @@ pub fn coriolis(m: &DMatrix<f64>, nu: &DVector<f64>) -> Result<DMatrix<f64>, Mod
     })
 }
 
+/// C(ν)ν over the modelled DOFs `dofs` (the columns of `m` and `nu`) for
+/// the symmetric part of M (Fossen 1994): the 6-DOF form with unmodelled
+/// velocities zero, so a horizontal model gets the 3-DOF C(ν)ν. Non-finite
+/// input propagates (no error: a diverging simulation shows as such).
+pub fn coriolis_force(dofs: &[Dof], m: &DMatrix<f64>, nu: &[f64]) -> Vec<f64> {
+    let mut m6 = [[0.0; 6]; 6];
+    let mut v6 = [0.0; 6];
+    for (i, di) in dofs.iter().enumerate() {
+        v6[di.index()] = nu[i];
+        for (j, dj) in dofs.iter().enumerate() {
+            m6[di.index()][dj.index()] = 0.5 * (m[(i, j)] + m[(j, i)]);
+        }
+    }
+    let a: [f64; 6] = std::array::from_fn(|i| (0..6).map(|j| m6[i][j] * v6[j]).sum());
+    let cross = |x: [f64; 3], y: [f64; 3]| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    let (n1, n2) = ([v6[0], v6[1], v6[2]], [v6[3], v6[4], v6[5]]);
+    let (a1, a2) = ([a[0], a[1], a[2]], [a[3], a[4], a[5]]);
+    let lin = cross(n2, a1);
+    let ang1 = cross(n1, a1);
+    let ang2 = cross(n2, a2);
+    let f6 = [
+        lin[0],
+        lin[1],
+        lin[2],
+        ang1[0] + ang2[0],
+        ang1[1] + ang2[1],
+        ang1[2] + ang2[2],
+    ];
+    dofs.iter().map(|d| f6[d.index()]).collect()
+}
+
+/// The second-order part of C(ν)ν about straight-ahead motion at the
+/// scheduled forward speed: C(δ)δ with δ = ν except u (the entry `surge`),
+/// which the scheduling follows.
+///
+/// C(ν)ν is quadratic in ν, so with ν = ν₀ + δ about ν₀ = (u₀, 0, …, 0) it
+/// is C(ν₀)ν₀ + J_C(u₀)δ + C(δ)δ. A sub-model linearized at u₀ holds the
+/// first two in its load and D̄; blending sub-models linearly in u about
+/// the measured u makes the u-products of the blend exact, leaving C(δ)δ —
+/// the centripetal forces of a turning, heaving, rolling hull (the surge
+/// force (M₂₂v + …)r of a turn) that no linear sub-model can carry. It adds
+/// no parameter: M gives it (Fossen et al. 1995, eq. 11).
+pub fn second_order_force(dofs: &[Dof], m: &DMatrix<f64>, nu: &[f64], surge: usize) -> Vec<f64> {
+    let mut delta = nu.to_vec();
+    delta[surge] = 0.0;
+    coriolis_force(dofs, m, &delta)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Diagonal M, δ = (0, v, 0, 0, 0, r): the only second-order force is
+    /// the surge −m_v·v·r of a turning hull (Fossen 2011, eq. 6.43 with
+    /// C(ν)ν on the left), and u plays no part.
+    #[test]
+    fn second_order_force_of_a_turn_is_the_surge_centripetal_term() {
+        let m = DMatrix::from_diagonal(&DVector::from_vec(vec![
+            300.0, 450.0, 500.0, 40.0, 60.0, 70.0,
+        ]));
+        let (v, r) = (0.3, 0.2);
+        for u in [0.0, 1.7] {
+            let f = second_order_force(&Dof::ALL, &m, &[u, v, 0.0, 0.0, 0.0, r], 0);
+            assert!((f[0] + 450.0 * v * r).abs() < 1e-12, "surge {}", f[0]);
+            for (i, x) in f.iter().enumerate().skip(1) {
+                assert!(x.abs() < 1e-12, "DOF {i}: {x}");
+            }
+        }
+        // The full C(ν)ν at u = 1.7 has the Munk moment (m_v − m_u)·u·v in
+        // yaw and m_u·u·r in sway: those belong to the linear sub-models.
+        let full = coriolis_force(&Dof::ALL, &m, &[1.7, v, 0.0, 0.0, 0.0, r]);
+        assert!((full[1] - 300.0 * 1.7 * r).abs() < 1e-9);
+        assert!((full[5] - (450.0 - 300.0) * 1.7 * v).abs() < 1e-9);
+    }
+
+    /// On a horizontal model (surge, sway, yaw) the embedding gives the
+    /// 3-DOF C(ν)ν.
+    #[test]
+    fn horizontal_embedding_is_the_three_dof_form() {
+        let m3 = Matrix3::new(300.0, 0.0, 0.0, 0.0, 450.0, 20.0, 0.0, 20.0, 70.0);
+        let nu = Vector3::new(1.2, -0.4, 0.15);
+        let want = coriolis_3dof(&m3, &nu) * nu;
+        let got = coriolis_force(
+            &[Dof::Surge, Dof::Sway, Dof::Yaw],
+            &DMatrix::from_iterator(3, 3, m3.iter().copied()),
+            nu.as_slice(),
+        );
+        for i in 0..3 {
+            assert!(
+                (got[i] - want[i]).abs() < 1e-9,
+                "{i}: {} vs {}",
+                got[i],
+                want[i]
+            );
+        }
+    }
 
     /// A coupled symmetric positive-definite M (ROV-like magnitudes).
     fn coupled_m() -> Matrix6<f64> {

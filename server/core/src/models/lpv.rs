@@ -23,6 +23,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::coriolis::second_order_force;
 use super::error::{ModelError, check_finite};
 pub use super::lpv_schedule::{Blend, Extension, ScheduleWeights, Scheduling};
 use super::lpv_schedule::{blend as schedule_blend, schedule};
@@ -40,6 +41,10 @@ pub struct LpvModel {
     points: Vec<LinearVesselModel>,
     scheduling: Scheduling,
     extension: Option<Extension>,
+    /// The vehicle's M per grid point for the second-order Coriolis–
+    /// centripetal force C(δ)δ ([`second_order_force`]); `None`: the thesis's
+    /// linear sub-models alone.
+    coriolis: Option<Vec<DMatrix<f64>>>,
 }
 
 /// An [`LpvModel`] discretized (ZOH) at one sample time, ready to step.
@@ -53,7 +58,14 @@ pub struct DiscreteLpv {
     /// at evenly spaced speeds from each grid end outwards to the edge,
     /// below and above; empty without an extension.
     beyond: [Vec<(f64, DiscreteStateSpace)>; 2],
+    dofs: Vec<Dof>,
+    /// M per grid point for C(δ)δ, if the model carries it.
+    coriolis: Option<Vec<DMatrix<f64>>>,
 }
+
+/// A discrete sub-model, its blending weight and the grid point whose M
+/// it has.
+type Weighted<'a> = (&'a DiscreteStateSpace, f64, usize);
 
 /// Speeds tabulated over each side of an extension. Φ = e^{Ah} is not
 /// linear in A: extrapolating the end points' Φ linearly can leave the
@@ -122,6 +134,7 @@ impl LpvModel {
             points,
             scheduling: Scheduling::default(),
             extension: None,
+            coriolis: None,
         })
     }
 
@@ -149,6 +162,58 @@ impl LpvModel {
         }
         self.extension = Some(ext);
         Ok(self)
+    }
+
+    /// The same model with the second-order Coriolis–centripetal force
+    /// C(δ)δ of the vehicle's inertia `m` (one per grid point, the M of the
+    /// vehicle rather than the M a log behind a faster controller shows):
+    /// each sub-model is driven by γ − C(δ)δ ([`second_order_force`]).
+    /// Beyond the grid the end point's M serves, as M does.
+    ///
+    /// # Errors
+    /// [`ModelError::Grid`] without a surge DOF (δ is taken about the
+    /// scheduled forward speed) or with one M per grid point missing;
+    /// [`ModelError::Shape`] or a finiteness error for a malformed M.
+    pub fn with_second_order_coriolis(mut self, m: Vec<DMatrix<f64>>) -> Result<Self, ModelError> {
+        if !self.dofs().contains(&Dof::Surge) {
+            return Err(ModelError::Grid {
+                reason: "the second-order Coriolis force is taken about the forward speed: surge must be modelled".into(),
+            });
+        }
+        if m.len() != self.points.len() {
+            return Err(ModelError::Grid {
+                reason: format!(
+                    "one M per grid point is needed for the Coriolis force: got {} for {} points",
+                    m.len(),
+                    self.points.len()
+                ),
+            });
+        }
+        let n = self.dofs().len();
+        for (k, mk) in m.iter().enumerate() {
+            if mk.shape() != (n, n) {
+                return Err(ModelError::Shape {
+                    name: format!("coriolis M[{k}]"),
+                    expected: format!("{n}×{n}"),
+                    found: mk.shape(),
+                });
+            }
+            check_finite("coriolis M", mk.iter())?;
+        }
+        self.coriolis = Some(m);
+        Ok(self)
+    }
+
+    /// The same model without the second-order Coriolis force.
+    pub fn without_second_order_coriolis(mut self) -> Self {
+        self.coriolis = None;
+        self
+    }
+
+    /// The vehicle's M per grid point of the second-order Coriolis force,
+    /// if the model carries it.
+    pub fn second_order_coriolis(&self) -> Option<&[DMatrix<f64>]> {
+        self.coriolis.as_deref()
     }
 
     /// The speeds the model extends to beyond its grid, if any.
@@ -257,6 +322,8 @@ impl LpvModel {
             points,
             surge: self.dofs().iter().position(|d| *d == Dof::Surge),
             beyond,
+            dofs: self.dofs().to_vec(),
+            coriolis: self.coriolis.clone(),
         })
     }
 
@@ -298,7 +365,7 @@ impl DiscreteLpv {
     /// nearest tabulated models).
     pub fn at(&self, speed: f64, scheduling: Scheduling) -> Result<DiscreteStateSpace, ModelError> {
         check_speed(speed)?;
-        let ((l, wl), (u, wu)) = self.pair(speed, scheduling);
+        let ((l, wl, _), (u, wu, _)) = self.pair(speed, scheduling);
         if wu == 0.0 {
             return Ok(l.clone());
         }
@@ -313,12 +380,9 @@ impl DiscreteLpv {
     }
 
     /// The two discrete models blended at `speed` with their weights (the
-    /// second weight 0 when one model serves).
-    fn pair(
-        &self,
-        speed: f64,
-        scheduling: Scheduling,
-    ) -> ((&DiscreteStateSpace, f64), (&DiscreteStateSpace, f64)) {
+    /// second weight 0 when one model serves) and the grid point whose M
+    /// each has.
+    fn pair(&self, speed: f64, scheduling: Scheduling) -> (Weighted<'_>, Weighted<'_>) {
         let g = &self.grid_speeds;
         let last = g.len() - 1;
         let side = match scheduling {
@@ -335,18 +399,28 @@ impl DiscreteLpv {
                 for (s, model) in table {
                     if d <= dist(*s) {
                         let w = (dist(*s) - d) / (dist(*s) - dist(prev.0));
-                        return ((prev.1, w), (model, 1.0 - w));
+                        return ((prev.1, w, end), (model, 1.0 - w, end));
                     }
                     prev = (*s, model);
                 }
-                return ((prev.1, 1.0), (prev.1, 0.0));
+                return ((prev.1, 1.0, end), (prev.1, 0.0, end));
             }
         }
         let w = schedule(g, speed, scheduling);
         (
-            (&self.points[w.lower], w.w_lower),
-            (&self.points[w.upper], 1.0 - w.w_lower),
+            (&self.points[w.lower], w.w_lower, w.lower),
+            (&self.points[w.upper], 1.0 - w.w_lower, w.upper),
         )
+    }
+
+    /// γ − C(δ)δ with grid point `k`'s M (γ itself without the term).
+    fn driving(&self, x: &DVector<f64>, u: &DVector<f64>, k: usize) -> DVector<f64> {
+        match (&self.coriolis, self.surge) {
+            (Some(m), Some(i)) => {
+                u - DVector::from_vec(second_order_force(&self.dofs, &m[k], x.as_slice(), i))
+            }
+            _ => u.clone(),
+        }
     }
 
     /// x̂(k+1 | k) from ν(k) = `x` and γ(k) = `u`, scheduled on the surge
@@ -354,15 +428,25 @@ impl DiscreteLpv {
     /// first grid point. A non-finite speed schedules on the first grid point
     /// too (its prediction is non-finite anyway).
     pub fn step(&self, x: &DVector<f64>, u: &DVector<f64>, scheduling: Scheduling) -> DVector<f64> {
-        let ((l, wl), (m, wm)) = match self.surge {
+        let ((l, wl, kl), (m, wm, km)) = match self.surge {
             Some(i) if x[i].is_finite() => self.pair(x[i], scheduling),
             _ => self.pair(self.grid_speeds[0], Scheduling::Nearest),
         };
-        let lower = l.step(x, u);
-        if wm == 0.0 {
-            return lower;
+        let blend = |force: &dyn Fn(usize) -> DVector<f64>| {
+            let lower = l.step(x, &force(kl));
+            if wm == 0.0 {
+                lower
+            } else {
+                lower * wl + m.step(x, &force(km)) * wm
+            }
+        };
+        if self.coriolis.is_none() {
+            return blend(&|_| u.clone());
         }
-        lower * wl + m.step(x, u) * wm
+        // C(δ)δ over the step by Heun's rule: its mean of the start and
+        // the predicted end (held at the start it lags fast turns).
+        let predicted = blend(&|k| self.driving(x, u, k));
+        blend(&|k| (self.driving(x, u, k) + self.driving(&predicted, u, k)) * 0.5)
     }
 }
 

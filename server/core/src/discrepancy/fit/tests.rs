@@ -23,6 +23,8 @@ fn surge_record(nu: impl Fn(f64) -> (f64, f64), theta: f64) -> (Baseline, [Recor
         m: DMatrix::from_element(1, 1, m),
         d_bar: DMatrix::from_element(1, 1, d),
         restoring: Default::default(),
+
+        coriolis: None,
     };
     (baseline, [rec])
 }
@@ -119,6 +121,8 @@ fn the_current_regressor_from_kept_signals_is_the_filtered_direct_one() {
         m: m.clone(),
         d_bar: d.clone(),
         restoring: Default::default(),
+
+        coriolis: None,
     };
     let records = [rec];
     let prep = Prepared::new(&baseline, &records, 0.5, 10, 5).expect("prepared");

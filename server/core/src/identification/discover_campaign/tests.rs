@@ -26,13 +26,15 @@ fn campaign(truth: &RovTruth) -> Vec<RunInput> {
     runs
 }
 
-/// The λ model without g(η) and constant loads, so that the restoring,
-/// tether and load effects the cases conceal are missing from it.
+/// The λ model without g(η), constant loads and C(δ)δ, so that the
+/// restoring, tether, load and Coriolis effects the cases conceal are
+/// missing from it.
 fn baseline(runs: &[RunInput]) -> Identified {
     let profile = surveyor_rov();
     let settings = LambdaCampaignSettings {
         estimate_restoring: false,
         constant_loads: false,
+        coriolis_second_order: false,
         ..LambdaCampaignSettings::default()
     };
     identify_lambda_campaign(
@@ -235,6 +237,7 @@ fn flown(truth: &RovTruth) -> (Vec<RunInput>, Identified, CampaignDiscovery) {
         &LambdaCampaignSettings {
             estimate_restoring: false,
             constant_loads: false,
+            coriolis_second_order: false,
             ..LambdaCampaignSettings::default()
         },
         &mut NoProgress,

@@ -268,3 +268,111 @@ fn inconsistent_grids_are_typed_errors() {
     );
     assert!(LpvModel::new(vec![], vec![]).is_err());
 }
+
+/// A horizontal hull with diagonal M and linear damping, integrated with
+/// its full C(ν)ν (Fossen 2011, eq. 6.43) through a turn at speed; the LPV
+/// model of its exact linearizations at 0.5, 1.0, 1.5 m/s (D̄ = D +
+/// J_C(M, u₀), no load: C(ν₀)ν₀ = 0) follows it only with C(δ)δ — the
+/// blend of J_C is exact in u, the rest is the second-order term.
+#[test]
+fn second_order_coriolis_follows_a_turning_hull() {
+    let (mu, mv, iz) = (400.0, 450.0, 300.0);
+    let d = [120.0, 400.0, 500.0];
+    let m = DMatrix::from_diagonal(&DVector::from_vec(vec![mu, mv, iz]));
+    let dofs = vec![Dof::Surge, Dof::Sway, Dof::Yaw];
+    let point = |u0: f64| {
+        let d_bar = DMatrix::from_row_slice(
+            3,
+            3,
+            &[
+                d[0],
+                0.0,
+                0.0,
+                0.0,
+                d[1],
+                mu * u0,
+                0.0,
+                (mv - mu) * u0,
+                d[2],
+            ],
+        );
+        LinearVesselModel::new(dofs.clone(), m.clone(), d_bar).unwrap()
+    };
+    let grid = vec![0.5, 1.0, 1.5];
+    let linear = LpvModel::new(grid.clone(), grid.iter().map(|&u| point(u)).collect()).unwrap();
+    let with_c = linear
+        .clone()
+        .with_second_order_coriolis(vec![m.clone(); 3])
+        .unwrap();
+    // The truth: M ν̇ + C(ν)ν + Dν = τ, a surge thrust and a yaw square wave.
+    let (h, n, sub) = (0.1, 1200, 20);
+    let tau = DMatrix::from_fn(n, 3, |k, j| match j {
+        0 => 150.0,
+        1 => 0.0,
+        _ => 100.0 * if (k / 150) % 2 == 0 { 1.0 } else { -1.0 },
+    });
+    let mut y = DMatrix::zeros(n, 3);
+    let mut x = vec![1.0, 0.0, 0.0];
+    for k in 0..n {
+        for j in 0..3 {
+            y[(k, j)] = x[j];
+        }
+        let g = vec![vec![tau[(k, 0)], tau[(k, 1)], tau[(k, 2)]]; sub];
+        let xs = rk4_simulate(
+            |s, t, ds| {
+                let (u, v, r) = (s[0], s[1], s[2]);
+                // C(ν)ν of a diagonal 3-DOF M: (−m_v v r, m_u u r, (m_v − m_u) u v).
+                let c = [-mv * v * r, mu * u * r, (mv - mu) * u * v];
+                ds[0] = (t[0] - c[0] - d[0] * u) / mu;
+                ds[1] = (t[1] - c[1] - d[1] * v) / mv;
+                ds[2] = (t[2] - c[2] - d[2] * r) / iz;
+            },
+            &x,
+            &g,
+            h / sub as f64,
+        );
+        x = xs[sub].clone();
+    }
+    let (lo, hi) = (y.column(0).min(), y.column(0).max());
+    assert!(
+        lo > 0.5 && hi < 1.5,
+        "the turn stays inside the grid: u {lo}..{hi}"
+    );
+    assert!(
+        y.column(2).amax() > 0.15,
+        "a real turn: r {}",
+        y.column(2).amax()
+    );
+    let rec = ValidationRecord { h, u: &tau, y: &y };
+    let fits = |p: &dyn Predictor| nrmse_fit_columns(&y, &p.simulate(&rec));
+    let (fl, fc) = (fits(&linear), fits(&with_c));
+    // Surge: the turn's centripetal m_v·v·r is what the linear model lacks.
+    assert!(fc[0].unwrap() > 0.99, "with C(δ)δ: surge fit {:?}", fc[0]);
+    assert!(
+        fl[0].unwrap() < fc[0].unwrap() - 0.05,
+        "without it surge should be clearly worse: {:?} vs {:?}",
+        fl[0],
+        fc[0]
+    );
+    for (j, f) in fc.iter().enumerate().skip(1) {
+        assert!(f.unwrap() > 0.99, "with C(δ)δ: channel {j} fit {f:?}");
+    }
+    // Without surge the term cannot be placed.
+    let yaw_only = LpvModel::new(
+        vec![0.5],
+        vec![
+            LinearVesselModel::new(
+                vec![Dof::Yaw],
+                m.view((2, 2), (1, 1)).into_owned(),
+                DMatrix::from_element(1, 1, 40.0),
+            )
+            .unwrap(),
+        ],
+    )
+    .unwrap();
+    assert!(
+        yaw_only
+            .with_second_order_coriolis(vec![DMatrix::from_element(1, 1, 70.0)])
+            .is_err()
+    );
+}
