@@ -26,13 +26,15 @@ before(async () => {
   const cs = await H.api('GET', '/api/campaigns');
   const rov = cs.json.find((c) => /Surveyor/.test(JSON.stringify(c)));
   assert.ok(rov, 'the demo has the Surveyor campaign');
-  // The baseline without g(η) and constant loads: the righting moment is
-  // then missing from it (the default λ model estimates it itself).
+  // The baseline without g(η), constant loads and C(δ)δ: the righting
+  // moment is then missing from it (the default λ model estimates it
+  // itself), and no second-order force is built from the roll and pitch
+  // inertia that such a baseline gets wrong.
   const j = await H.api('POST', '/api/jobs', {
     kind: 'identify',
     campaign_id: rov.id,
     method: 'lambda_kf',
-    settings: { estimate_restoring: false, constant_loads: false },
+    settings: { estimate_restoring: false, constant_loads: false, coriolis_second_order: false },
   });
   assert.equal(j.status, 202, JSON.stringify(j.json));
   const done = await waitJob(j.json.id, 120);
