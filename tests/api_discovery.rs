@@ -24,7 +24,7 @@ async fn app() -> TestApp {
 /// the baseline.
 async fn identified(app: &TestApp, cid: &str, method: &str) -> String {
     let settings = if method == "lambda_kf" {
-        json!({ "estimate_restoring": false, "constant_loads": false, "coriolis_second_order": false })
+        json!({ "estimate_restoring": false, "constant_loads": false, "coriolis_second_order": false, "symmetric_inertia": false, "quadratic_damping": false, "extend_above_grid": false })
     } else {
         json!({})
     };

@@ -386,6 +386,8 @@ pub async fn stored_model(
             logged_controller: None,
             extension: None,
             coriolis_second_order: false,
+            quadratic_damping: None,
+            quadratic_damping_std: None,
         }),
         dp_ship: None,
         state_space: None,

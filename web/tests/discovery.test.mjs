@@ -34,7 +34,7 @@ before(async () => {
     kind: 'identify',
     campaign_id: rov.id,
     method: 'lambda_kf',
-    settings: { estimate_restoring: false, constant_loads: false, coriolis_second_order: false },
+    settings: { estimate_restoring: false, constant_loads: false, coriolis_second_order: false, symmetric_inertia: false, quadratic_damping: false, extend_above_grid: false },
   });
   assert.equal(j.status, 202, JSON.stringify(j.json));
   const done = await waitJob(j.json.id, 120);

@@ -2,13 +2,16 @@
 //! the λ-filter identification's parameter errors in σ and its validation
 //! fits against the true model and an affine least-squares baseline.
 //!
-//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--noise-free] [--controller-hz 20] [--symmetric-m]`
+//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--noise-free] [--controller-hz 20] [--projected-m] [--quadratic-damping] [--held-above]`
 //!
 //! `--in-grid` flies the validation staircase at speeds inside the grid
 //! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it;
 //! `--noise-free` flies without measurement noise; `--controller-hz` tells the identification the controller's rate (the
-//! truth's loop runs at 20 Hz, logged at 10 Hz); `--symmetric-m` fits M
-//! symmetric (`settings.symmetric_inertia`).
+//! truth's loop runs at 20 Hz, logged at 10 Hz); `--projected-m` fits M's
+//! rows freely and stores the nearest symmetric M (`symmetric_inertia:
+//! false`); `--quadratic-damping` estimates quadratic damping
+//! (`quadratic_damping: true`); `--held-above` holds the top sub-model
+//! above the grid (`extend_above_grid: false`).
 
 #[path = "../tests/support/open_world.rs"]
 mod open_world;
@@ -20,7 +23,9 @@ fn main() {
     let mut seeds = Vec::new();
     let mut structure = None;
     let mut controller_hz = None;
-    let mut symmetric = false;
+    let mut symmetric = true;
+    let mut quadratic = false;
+    let mut above = true;
     let mut spec = seatrial_truth::CampaignSpec::default();
     let mut it = args.iter();
     while let Some(a) = it.next() {
@@ -33,8 +38,12 @@ fn main() {
             });
         } else if a == "--controller-hz" {
             controller_hz = it.next().and_then(|v| v.parse::<f64>().ok());
-        } else if a == "--symmetric-m" {
-            symmetric = true;
+        } else if a == "--projected-m" {
+            symmetric = false;
+        } else if a == "--quadratic-damping" {
+            quadratic = true;
+        } else if a == "--held-above" {
+            above = false;
         } else if a == "--noise-free" {
             spec.noise = seatrial_truth::NoiseSpec::none();
         } else if a == "--in-grid" {
@@ -49,6 +58,8 @@ fn main() {
     let mut settings = open_world::settings(structure);
     settings.controller_rate_hz = controller_hz;
     settings.symmetric_inertia = symmetric;
+    settings.quadratic_damping = quadratic;
+    settings.extend_above_grid = above;
     for seed in seeds {
         let t = std::time::Instant::now();
         let r = open_world::evaluate_with(seed, true, &settings, &spec);

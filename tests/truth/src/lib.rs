@@ -37,7 +37,9 @@ pub use campaign::{
     TruthRecord, campaign_as_external, external_envelope, fly_campaign, fly_external,
     fly_external_campaign, fly_external_runs, run_seed,
 };
-pub use linearization::{Linearization, effective_linearization};
+pub use linearization::{
+    Linearization, effective_linearization, effective_linearization_given_quadratic,
+};
 pub use plant::{Plant, State};
 pub use predict::{
     TruePredictions, free_run, free_run_restarted, predict_k_step, true_predictions,

@@ -82,9 +82,35 @@ impl Vessel {
 /// the pseudo-inverse (zero on the centred regressor), so read only what was
 /// flown.
 pub fn effective_linearization(vessel: &Vessel, runs: &[&Run]) -> Linearization {
+    fit_affine(vessel, &stacked(runs))
+}
+
+/// The statistical linearization of a model that carries diagonal
+/// quadratic damping `d_q` (surge entry unused): least squares of
+/// f(ν) − D_q|δ|δ on [ν, 1] over `runs` as [`effective_linearization`],
+/// δ = ν except u (whose quadratic damping is the forward-speed
+/// schedule's). Grade the D̄ of M ν̇ + D̄ν + D_q|δ|δ + b = γ with the
+/// truth's own D_q against this.
+pub fn effective_linearization_given_quadratic(
+    vessel: &Vessel,
+    runs: &[&Run],
+    d_q: &Vector6<f64>,
+) -> Linearization {
+    let nus = stacked(runs);
+    fit_affine_of(vessel, &nus, |nu| {
+        let mut f = vessel.hydrodynamic_force(nu);
+        for i in 1..6 {
+            f[i] -= d_q[i] * nu[i].abs() * nu[i];
+        }
+        f
+    })
+}
+
+/// The true velocities of `runs` at their log instants, stacked (N×6).
+fn stacked(runs: &[&Run]) -> DMatrix<f64> {
     let rows: usize = runs.iter().map(|r| r.truth.nu.nrows()).sum();
-    assert!(rows > 6, "effective_linearization needs logged samples");
-    let nus = DMatrix::from_fn(rows, 6, |i, j| {
+    assert!(rows > 6, "a linearization needs logged samples");
+    DMatrix::from_fn(rows, 6, |i, j| {
         let mut k = i;
         for r in runs {
             if k < r.truth.nu.nrows() {
@@ -93,13 +119,21 @@ pub fn effective_linearization(vessel: &Vessel, runs: &[&Run]) -> Linearization 
             k -= r.truth.nu.nrows();
         }
         unreachable!()
-    });
-    fit_affine(vessel, &nus)
+    })
 }
 
 /// Least squares f(ν) ≈ D̄ν + b over the rows of `nus` (N×6), on centred
 /// regressors for conditioning, solved by SVD.
 pub fn fit_affine(vessel: &Vessel, nus: &DMatrix<f64>) -> Linearization {
+    fit_affine_of(vessel, nus, |nu| vessel.hydrodynamic_force(nu))
+}
+
+/// Least squares `force(ν)` ≈ D̄ν + b over the rows of `nus`.
+fn fit_affine_of(
+    vessel: &Vessel,
+    nus: &DMatrix<f64>,
+    force: impl Fn(&Vector6<f64>) -> Vector6<f64>,
+) -> Linearization {
     let n = nus.nrows();
     let mean = Vector6::from_fn(|j, _| nus.column(j).mean());
     let mut xtx = SMatrix::<f64, 6, 6>::zeros();
@@ -108,7 +142,7 @@ pub fn fit_affine(vessel: &Vessel, nus: &DMatrix<f64>) -> Linearization {
     for i in 0..n {
         let nu: Vector6<f64> = SVector::from_fn(|j, _| nus[(i, j)]);
         let x = nu - mean;
-        let f = vessel.hydrodynamic_force(&nu);
+        let f = force(&nu);
         xtx += x * x.transpose();
         xty += x * f.transpose();
         fmean += f;

@@ -1,7 +1,7 @@
 //! What discovery works on: the baseline M ν̇ + D̄ ν = γ with γ = τ − g(η)
 //! (thesis eq. 2.7–2.9), and recorded runs on a uniform grid.
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::error::DiscoveryError;
@@ -60,6 +60,9 @@ pub struct Baseline {
     /// C(δ)δ the baseline carries (see
     /// [`crate::models::coriolis::second_order_force`]); `None`: linear.
     pub coriolis: Option<DMatrix<f64>>,
+    /// Diagonal quadratic damping D_q of D_q|δ|δ the baseline carries (see
+    /// [`crate::models::quadratic_damping`]); `None`: linear damping.
+    pub quadratic: Option<DVector<f64>>,
 }
 
 impl Baseline {
@@ -73,16 +76,22 @@ impl Baseline {
             d_bar: model.d_bar().clone(),
             restoring,
             coriolis: None,
+            quadratic: None,
         }
     }
 
     /// The forces the baseline knows beside M ν̇ + D̄ ν at pose `eta` and
     /// velocity `nu` (modelled DOFs): g(η) with its constant loads, plus
-    /// C(δ)δ when the baseline carries it.
+    /// C(δ)δ and D_q|δ|δ when the baseline carries them.
     pub fn known_force(&self, eta: &[f64; 6], nu: &[f64]) -> Vec<f64> {
         let mut f = self.g(eta);
         if let Some(r) = self.second_order(nu) {
             f.iter_mut().zip(r).for_each(|(a, b)| *a += b);
+        }
+        if let Some(d) = &self.quadratic {
+            let q =
+                crate::models::quadratic_damping::quadratic_force(d, nu, self.index_of(Dof::Surge));
+            f.iter_mut().zip(q).for_each(|(a, b)| *a += b);
         }
         f
     }

@@ -105,6 +105,7 @@ pub(crate) fn current_drift(
         d_bar: model.d_bar.clone(),
         restoring: model.restoring,
         coriolis: model.coriolis.clone(),
+        quadratic: model.quadratic.clone(),
     };
     let prep = Prepared::new(&held, &windows, svf_t, skip, hac_lags)?.frozen();
     let mut est_w: Vec<(usize, usize, Vector2<f64>, Matrix2<f64>)> = Vec::new();

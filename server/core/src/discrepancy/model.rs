@@ -64,6 +64,8 @@ pub struct AugmentedModel {
     pub terms: Vec<ModelTerm>,
     /// The vehicle's M of the baseline's C(δ)δ, if it carries one.
     pub coriolis: Option<DMatrix<f64>>,
+    /// D_q of the baseline's D_q|δ|δ, if it carries one.
+    pub quadratic: Option<nalgebra::DVector<f64>>,
     m_inv: DMatrix<f64>,
     /// ‖M⁻¹D̄‖∞ (1/s), a bound on the fastest linear mode: a step of h is
     /// split so that h·rate ≤ 2, inside RK4's stability interval (−2.78, 0].
@@ -132,6 +134,7 @@ impl AugmentedModel {
             d_bar: self.d_bar.clone(),
             restoring: self.restoring,
             coriolis: self.coriolis.clone(),
+            quadratic: self.quadratic.clone(),
         }
     }
 
@@ -147,12 +150,20 @@ impl AugmentedModel {
             vec![],
         )
         .with_coriolis(b.coriolis.clone())
+        .with_quadratic(b.quadratic.clone())
     }
 
     /// The same model carrying the second-order Coriolis force C(δ)δ of
     /// the vehicle's inertia `m` (`None`: without it).
     pub fn with_coriolis(mut self, m: Option<DMatrix<f64>>) -> Self {
         self.coriolis = m;
+        self
+    }
+
+    /// The same model carrying the quadratic damping D_q|δ|δ of `d_q`
+    /// (`None`: without it).
+    pub fn with_quadratic(mut self, d_q: Option<nalgebra::DVector<f64>>) -> Self {
+        self.quadratic = d_q;
         self
     }
 
@@ -185,6 +196,7 @@ impl AugmentedModel {
             m_inv,
             rate: if rate.is_finite() { rate } else { 0.0 },
             coriolis: None,
+            quadratic: None,
         }
     }
 
@@ -244,6 +256,13 @@ impl AugmentedModel {
             let c = crate::models::coriolis::second_order_force(&self.dofs, m, &nu[..n], s);
             for i in 0..n {
                 f[i] -= c[i];
+            }
+        }
+        if let Some(d) = &self.quadratic {
+            let surge = self.dofs.iter().position(|d| *d == Dof::Surge);
+            let q = crate::models::quadratic_damping::quadratic_force(d, &nu[..n], surge);
+            for i in 0..n {
+                f[i] -= q[i];
             }
         }
         for (i, o) in out.iter_mut().enumerate().take(n) {
@@ -544,6 +563,7 @@ mod tests {
             d_bar: DMatrix::from_element(1, 1, d),
             restoring: Restoring::default(),
             coriolis: None,
+            quadratic: None,
         };
         let rec = Record {
             name: "step".into(),

@@ -79,12 +79,17 @@ pub fn baseline_at(doc: &ModelDocument, point: &LpvPoint) -> Result<Baseline, Id
         .is_some_and(|l| l.coriolis_second_order)
         .then(|| vehicle_m.clone());
     let (m, d_bar) = logged_view(doc, vehicle_m, matrix(&point.d_bar, "D̄")?)?;
+    let quadratic = match doc.lpv.as_ref() {
+        Some(l) => super::predictor::quadratic_of(l, doc.dofs.len())?,
+        None => None,
+    };
     Ok(Baseline {
         dofs: doc.dofs.clone(),
         m,
         d_bar,
         restoring,
         coriolis,
+        quadratic,
     })
 }
 
@@ -105,7 +110,8 @@ pub fn augmented_at(
             matrix(&a.d_ref, "augmentation.d_ref")?,
             a.terms.clone(),
         )
-        .with_coriolis(b.coriolis),
+        .with_coriolis(b.coriolis)
+        .with_quadratic(b.quadratic),
     })
 }
 
@@ -250,7 +256,8 @@ fn beyond(base: &LpvModel, end: &AugmentedModel, s: f64) -> Result<AugmentedMode
         end.d_ref.clone(),
         end.terms.clone(),
     )
-    .with_coriolis(end.coriolis.clone()))
+    .with_coriolis(end.coriolis.clone())
+    .with_quadratic(end.quadratic.clone()))
 }
 
 /// Maximal stretches [start, end) over which the forward speed `u`,

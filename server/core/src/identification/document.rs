@@ -185,6 +185,15 @@ pub struct LpvDoc {
     /// Absent or false: the linear sub-models alone (thesis).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub coriolis_second_order: bool,
+    /// Diagonal quadratic damping D_q per DOF (N·s²/m², N·m·s²/rad²), one
+    /// for the campaign: every sub-model is driven by γ − D_q|δ|δ, δ = ν
+    /// except the surge velocity (entry 0: the schedule follows u). Absent:
+    /// linear damping only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quadratic_damping: Option<Vec<f64>>,
+    /// Std of `quadratic_damping`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quadratic_damping_std: Option<Vec<f64>>,
 }
 
 /// Speeds (m/s) an LPV model extends to beyond its grid.

@@ -140,6 +140,11 @@ pub struct FossenParameterSet {
     /// Thrust coefficients K (diagonal, DP ship).
     #[serde(rename = "K", skip_serializing_if = "Option::is_none")]
     pub k: Option<Vec<f64>>,
+    /// Diagonal quadratic damping D_q per DOF (N·s²/m², N·m·s²/rad²), one
+    /// for every forward speed; the surge entry is 0 (the schedule on U
+    /// carries surge's). Absent: linear damping only.
+    #[serde(rename = "D_q", default, skip_serializing_if = "Option::is_none")]
+    pub d_q: Option<Vec<f64>>,
     /// How to use it.
     pub notes: Vec<String>,
 }
@@ -170,16 +175,24 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
             if lpv.coriolis_second_order {
                 notes.push("Second-order Coriolis–centripetal force: add C(δ)δ to the left-hand side, C(ν) from the point's M (Fossen 2011, eq. 6.43) at δ = ν with the forward speed u set to zero — the turning, heaving and rolling forces about straight-ahead motion; the linear part about U is in D and b.".into());
             }
+            if lpv.quadratic_damping.is_some() {
+                notes.push("Quadratic damping: add D_q|δ|δ to the left-hand side, D_q diagonal (`D_q`, one for every U), δ = ν with the forward speed u set to zero — hull damping that grows with the amplitude of sway, heave and the rotations; surge's is in D and b per U.".into());
+            }
             if augmented {
                 notes.push("Discovered physics: each point's `terms` add to the left-hand side (their coefficients times the regressor named in `label`), or shape τ before it acts (lag, delay, saturation, dead zone); M and D are then the refitted ones.".into());
             }
             Ok(FossenParameterSet {
                 format: "seatrial-fossen/1".into(),
-                equation: match (augmented, lpv.coriolis_second_order) {
-                    (true, false) => "M·ν̇ + D·ν + b + Σ terms(ν, η) + g(η) = τ_applied (per forward speed U)".into(),
-                    (true, true) => "M·ν̇ + D·ν + b + C(δ)δ + Σ terms(ν, η) + g(η) = τ_applied (per forward speed U)".into(),
-                    (false, true) => "M·ν̇ + D·ν + b + C(δ)δ + g(η) = τ (per forward speed U; C(δ) from M, δ = ν with u = 0)".into(),
-                    (false, false) => "M·ν̇ + D·ν + b + g(η) = τ (per forward speed U; C(ν) from M)".into(),
+                equation: {
+                    let coriolis = if lpv.coriolis_second_order { " + C(δ)δ" } else { "" };
+                    let quadratic = if lpv.quadratic_damping.is_some() { " + D_q|δ|δ" } else { "" };
+                    if augmented {
+                        format!("M·ν̇ + D·ν + b{coriolis}{quadratic} + Σ terms(ν, η) + g(η) = τ_applied (per forward speed U)")
+                    } else if coriolis.is_empty() && quadratic.is_empty() {
+                        "M·ν̇ + D·ν + b + g(η) = τ (per forward speed U; C(ν) from M)".into()
+                    } else {
+                        format!("M·ν̇ + D·ν + b{coriolis}{quadratic} + g(η) = τ (per forward speed U; δ = ν with u = 0{})", if coriolis.is_empty() { "" } else { ", C(δ) from M" })
+                    }
                 },
                 dofs,
                 units: "SI (kg, kg·m, kg·m², kg/s, N, N·m)".into(),
@@ -197,6 +210,7 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                 restoring,
                 t: None,
                 k: None,
+                d_q: lpv.quadratic_damping.clone(),
                 notes,
             })
         }
@@ -220,6 +234,7 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                 restoring,
                 t: Some(s.t_config.clone()),
                 k: Some(s.k.clone()),
+                d_q: None,
                 notes: vec![
                     "Low-frequency DP model at rest (U = 0); D″ = −A″_h·M″ (eq. 39); M″ and T″ are the a-priori values (eq. 29–30), A″_h and K″ identified (eq. 48–49).".into(),
                     format!("A″_h = {:?}", s.a_h),
@@ -272,6 +287,8 @@ mod tests {
                 logged_controller: None,
                 extension: None,
                 coriolis_second_order: false,
+                quadratic_damping: None,
+                quadratic_damping_std: None,
             }),
             dp_ship: None,
             state_space: None,

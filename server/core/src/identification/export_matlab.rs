@@ -141,6 +141,17 @@ pub fn matlab_script(doc: &ModelDocument, name: &str, version: i64) -> String {
                 "false"
             }
         );
+        if let Some(d) = &l.quadratic_damping {
+            let _ = writeln!(
+                w,
+                "% Quadratic damping: add Dq .* abs(d) .* d to the left-hand side, d = nu but u = 0 (one Dq for every grid speed)."
+            );
+            let _ = writeln!(
+                w,
+                "model.lpv.quadratic_damping = {};  % N*s^2/m^2 (linear DOFs), N*m*s^2/rad^2 (rotations)",
+                vector(d)
+            );
+        }
         let _ = writeln!(w, "model.lpv.t_lambda_s = {};", number(l.t_lambda_s));
         let _ = writeln!(w, "model.lpv.structure = {};", string(&l.structure));
         let speeds: Vec<f64> = l.points.iter().map(|p| p.speed_mps).collect();

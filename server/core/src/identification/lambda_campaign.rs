@@ -4,7 +4,6 @@
 //! physical structure enforced; validated on the held-out runs.
 
 use nalgebra::DVector;
-use serde::{Deserialize, Serialize};
 
 use super::dataset::Segment;
 use super::dataset::{RunInput, segments};
@@ -18,9 +17,10 @@ use super::joint_restoring::{Functions, PooledRestoring, load, specification};
 use super::lambda_consistency::{inflate_inertia_std, symmetry_note};
 use super::lambda_coriolis::fit_points;
 use super::lambda_data::{experiment, per_point, regression_columns, static_holds};
-use super::lambda_extension::{BELOW, choose_extension, speed_coverage_notes};
+use super::lambda_extension::{Sides, choose_extension, speed_coverage_notes};
 use super::lambda_information::default_t_lambda;
 use super::lambda_physical::enforce;
+use super::lambda_quadratic;
 use super::lambda_structure::choose_structure;
 use super::lambda_validation::{HeldOut, choose_second_order};
 use super::outcome::Identified;
@@ -33,142 +33,7 @@ use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
 use crate::validation::ValidationSettings;
 
-/// The coupling structure to identify.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
-#[serde(rename_all = "snake_case")]
-pub enum StructureChoice {
-    /// Port–starboard symmetry (default for 6-DOF and 3-DOF vessels) plus
-    /// any pair the partial coherence between DOFs proposes; for other DOF
-    /// sets the coherence proposal alone.
-    #[default]
-    Auto,
-    /// Port–starboard (xz-plane) symmetry: surge, heave and pitch couple
-    /// among themselves, sway, roll and yaw among themselves (Fossen 2011,
-    /// sec. 7.5: the longitudinal and lateral subsystems).
-    Symmetric,
-    /// Each DOF alone (the thesis's first, uncoupled LPV model).
-    Diagonal,
-    /// Every entry of A and B free.
-    Coupled,
-    /// The user's pattern in `settings.coupling` (rows: ν_i, columns: DOFs).
-    Custom,
-}
-
-/// How predictions schedule between grid points.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
-#[serde(rename_all = "snake_case")]
-pub enum SchedulingChoice {
-    /// Nearest grid point (thesis eq. 2.17).
-    Nearest,
-    /// Blend of the neighbouring sub-models (eq. 2.18).
-    #[default]
-    Interpolate,
-}
-
-/// Settings of a λ-filter identification (JSON `settings` of the job).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
-#[serde(deny_unknown_fields)]
-pub struct LambdaCampaignSettings {
-    /// Coupling structure.
-    #[serde(default)]
-    pub structure: StructureChoice,
-    /// Free entries for `custom`: n × n booleans in the order of the vessel's DOFs.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub coupling: Option<Vec<Vec<bool>>>,
-    /// Partial-coherence threshold of the `auto` proposal (0–1).
-    #[serde(default = "default_threshold")]
-    pub coupling_threshold: f64,
-    /// Time constant T of λ(s) = 1/(1+sT) (s); default: half the shortest
-    /// expected time constant of the vessel, at least 5 samples.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub t_lambda_s: Option<f64>,
-    /// Held-out runs; default: the plan's validation runs.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub validation_run_ids: Option<Vec<String>>,
-    /// Horizon of the k-step predictions of validation.
-    #[serde(default = "default_k")]
-    pub k: usize,
-    /// Scheduling of predictions on forward speed.
-    #[serde(default)]
-    pub scheduling: SchedulingChoice,
-    /// Estimate g(η) (W − B, z_G·W − z_B·B) jointly with M and D̄ from every
-    /// run where the attitude moves, sharpened by static attitude holds when
-    /// there are any (6-DOF vessels).
-    #[serde(default = "default_true")]
-    pub estimate_restoring: bool,
-    /// Estimate a constant load b per DOF and grid point (tether, the heave
-    /// part of W − B, the offset of the damping's linearization at speed).
-    #[serde(default = "default_true")]
-    pub constant_loads: bool,
-    /// Take the couplings of C(ν)ν at the grid speed from the estimated M
-    /// (Fossen 2011, eq. 6.43; 6-DOF and 3-DOF horizontal models), so the
-    /// structure constrains the damping D and D̄ = D + J_C(M, u₀).
-    #[serde(default = "default_true")]
-    pub coriolis_from_m: bool,
-    /// Rate of the vehicle's feedback controller (Hz); default: the vessel
-    /// profile's `controller_rate_hz`. When it runs faster than the log
-    /// (e.g. a 20 Hz loop logged at 10 Hz), M and D̄ are corrected for the
-    /// commands the log does not show, with the controller's gains read
-    /// from the log (see `intersample`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub controller_rate_hz: Option<f64>,
-    /// Extend the model a short way below its lowest grid speed (up to 0.6
-    /// of the first spacing, not below 0 m/s, as far as it stays physical
-    /// and stable: damping extrapolated linearly in speed, the load
-    /// quadratically) instead of holding the lowest sub-model there
-    /// (thesis). Interpolated scheduling on three or more grid speeds;
-    /// above the grid the highest sub-model is held.
-    #[serde(default = "default_true")]
-    pub extend_below_grid: bool,
-    /// Fit M symmetric: the rows of each sub-model re-estimated under
-    /// M = Mᵀ by least squares over their joint uncertainty, with σ scaled
-    /// by how far the unconstrained rows were from it. Off by default (the
-    /// rows fitted freely, the nearest symmetric M stored with D̄ unchanged)
-    /// until discovery's refit of touched rows works from such a model.
-    #[serde(default)]
-    pub symmetric_inertia: bool,
-    /// Carry the second-order Coriolis–centripetal force C(δ)δ of the
-    /// estimated M in the model (δ = ν about straight-ahead motion at the
-    /// scheduled speed): the centripetal forces of turning, heaving and
-    /// rolling that no linear sub-model holds, with no parameter added
-    /// (models with a surge DOF).
-    #[serde(default = "default_true")]
-    pub coriolis_second_order: bool,
-}
-
-fn default_threshold() -> f64 {
-    0.2
-}
-fn default_k() -> usize {
-    10
-}
-fn default_true() -> bool {
-    true
-}
-
-impl Default for LambdaCampaignSettings {
-    fn default() -> Self {
-        LambdaCampaignSettings {
-            structure: StructureChoice::Auto,
-            coupling: None,
-            coupling_threshold: default_threshold(),
-            t_lambda_s: None,
-            validation_run_ids: None,
-            k: default_k(),
-            scheduling: SchedulingChoice::Interpolate,
-            estimate_restoring: true,
-            constant_loads: true,
-            coriolis_from_m: true,
-            controller_rate_hz: None,
-            extend_below_grid: true,
-            symmetric_inertia: false,
-            coriolis_second_order: true,
-        }
-    }
-}
+pub use super::lambda_settings::{LambdaCampaignSettings, SchedulingChoice, StructureChoice};
 
 /// Unit of an entry (i, j) of M (`per_s` false) or D̄ (true).
 fn unit(dofs: &[Dof], i: usize, j: usize, per_s: bool) -> String {
@@ -338,26 +203,57 @@ pub fn identify_lambda_campaign(
         .and_then(|g| g.as_ref())
         .map(|(g, c)| inertia_offset(g, *c));
 
-    // 1. g(η) jointly with M, D̄ and constant loads, pooled over the grid.
+    let second_order = settings.coriolis_second_order && dofs.contains(&Dof::Surge);
+    let quad_cols = if settings.quadratic_damping {
+        lambda_quadratic::columns(&dofs)
+    } else {
+        Vec::new()
+    };
+    let with_quadratic = |exps: Vec<Vec<Experiment>>| -> Vec<Vec<Experiment>> {
+        exps.into_iter()
+            .map(|point| {
+                point
+                    .into_iter()
+                    .map(|e| lambda_quadratic::append(e, &quad_cols))
+                    .collect()
+            })
+            .collect()
+    };
+
+    // 1. g(η) and D_q jointly with M, D̄ and constant loads, pooled over
+    // the grid.
     let mut restoring: Option<(RestoringParams, RestoringDoc)> = None;
-    if with_restoring {
-        let holds = static_holds(&roles, &dofs, &cols, &outputs, &mut notes)?;
-        lambda_settings.exogenous = Some(specification(
+    let loads = settings.constant_loads.then_some(Functions::Constant);
+    let joint_functions = if with_restoring {
+        Some(Functions::ConstantAndRestoring)
+    } else {
+        loads
+    };
+    let holds = if with_restoring {
+        static_holds(&roles, &dofs, &cols, &outputs, &mut notes)?
+    } else {
+        None
+    };
+    let joint = if with_restoring || !quad_cols.is_empty() {
+        lambda_settings.exogenous = lambda_quadratic::specification(
+            joint_functions.map(|f| specification(profile, &dofs, f)),
             profile,
             &dofs,
-            Functions::ConstantAndRestoring,
-        ));
-        let joint = {
-            let mut sub = SubProgress::new(progress, 0.05, 0.4);
-            fit_points(
-                &points_of(build(None, Some(Functions::ConstantAndRestoring))?),
-                &lambda_settings,
-                settings.coriolis_from_m,
-                &mut sub,
-                &mut notes,
-            )
-            .map_err(lambda_error)?
-        };
+            &quad_cols,
+        );
+        let mut sub = SubProgress::new(progress, 0.05, 0.4);
+        fit_points(
+            &points_of(with_quadratic(build(None, joint_functions)?)),
+            &lambda_settings,
+            settings.coriolis_from_m,
+            &mut sub,
+            &mut notes,
+        )
+        .map_err(lambda_error)?
+    } else {
+        Vec::new()
+    };
+    if with_restoring {
         match PooledRestoring::from_points(&joint) {
             Some(pooled) => {
                 let pooled = match &holds {
@@ -373,13 +269,25 @@ pub fn identify_lambda_campaign(
         }
     }
     let g = restoring.as_ref().map(|(p, _)| p);
+    let quadratic = lambda_quadratic::pool(&joint, &dofs, &mut notes);
+    let surge = dofs.iter().position(|d| *d == Dof::Surge);
 
-    // 2. The sub-models with g(η) fixed at the pooled value.
-    let loads = settings.constant_loads.then_some(Functions::Constant);
+    // 2. The sub-models with g(η) and D_q fixed at the pooled values.
     lambda_settings.exogenous = loads.map(|f| specification(profile, &dofs, f));
-    let exps = build(g, loads)?;
+    let exps: Vec<Vec<Experiment>> = build(g, loads)?
+        .into_iter()
+        .map(|point| {
+            point
+                .into_iter()
+                .map(|e| match &quadratic {
+                    Some((d_q, _)) => lambda_quadratic::subtract(e, d_q, surge),
+                    None => e,
+                })
+                .collect()
+        })
+        .collect();
     let estimates = {
-        let from = if with_restoring { 0.4 } else { 0.1 };
+        let from = if joint.is_empty() { 0.1 } else { 0.4 };
         let mut sub = SubProgress::new(progress, from, 0.8);
         fit_points(
             &points_of(exps.clone()),
@@ -391,6 +299,21 @@ pub fn identify_lambda_campaign(
         .map_err(lambda_error)?
     };
 
+    let estimates = match &quadratic {
+        Some((_, d_std)) => {
+            let per_point = points_of(exps.clone());
+            estimates
+                .into_iter()
+                .map(|(u0, mut est)| {
+                    if let Some((_, e)) = per_point.iter().find(|(s, _)| *s == u0) {
+                        lambda_quadratic::widen(&mut est, e, d_std, &dofs);
+                    }
+                    (u0, est)
+                })
+                .collect()
+        }
+        None => estimates,
+    };
     let (mut estimates, logged_controller) =
         correct_estimates(estimates, gains, h_log, rate_hz, &dofs, &mut notes);
     symmetry_note(&estimates, &mut notes);
@@ -487,7 +410,6 @@ pub fn identify_lambda_campaign(
         SchedulingChoice::Interpolate => Scheduling::Interpolate,
     };
     let speeds: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
-    let second_order = settings.coriolis_second_order && dofs.contains(&Dof::Surge);
     let vehicle_m: Vec<_> = vehicle.iter().map(|v| v.m().clone()).collect();
     let lpv = LpvModel::new(speeds.clone(), models)
         .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
@@ -498,11 +420,39 @@ pub fn identify_lambda_campaign(
     } else {
         lpv
     };
+    let lpv = match &quadratic {
+        Some((d_q, _)) => lpv
+            .with_quadratic_damping(vec![d_q.clone(); speeds.len()])
+            .map_err(|e| IdentifyError::invalid("model", e.to_string()))?,
+        None => lpv,
+    };
+    if let Some((d_q, std)) = &quadratic {
+        for i in lambda_quadratic::columns(&dofs)
+            .into_iter()
+            .filter(|&i| std[i] > 0.0)
+        {
+            parameters.push(ParameterRow {
+                group: "D_q".into(),
+                symbol: format!("D_q[{}]", dofs[i].name()),
+                grid_speed_mps: None,
+                value: d_q[i],
+                std: Some(std[i]),
+                unit: lambda_quadratic::unit(dofs[i]).into(),
+            });
+        }
+    }
     // Beyond the grid: extended as far as the vehicle's model stays physical.
-    let extension = (settings.extend_below_grid && scheduling == Scheduling::Interpolate)
+    let extension = ((settings.extend_below_grid || settings.extend_above_grid)
+        && scheduling == Scheduling::Interpolate)
         .then(|| LpvModel::new(speeds, vehicle).ok())
         .flatten()
-        .and_then(|v| choose_extension(&v, settings.coriolis_from_m, g, BELOW));
+        .and_then(|v| {
+            let sides = Sides {
+                below: settings.extend_below_grid,
+                above: settings.extend_above_grid,
+            };
+            choose_extension(&v, settings.coriolis_from_m, g, sides)
+        });
     let lpv = match &extension {
         Some((ext, note)) => {
             notes.push(note.clone());
@@ -566,6 +516,8 @@ pub fn identify_lambda_campaign(
             logged_controller,
             extension: extension.map(|(e, _)| SpeedExtension::from(e)),
             coriolis_second_order: second_order,
+            quadratic_damping: quadratic.as_ref().map(|(d, _)| d.iter().copied().collect()),
+            quadratic_damping_std: quadratic.as_ref().map(|(_, s)| s.iter().copied().collect()),
         }),
         dp_ship: None,
         state_space: None,

@@ -17,7 +17,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::estimation::lambda::{Experiment, Inversion, LambdaEstimate, LambdaSettings, identify};
 use crate::estimation::{Cancelled, Progress};
-use crate::models::coriolis;
+use crate::models::coriolis::coriolis;
 use crate::planning::dof::Dof;
 
 /// Fixed-point passes of M̂ → J_C → fit.
@@ -76,8 +76,10 @@ fn moved(exps: &[Experiment], j: &DMatrix<f64>) -> Vec<Experiment> {
 }
 
 /// The sub-model at `u0` with C(ν)ν from its own M: returns the estimate
-/// with `d_bar` = D + J_C (and A, B consistent with it) and J_C. Without a
-/// C(ν) form for the DOF set, the plain fit.
+/// with `d_bar` = D + J_C (and A, B consistent with it) and J_C. M is the
+/// vehicle's: the fit's M̂ plus the settings' inertia offset (what a
+/// controller faster than the log hides). Without a C(ν) form for the DOF
+/// set, the plain fit.
 pub(crate) fn identify_with_coriolis(
     exps: &[Experiment],
     settings: &LambdaSettings,
@@ -90,7 +92,11 @@ pub(crate) fn identify_with_coriolis(
         progress
             .update(pass as f64 / PASSES as f64, "C(ν) from M at the grid speed")
             .map_err(|Cancelled| crate::estimation::lambda::LambdaError::Cancelled)?;
-        let Some(j) = coriolis_jacobian(&est.m, &settings.dofs, u0) else {
+        let vehicle = match &settings.inertia_offset {
+            Some(s) if s.shape() == est.m.shape() => &est.m + s,
+            _ => est.m.clone(),
+        };
+        let Some(j) = coriolis_jacobian(&vehicle, &settings.dofs, u0) else {
             return Ok((est, None));
         };
         est = identify(&moved(exps, &j), settings)?;

@@ -55,6 +55,8 @@ mod lambda_data;
 mod lambda_extension;
 pub mod lambda_information;
 mod lambda_physical;
+mod lambda_quadratic;
+mod lambda_settings;
 mod lambda_structure;
 mod lambda_validation;
 pub mod mat;

@@ -118,11 +118,32 @@ pub(crate) fn baseline_lpv(doc: &ModelDocument) -> Result<LpvModel, IdentifyErro
     } else {
         model
     };
+    let model = match quadratic_of(lpv, doc.dofs.len())? {
+        Some(d_q) => model
+            .with_quadratic_damping(vec![d_q; lpv.points.len()])
+            .map_err(|e| IdentifyError::invalid("document.lpv.quadratic_damping", e.to_string()))?,
+        None => model,
+    };
     match lpv.extension {
         Some(e) => model
             .with_extension(e.into())
             .map_err(|e| IdentifyError::invalid("document.lpv.extension", e.to_string())),
         None => Ok(model),
+    }
+}
+
+/// D_q of `lpv` (`n` entries), if it carries quadratic damping.
+pub(crate) fn quadratic_of(
+    lpv: &super::document::LpvDoc,
+    n: usize,
+) -> Result<Option<nalgebra::DVector<f64>>, IdentifyError> {
+    match &lpv.quadratic_damping {
+        None => Ok(None),
+        Some(d) if d.len() == n => Ok(Some(nalgebra::DVector::from_column_slice(d))),
+        Some(d) => Err(IdentifyError::invalid(
+            "document.lpv.quadratic_damping",
+            format!("{} entries for {n} DOFs", d.len()),
+        )),
     }
 }
 

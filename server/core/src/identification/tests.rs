@@ -368,6 +368,8 @@ pub(crate) fn lpv_doc(
             logged_controller: None,
             extension: None,
             coriolis_second_order: false,
+            quadratic_damping: None,
+            quadratic_damping_std: None,
         }),
         dp_ship: None,
         state_space: None,

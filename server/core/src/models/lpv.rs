@@ -28,6 +28,7 @@ use super::error::{ModelError, check_finite};
 pub use super::lpv_schedule::{Blend, Extension, ScheduleWeights, Scheduling};
 use super::lpv_schedule::{blend as schedule_blend, schedule};
 use super::predict::{check_record, free_run, k_step, no_prediction};
+use super::quadratic_damping::quadratic_force;
 use super::state_space::DiscreteStateSpace;
 use super::vessel::LinearVesselModel;
 use crate::planning::dof::Dof;
@@ -45,6 +46,9 @@ pub struct LpvModel {
     /// centripetal force C(δ)δ ([`second_order_force`]); `None`: the thesis's
     /// linear sub-models alone.
     coriolis: Option<Vec<DMatrix<f64>>>,
+    /// Diagonal quadratic damping D_q per grid point (one entry per DOF,
+    /// [`quadratic_force`]); `None`: linear damping only.
+    quadratic: Option<Vec<DVector<f64>>>,
 }
 
 /// An [`LpvModel`] discretized (ZOH) at one sample time, ready to step.
@@ -61,6 +65,8 @@ pub struct DiscreteLpv {
     dofs: Vec<Dof>,
     /// M per grid point for C(δ)δ, if the model carries it.
     coriolis: Option<Vec<DMatrix<f64>>>,
+    /// D_q per grid point, if the model carries it.
+    quadratic: Option<Vec<DVector<f64>>>,
 }
 
 /// A discrete sub-model, its blending weight and the grid point whose M
@@ -135,6 +141,7 @@ impl LpvModel {
             scheduling: Scheduling::default(),
             extension: None,
             coriolis: None,
+            quadratic: None,
         })
     }
 
@@ -214,6 +221,58 @@ impl LpvModel {
     /// if the model carries it.
     pub fn second_order_coriolis(&self) -> Option<&[DMatrix<f64>]> {
         self.coriolis.as_deref()
+    }
+
+    /// The same model with diagonal quadratic damping D_q|δ|δ, one D_q per
+    /// grid point (n entries, N·s²/m² or N·m·s²/rad²; the surge entry is
+    /// unused when surge is modelled, the schedule following u): each
+    /// sub-model is driven by γ − D_q|δ|δ ([`quadratic_force`]). Beyond
+    /// the grid the end point's D_q serves.
+    ///
+    /// # Errors
+    /// [`ModelError::Grid`] with one D_q per grid point missing;
+    /// [`ModelError::Shape`] for a wrong length; an invalid-parameter error
+    /// for a negative or non-finite entry (D_q must dissipate).
+    pub fn with_quadratic_damping(mut self, d_q: Vec<DVector<f64>>) -> Result<Self, ModelError> {
+        if d_q.len() != self.points.len() {
+            return Err(ModelError::Grid {
+                reason: format!(
+                    "one D_q per grid point is needed for the quadratic damping: got {} for {} points",
+                    d_q.len(),
+                    self.points.len()
+                ),
+            });
+        }
+        let n = self.dofs().len();
+        for (k, d) in d_q.iter().enumerate() {
+            if d.len() != n {
+                return Err(ModelError::Shape {
+                    name: format!("D_q[{k}]"),
+                    expected: format!("{n}×1"),
+                    found: (d.len(), 1),
+                });
+            }
+            if let Some(&v) = d.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+                return Err(ModelError::InvalidParameter {
+                    name: "D_q",
+                    value: v,
+                    requirement: "finite and ≥ 0 (quadratic damping dissipates)",
+                });
+            }
+        }
+        self.quadratic = Some(d_q);
+        Ok(self)
+    }
+
+    /// The same model without quadratic damping.
+    pub fn without_quadratic_damping(mut self) -> Self {
+        self.quadratic = None;
+        self
+    }
+
+    /// D_q per grid point, if the model carries quadratic damping.
+    pub fn quadratic_damping(&self) -> Option<&[DVector<f64>]> {
+        self.quadratic.as_deref()
     }
 
     /// The speeds the model extends to beyond its grid, if any.
@@ -324,6 +383,7 @@ impl LpvModel {
             beyond,
             dofs: self.dofs().to_vec(),
             coriolis: self.coriolis.clone(),
+            quadratic: self.quadratic.clone(),
         })
     }
 
@@ -413,14 +473,17 @@ impl DiscreteLpv {
         )
     }
 
-    /// γ − C(δ)δ with grid point `k`'s M (γ itself without the term).
+    /// γ − C(δ)δ − D_q|δ|δ with grid point `k`'s M and D_q (γ itself
+    /// without the terms).
     fn driving(&self, x: &DVector<f64>, u: &DVector<f64>, k: usize) -> DVector<f64> {
-        match (&self.coriolis, self.surge) {
-            (Some(m), Some(i)) => {
-                u - DVector::from_vec(second_order_force(&self.dofs, &m[k], x.as_slice(), i))
-            }
-            _ => u.clone(),
+        let mut out = u.clone();
+        if let (Some(m), Some(i)) = (&self.coriolis, self.surge) {
+            out -= DVector::from_vec(second_order_force(&self.dofs, &m[k], x.as_slice(), i));
         }
+        if let Some(d) = &self.quadratic {
+            out -= DVector::from_vec(quadratic_force(&d[k], x.as_slice(), self.surge));
+        }
+        out
     }
 
     /// x̂(k+1 | k) from ν(k) = `x` and γ(k) = `u`, scheduled on the surge
@@ -440,11 +503,12 @@ impl DiscreteLpv {
                 lower * wl + m.step(x, &force(km)) * wm
             }
         };
-        if self.coriolis.is_none() {
+        if self.coriolis.is_none() && self.quadratic.is_none() {
             return blend(&|_| u.clone());
         }
-        // C(δ)δ over the step by Heun's rule: its mean of the start and
-        // the predicted end (held at the start it lags fast turns).
+        // C(δ)δ and D_q|δ|δ over the step by Heun's rule: their mean of the
+        // start and the predicted end (held at the start they lag fast
+        // turns).
         let predicted = blend(&|k| self.driving(x, u, k));
         blend(&|k| (self.driving(x, u, k) + self.driving(&predicted, u, k)) * 0.5)
     }

@@ -14,6 +14,8 @@
 //!   interpolated (eq. 2.18) scheduling; a `Predictor` scheduled on u.
 //! - [`lpv_schedule`]: the sub-models' weights at a speed, and the optional
 //!   extension beyond the grid (damping linear, load quadratic in u₀).
+//! - [`quadratic_damping`]: D_q|δ|δ, the quadratic hull damping about
+//!   straight-ahead motion that linear sub-models cannot carry.
 //! - [`error`]: the typed errors of all of the above.
 //! - `predict` (private): k-step and free-run loops shared by the predictors.
 
@@ -23,6 +25,7 @@ pub mod lpv;
 pub mod lpv_schedule;
 pub(crate) mod predict;
 pub mod projection;
+pub mod quadratic_damping;
 pub mod state_space;
 pub mod structure;
 pub mod vessel;

@@ -23,8 +23,8 @@ use seatrial_core::planning::examples::surveyor_rov;
 use seatrial_core::planning::vessel::VesselProfile;
 use seatrial_core::validation::{ValidationSettings, nrmse_fit};
 use seatrial_truth::{
-    Campaign, CampaignSpec, Role, Run, Vessel, effective_linearization, fly_campaign,
-    true_predictions,
+    Campaign, CampaignSpec, Role, Run, Vessel, effective_linearization,
+    effective_linearization_given_quadratic, fly_campaign, true_predictions,
 };
 
 /// One parameter's error in units of its reported std.
@@ -266,7 +266,26 @@ pub fn evaluate_with(
     let restoring = doc.restoring.as_ref().map(|r| r.params);
     let wb_est = restoring.map_or(0.0, |r| r.weight_minus_buoyancy_n);
     for point in &lpv.points {
-        let lin = fitted_linearization(&vessel, &campaign, &point.run_ids);
+        // A model with quadratic damping is graded against the truth's best
+        // linear-affine model beside the truth's own D_q, in the DOFs the
+        // model gives one (an entry left out, σ 0, is linear there).
+        let lin = if let Some(std) = &lpv.quadratic_damping_std {
+            let d_q = nalgebra::Vector6::from_fn(|i, _| {
+                if std.get(i).is_some_and(|s| *s > 0.0) {
+                    vessel.damping_quadratic[i]
+                } else {
+                    0.0
+                }
+            });
+            let runs: Vec<&Run> = campaign
+                .runs
+                .iter()
+                .filter(|r| point.run_ids.contains(&r.meta.name))
+                .collect();
+            effective_linearization_given_quadratic(&vessel, &runs, &d_q)
+        } else {
+            fitted_linearization(&vessel, &campaign, &point.run_ids)
+        };
         let name = |g: &str, i: usize, j: usize| {
             format!(
                 "{g}[{},{}]@{:.2}",
@@ -319,6 +338,19 @@ pub fn evaluate_with(
             }
         }
     }
+    if let (Some(d_q), Some(std)) = (&lpv.quadratic_damping, &lpv.quadratic_damping_std) {
+        for i in 1..6 {
+            // An entry left out (0, no σ) is not an estimate to judge.
+            if std[i] > 0.0 && std[i].is_finite() {
+                z.push(ZScore {
+                    name: format!("D_q[{}]", Dof::ALL[i].name()),
+                    estimate: d_q[i],
+                    truth: vessel.damping_quadratic[i],
+                    std: std[i],
+                });
+            }
+        }
+    }
     if let Some(r) = &doc.restoring {
         for p in &r.parameters {
             let truth = match p.symbol.as_str() {
@@ -359,6 +391,8 @@ pub fn evaluate_with(
             r.params.weight_minus_buoyancy_n = vessel.w_minus_b;
             r.params.zg_weight_minus_zb_buoyancy_nm = vessel.zg_w_minus_zb_b();
         }
+        // The best linear model: no quadratic damping.
+        doc.lpv.as_mut().expect("an LPV model").quadratic_damping = None;
         for point in doc.lpv.as_mut().expect("an LPV model").points.iter_mut() {
             let lin = fitted_linearization(&vessel, &campaign, &point.run_ids);
             point.m = (0..6)

@@ -25,6 +25,7 @@ fn surge_record(nu: impl Fn(f64) -> (f64, f64), theta: f64) -> (Baseline, [Recor
         restoring: Default::default(),
 
         coriolis: None,
+        quadratic: None,
     };
     (baseline, [rec])
 }
@@ -123,6 +124,7 @@ fn the_current_regressor_from_kept_signals_is_the_filtered_direct_one() {
         restoring: Default::default(),
 
         coriolis: None,
+        quadratic: None,
     };
     let records = [rec];
     let prep = Prepared::new(&baseline, &records, 0.5, 10, 5).expect("prepared");

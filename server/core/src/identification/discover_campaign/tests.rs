@@ -35,6 +35,9 @@ fn baseline(runs: &[RunInput]) -> Identified {
         estimate_restoring: false,
         constant_loads: false,
         coriolis_second_order: false,
+        symmetric_inertia: false,
+        quadratic_damping: false,
+        extend_above_grid: false,
         ..LambdaCampaignSettings::default()
     };
     identify_lambda_campaign(
@@ -238,6 +241,9 @@ fn flown(truth: &RovTruth) -> (Vec<RunInput>, Identified, CampaignDiscovery) {
             estimate_restoring: false,
             constant_loads: false,
             coriolis_second_order: false,
+            symmetric_inertia: false,
+            quadratic_damping: false,
+            extend_above_grid: false,
             ..LambdaCampaignSettings::default()
         },
         &mut NoProgress,
