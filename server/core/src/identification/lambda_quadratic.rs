@@ -134,7 +134,7 @@ pub(crate) fn of_estimate(
 /// One D_q for the campaign from the grid points' joint estimates `points`
 /// (inverse-variance pooling per DOF), with its std and notes: entries
 /// pooled negative or within 2σ of zero are left out (0) and said so.
-/// `None` when no point estimated D_q.
+/// `None` when no point estimated D_q or every entry was left out.
 pub(crate) fn pool(
     points: &[(f64, LambdaEstimate)],
     dofs: &[Dof],
@@ -188,7 +188,8 @@ pub(crate) fn pool(
             left_out.join(", ")
         ));
     }
-    Some((d, s))
+    // Every entry left out: the model is linear, not "D_q = 0".
+    (s.iter().any(|v| *v > 0.0)).then_some((d, s))
 }
 
 /// `exp` with the known D_q|δ|δ moved to the force side, γ' = γ − F̄, F̄ the
