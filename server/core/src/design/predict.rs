@@ -226,10 +226,20 @@ pub fn predict_precision(
     progress
         .update(0.99, "tabulating")
         .map_err(|_| cancelled())?;
-    let first = rows(&done[0].doc);
     let per: Vec<HashMap<_, ParameterRow>> = done
         .iter()
         .map(|r| rows(&r.doc).into_iter().map(|p| (key(&p), p)).collect())
+        .collect();
+    // M fitted symmetric has one parameter per off-diagonal pair: the
+    // lower entry, equal to the upper in every realisation, is not listed.
+    let mut mirrored = 0;
+    let first: Vec<ParameterRow> = rows(&done[0].doc)
+        .into_iter()
+        .filter(|p| {
+            let dup = mirrors_upper_entry(p, &per);
+            mirrored += usize::from(dup);
+            !dup
+        })
         .collect();
     // Per parameter: mean value, spread over realisations, median reported std.
     let mut reported_median = Vec::with_capacity(first.len());
@@ -318,6 +328,11 @@ pub fn predict_precision(
             failed.len()
         ));
     }
+    if mirrored > 0 {
+        notes.push(format!(
+            "M is fitted symmetric: each of its {mirrored} off-diagonal pairs is one parameter, listed once as its upper entry M[i,j] = M[j,i]"
+        ));
+    }
     if fixed > 0 {
         notes.push(format!(
             "{fixed} matrix entries left out: the identification's structure fixes them (at zero or from M) in most realisations"
@@ -379,15 +394,43 @@ pub(super) fn run_input(
     })
 }
 
+/// (i, j) in DOF order of a matrix entry's symbol "X[dof_i,dof_j]".
+fn matrix_entry(symbol: &str) -> Option<(usize, usize)> {
+    let inner = symbol.split_once('[')?.1.strip_suffix(']')?;
+    let (a, b) = inner.split_once(',')?;
+    let idx = |n: &str| Dof::ALL.iter().position(|d| d.name() == n.trim());
+    Some((idx(a)?, idx(b)?))
+}
+
+/// `row` is a lower entry M[j,i] (j > i) equal to M[i,j] at its grid speed
+/// in every realisation: the same parameter as the upper entry.
+fn mirrors_upper_entry(
+    row: &ParameterRow,
+    per: &[HashMap<(String, String, Option<u64>), ParameterRow>],
+) -> bool {
+    let Some((j, i)) = matrix_entry(&row.symbol) else {
+        return false;
+    };
+    if row.group != "M" || j <= i {
+        return false;
+    }
+    let upper = ParameterRow {
+        symbol: format!("M[{},{}]", Dof::ALL[i].name(), Dof::ALL[j].name()),
+        ..row.clone()
+    };
+    let (kl, ku) = (key(row), key(&upper));
+    per.iter().all(|m| match (m.get(&kl), m.get(&ku)) {
+        (Some(l), Some(u)) => {
+            (l.value - u.value).abs() <= 1e-9 * l.value.abs().max(u.value.abs()).max(1e-300)
+        }
+        _ => false,
+    })
+}
+
 /// Each row with the magnitude its std is measured against (module docs
 /// of [`super`]).
 fn scale_rows<'a>(profile: &VesselProfile, rows: &[&'a ParameterRow]) -> Vec<Scaled<'a>> {
-    let entry = |symbol: &str| -> Option<(usize, usize)> {
-        let inner = symbol.split_once('[')?.1.strip_suffix(']')?;
-        let (a, b) = inner.split_once(',')?;
-        let idx = |n: &str| Dof::ALL.iter().position(|d| d.name() == n.trim());
-        Some((idx(a)?, idx(b)?))
-    };
+    let entry = matrix_entry;
     let mut diagonal: HashMap<(String, u64, usize), f64> = HashMap::new();
     for r in rows {
         if let Some((i, j)) = entry(&r.symbol)
