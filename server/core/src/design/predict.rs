@@ -131,7 +131,10 @@ fn rows(doc: &ModelDocument) -> Vec<ParameterRow> {
     rows
 }
 
-fn key(r: &ParameterRow) -> (String, String, Option<u64>) {
+/// A parameter row's identity: group, symbol, grid speed (bits).
+type RowKey = (String, String, Option<u64>);
+
+fn key(r: &ParameterRow) -> RowKey {
     (
         r.group.clone(),
         r.symbol.clone(),
@@ -404,10 +407,7 @@ fn matrix_entry(symbol: &str) -> Option<(usize, usize)> {
 
 /// `row` is a lower entry M[j,i] (j > i) equal to M[i,j] at its grid speed
 /// in every realisation: the same parameter as the upper entry.
-fn mirrors_upper_entry(
-    row: &ParameterRow,
-    per: &[HashMap<(String, String, Option<u64>), ParameterRow>],
-) -> bool {
+fn mirrors_upper_entry(row: &ParameterRow, per: &[HashMap<RowKey, ParameterRow>]) -> bool {
     let Some((j, i)) = matrix_entry(&row.symbol) else {
         return false;
     };
