@@ -85,24 +85,21 @@ pub(crate) fn specification(
 }
 
 /// `exp` with the columns |ν_i|ν_i (i in `cols`) appended, held over each
-/// step like γ: row k the mean of the step's ends (the last row its own).
+/// step like γ as the model applies the force (linearly implicit,
+/// [`crate::models::LpvModel`]): row k is |ν_i(k)|ν_i(k+1) (the last row
+/// |ν_i|ν_i).
 pub(crate) fn append(exp: Experiment, cols: &[usize]) -> Experiment {
     if cols.is_empty() {
         return exp;
     }
     let rows = exp.nu.nrows();
     let q0 = exp.exogenous.ncols();
-    let f = |k: usize, i: usize| exp.nu[(k, i)].abs() * exp.nu[(k, i)];
+    let f = |k: usize, i: usize| exp.nu[(k, i)].abs() * exp.nu[((k + 1).min(rows - 1), i)];
     let e = DMatrix::from_fn(rows, q0 + cols.len(), |k, j| {
         if j < q0 {
             exp.exogenous[(k, j)]
         } else {
-            let i = cols[j - q0];
-            if k + 1 < rows {
-                0.5 * (f(k, i) + f(k + 1, i))
-            } else {
-                f(k, i)
-            }
+            f(k, cols[j - q0])
         }
     });
     Experiment {
@@ -192,21 +189,15 @@ pub(crate) fn pool(
     (s.iter().any(|v| *v > 0.0)).then_some((d, s))
 }
 
-/// `exp` with the known D_q|δ|δ moved to the force side, γ' = γ − F̄, F̄ the
-/// step mean of the force at the step's ends (as the model applies it over
-/// the step, Heun).
+/// `exp` with the known D_q|δ|δ moved to the force side, γ' = γ − F, F
+/// over step k as the model applies it: D_q,i |δ_i(k)| δ_i(k+1).
 pub(crate) fn subtract(exp: Experiment, d_q: &DVector<f64>, surge: Option<usize>) -> Experiment {
     let rows = exp.nu.nrows();
-    let force = |k: usize| {
-        let nu: Vec<f64> = exp.nu.row(k).iter().copied().collect();
-        crate::models::quadratic_damping::quadratic_force(d_q, &nu, surge)
-    };
     let mut gamma = exp.gamma.clone();
     for k in 0..rows {
-        let next = if k + 1 < rows { k + 1 } else { k };
-        let (f0, f1) = (force(k), force(next));
-        for i in 0..gamma.ncols() {
-            gamma[(k, i)] -= 0.5 * (f0[i] + f1[i]);
+        let next = (k + 1).min(rows - 1);
+        for i in (0..gamma.ncols().min(d_q.len())).filter(|&i| Some(i) != surge) {
+            gamma[(k, i)] -= d_q[i] * exp.nu[(k, i)].abs() * exp.nu[(next, i)];
         }
     }
     Experiment { gamma, ..exp }
@@ -296,8 +287,8 @@ mod tests {
             exogenous: DMatrix::zeros(2, 0),
         };
         let e = append(exp, &cols).exogenous;
-        // step mean of −0.04 and +0.04; of 0.16 and 0
-        assert!(e[(0, 0)].abs() < 1e-12 && (e[(0, 1)] - 0.08).abs() < 1e-12);
+        // |v(0)| v(1) = 0.2 · 0.2; |r(0)| r(1) = 0.4 · 0; the last row its own
+        assert!((e[(0, 0)] - 0.04).abs() < 1e-12 && e[(0, 1)].abs() < 1e-12);
         assert!((e[(1, 0)] - 0.04).abs() < 1e-12 && e[(1, 1)].abs() < 1e-12);
     }
 

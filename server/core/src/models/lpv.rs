@@ -28,7 +28,6 @@ use super::error::{ModelError, check_finite};
 pub use super::lpv_schedule::{Blend, Extension, ScheduleWeights, Scheduling};
 use super::lpv_schedule::{blend as schedule_blend, schedule};
 use super::predict::{check_record, free_run, k_step, no_prediction};
-use super::quadratic_damping::quadratic_force;
 use super::state_space::DiscreteStateSpace;
 use super::vessel::LinearVesselModel;
 use crate::planning::dof::Dof;
@@ -47,7 +46,7 @@ pub struct LpvModel {
     /// linear sub-models alone.
     coriolis: Option<Vec<DMatrix<f64>>>,
     /// Diagonal quadratic damping D_q per grid point (one entry per DOF,
-    /// [`quadratic_force`]); `None`: linear damping only.
+    /// [`super::quadratic_damping::quadratic_force`]); `None`: linear damping only.
     quadratic: Option<Vec<DVector<f64>>>,
 }
 
@@ -226,8 +225,9 @@ impl LpvModel {
     /// The same model with diagonal quadratic damping D_q|δ|δ, one D_q per
     /// grid point (n entries, N·s²/m² or N·m·s²/rad²; the surge entry is
     /// unused when surge is modelled, the schedule following u): each
-    /// sub-model is driven by γ − D_q|δ|δ ([`quadratic_force`]). Beyond
-    /// the grid the end point's D_q serves.
+    /// sub-model is driven by γ − D_q|δ|δ
+    /// ([`super::quadratic_damping::quadratic_force`]), taken linearly
+    /// implicit over each step. Beyond the grid the end point's D_q serves.
     ///
     /// # Errors
     /// [`ModelError::Grid`] with one D_q per grid point missing;
@@ -473,17 +473,45 @@ impl DiscreteLpv {
         )
     }
 
-    /// γ − C(δ)δ − D_q|δ|δ with grid point `k`'s M and D_q (γ itself
-    /// without the terms).
+    /// γ − C(δ)δ with grid point `k`'s M (γ itself without C(δ)δ).
     fn driving(&self, x: &DVector<f64>, u: &DVector<f64>, k: usize) -> DVector<f64> {
         let mut out = u.clone();
         if let (Some(m), Some(i)) = (&self.coriolis, self.surge) {
             out -= DVector::from_vec(second_order_force(&self.dofs, &m[k], x.as_slice(), i));
         }
-        if let Some(d) = &self.quadratic {
-            out -= DVector::from_vec(quadratic_force(&d[k], x.as_slice(), self.surge));
-        }
         out
+    }
+
+    /// `explicit` (the step from ν(k) = `x` without D_q|δ|δ) with the
+    /// quadratic damping over the step as −D_q diag|δ(k)| δ(k+1): with
+    /// K = Σ w Γ D_q diag|δ(k)|, (I + K) x⁺ = x̂. Linearly implicit, it
+    /// damps at any D_q and step (the explicit force overshoots zero and
+    /// diverges), and for one DOF m v̇ + d v + q|v|v = 0 under ZOH it is
+    /// exact: 1/v(k+1) = e^{hd/m}(1/v(k) + q/d) − q/d.
+    fn implicit_quadratic(
+        &self,
+        explicit: DVector<f64>,
+        parts: [(&DiscreteStateSpace, f64, usize); 2],
+        x: &DVector<f64>,
+    ) -> DVector<f64> {
+        let Some(d) = &self.quadratic else {
+            return explicit;
+        };
+        let n = explicit.len();
+        let mut lhs = DMatrix::<f64>::identity(n, n);
+        for (model, w, k) in parts {
+            if w == 0.0 {
+                continue;
+            }
+            let gamma = model.gamma();
+            for j in (0..n.min(gamma.ncols())).filter(|&j| Some(j) != self.surge) {
+                let scale = w * d[k].get(j).copied().unwrap_or(0.0) * x[j].abs();
+                for i in 0..n {
+                    lhs[(i, j)] += gamma[(i, j)] * scale;
+                }
+            }
+        }
+        lhs.lu().solve(&explicit).unwrap_or(explicit)
     }
 
     /// x̂(k+1 | k) from ν(k) = `x` and γ(k) = `u`, scheduled on the surge
@@ -506,11 +534,16 @@ impl DiscreteLpv {
         if self.coriolis.is_none() && self.quadratic.is_none() {
             return blend(&|_| u.clone());
         }
-        // C(δ)δ and D_q|δ|δ over the step by Heun's rule: their mean of the
-        // start and the predicted end (held at the start they lag fast
-        // turns).
-        let predicted = blend(&|k| self.driving(x, u, k));
-        blend(&|k| (self.driving(x, u, k) + self.driving(&predicted, u, k)) * 0.5)
+        // C(δ)δ over the step by Heun's rule: the mean of the start and the
+        // predicted end (held at the start it lags fast turns); D_q|δ|δ
+        // linearly implicit about |δ| of the start.
+        let parts = [(l, wl, kl), (m, wm, km)];
+        let predicted = self.implicit_quadratic(blend(&|k| self.driving(x, u, k)), parts, x);
+        self.implicit_quadratic(
+            blend(&|k| (self.driving(x, u, k) + self.driving(&predicted, u, k)) * 0.5),
+            parts,
+            x,
+        )
     }
 }
 
