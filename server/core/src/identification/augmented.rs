@@ -8,6 +8,7 @@ use nalgebra::DMatrix;
 use super::document::{LpvPoint, ModelDocument, from_rows};
 use super::error::IdentifyError;
 use super::intersample::logged_equivalent;
+use super::lambda_coriolis::document_inertia;
 use crate::discrepancy::model::{Drive, State, free_run, k_step};
 use crate::discrepancy::{AugmentedModel, Baseline, Record, Restoring};
 use crate::models::{LpvModel, Scheduling};
@@ -76,8 +77,8 @@ pub fn baseline_at(doc: &ModelDocument, point: &LpvPoint) -> Result<Baseline, Id
     let coriolis = doc
         .lpv
         .as_ref()
-        .is_some_and(|l| l.coriolis_second_order)
-        .then(|| vehicle_m.clone());
+        .filter(|l| l.coriolis_second_order)
+        .map(|l| document_inertia(l).unwrap_or_else(|| vehicle_m.clone()));
     let (m, d_bar) = logged_view(doc, vehicle_m, matrix(&point.d_bar, "D̄")?)?;
     let quadratic = match doc.lpv.as_ref() {
         Some(l) => super::predictor::quadratic_of(l, doc.dofs.len())?,

@@ -180,8 +180,10 @@ pub struct LpvDoc {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extension: Option<SpeedExtension>,
     /// The sub-models are driven by γ − C(δ)δ: the second-order Coriolis–
-    /// centripetal force of each point's M, with δ = ν except the forward
-    /// speed u the model is scheduled on (C(ν) of Fossen 2011, eq. 6.43).
+    /// centripetal force of one vehicle M (the points' M pooled per entry
+    /// by inverse variance; each point's own M if that pool is not positive
+    /// definite), with δ = ν except the forward speed u the model is
+    /// scheduled on (C(ν) of Fossen 2011, eq. 6.43).
     /// Absent or false: the linear sub-models alone (thesis).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub coriolis_second_order: bool,

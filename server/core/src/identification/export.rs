@@ -6,8 +6,9 @@
 
 use serde::Serialize;
 
-use super::document::{Matrix, ModelDocument, ModelKind, ParameterRow};
+use super::document::{Matrix, ModelDocument, ModelKind, ParameterRow, to_rows};
 use super::export_terms::{ExportedTerm, point_terms};
+use super::lambda_coriolis::document_inertia;
 
 /// A CSV field, quoted when it holds a comma, a quote or a line break.
 pub(crate) fn csv_field(s: &str) -> String {
@@ -145,6 +146,11 @@ pub struct FossenParameterSet {
     /// carries surge's). Absent: linear damping only.
     #[serde(rename = "D_q", default, skip_serializing_if = "Option::is_none")]
     pub d_q: Option<Vec<f64>>,
+    /// M of the second-order Coriolis–centripetal force C(δ)δ (kg, kg·m,
+    /// kg·m²): one for the vehicle, each entry the inverse-variance mean of
+    /// the grid points' M. Absent: no C(δ)δ, or each point's own M serves.
+    #[serde(rename = "M_C", default, skip_serializing_if = "Option::is_none")]
+    pub m_coriolis: Option<Matrix>,
     /// How to use it.
     pub notes: Vec<String>,
 }
@@ -162,6 +168,11 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
         ModelKind::Lpv => {
             let lpv = doc.lpv.as_ref().ok_or("the LPV model has no grid points")?;
             let augmented = lpv.points.iter().any(|p| p.augmentation.is_some());
+            let m_coriolis = lpv
+                .coriolis_second_order
+                .then(|| document_inertia(lpv))
+                .flatten()
+                .map(|m| to_rows(&m));
             let mut notes = vec![
                 "Schedule on forward speed: nearest U, or interpolate M and D between neighbours."
                     .into(),
@@ -173,7 +184,12 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                 notes.push(e.describe(lo.speed_mps, hi.speed_mps));
             }
             if lpv.coriolis_second_order {
-                notes.push("Second-order Coriolis–centripetal force: add C(δ)δ to the left-hand side, C(ν) from the point's M (Fossen 2011, eq. 6.43) at δ = ν with the forward speed u set to zero — the turning, heaving and rolling forces about straight-ahead motion; the linear part about U is in D and b.".into());
+                let from = if m_coriolis.is_some() {
+                    "`M_C`, the vehicle's M pooled over the grid points by inverse variance"
+                } else {
+                    "the point's M"
+                };
+                notes.push(format!("Second-order Coriolis–centripetal force: add C(δ)δ to the left-hand side, C(ν) from {from} (Fossen 2011, eq. 6.43) at δ = ν with the forward speed u set to zero — the turning, heaving and rolling forces about straight-ahead motion; the linear part about U is in D and b."));
             }
             if lpv.quadratic_damping.is_some() {
                 notes.push("Quadratic damping: add D_q|δ|δ to the left-hand side, D_q diagonal (`D_q`, one for every U), δ = ν with the forward speed u set to zero — hull damping that grows with the amplitude of sway, heave and the rotations; surge's is in D and b per U.".into());
@@ -211,6 +227,7 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                 t: None,
                 k: None,
                 d_q: lpv.quadratic_damping.clone(),
+                m_coriolis,
                 notes,
             })
         }
@@ -235,6 +252,7 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                 t: Some(s.t_config.clone()),
                 k: Some(s.k.clone()),
                 d_q: None,
+                m_coriolis: None,
                 notes: vec![
                     "Low-frequency DP model at rest (U = 0); D″ = −A″_h·M″ (eq. 39); M″ and T″ are the a-priori values (eq. 29–30), A″_h and K″ identified (eq. 48–49).".into(),
                     format!("A″_h = {:?}", s.a_h),
@@ -326,6 +344,29 @@ mod tests {
         let mut ss = doc();
         ss.kind = ModelKind::StateSpace;
         assert!(fossen_parameter_set(&ss).unwrap_err().contains("black box"));
+    }
+
+    /// Two points with M 2700 ± 30 and 2900 ± 90 give C(δ)δ one M:
+    /// (2700/900 + 2900/8100) / (1/900 + 1/8100) = 2720, in the set as
+    /// `M_C` and named in its note; without C(δ)δ there is none.
+    #[test]
+    fn fossen_set_carries_the_pooled_inertia_of_the_coriolis_force() {
+        let mut d = doc();
+        assert!(fossen_parameter_set(&d).unwrap().m_coriolis.is_none());
+        let lpv = d.lpv.as_mut().unwrap();
+        lpv.coriolis_second_order = true;
+        let mut second = lpv.points[0].clone();
+        second.speed_mps = 1.0;
+        second.m = vec![vec![2900.0]];
+        second.m_std = vec![vec![90.0]];
+        lpv.points.push(second);
+        let set = fossen_parameter_set(&d).unwrap();
+        let m_c = set.m_coriolis.clone().unwrap()[0][0];
+        assert!((m_c - 2720.0).abs() < 1e-9, "{m_c}");
+        assert!(set.notes.iter().any(|n| n.contains("`M_C`")));
+        assert_eq!(serde_json::to_value(&set).unwrap()["M_C"][0][0], m_c);
+        let script = super::super::export_matlab::matlab_script(&d, "rov", 1);
+        assert!(script.contains("model.lpv.coriolis_M = [2720]"), "{script}");
     }
 
     #[test]

@@ -10,7 +10,8 @@
 
 use std::fmt::Write;
 
-use super::document::{Matrix, ModelDocument};
+use super::document::{Matrix, ModelDocument, to_rows};
+use super::lambda_coriolis::document_inertia;
 
 /// A MATLAB string literal ('' escapes a quote; control characters dropped).
 fn string(s: &str) -> String {
@@ -122,10 +123,19 @@ pub fn matlab_script(doc: &ModelDocument, name: &str, version: i64) -> String {
             w,
             "% (nu_dot = A nu + B (tau - g(eta) - b)); between grid points interpolate or take the nearest."
         );
+        let m_c = l
+            .coriolis_second_order
+            .then(|| document_inertia(l))
+            .flatten();
         if l.coriolis_second_order {
             let _ = writeln!(
                 w,
-                "% Second-order Coriolis: add C(d)*d to the left-hand side, with d = nu but u = 0 and C from M(:,:,i) (Fossen 2011, eq. 6.43):"
+                "% Second-order Coriolis: add C(d)*d to the left-hand side, with d = nu but u = 0 and C from {} (Fossen 2011, eq. 6.43):",
+                if m_c.is_some() {
+                    "model.lpv.coriolis_M, the vehicle's M pooled over the grid points by inverse variance"
+                } else {
+                    "M(:,:,i)"
+                }
             );
             let _ = writeln!(
                 w,
@@ -141,6 +151,13 @@ pub fn matlab_script(doc: &ModelDocument, name: &str, version: i64) -> String {
                 "false"
             }
         );
+        if let Some(m) = &m_c {
+            let _ = writeln!(
+                w,
+                "model.lpv.coriolis_M = {};  % kg, kg*m, kg*m^2",
+                matrix(&to_rows(m))
+            );
+        }
         if let Some(d) = &l.quadratic_damping {
             let _ = writeln!(
                 w,

@@ -15,7 +15,7 @@ use super::error::IdentifyError;
 use super::intersample::{correct_estimates, inertia_offset, logged_equivalent, logged_gains};
 use super::joint_restoring::{Functions, PooledRestoring, load, specification};
 use super::lambda_consistency::{inflate_inertia_std, symmetry_note};
-use super::lambda_coriolis::fit_points;
+use super::lambda_coriolis::{fit_points, pooled_inertia};
 use super::lambda_data::{experiment, per_point, regression_columns, static_holds};
 use super::lambda_extension::{Sides, choose_extension, speed_coverage_notes};
 use super::lambda_information::default_t_lambda;
@@ -411,6 +411,11 @@ pub fn identify_lambda_campaign(
     };
     let speeds: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
     let vehicle_m: Vec<_> = vehicle.iter().map(|v| v.m().clone()).collect();
+    let m_std: Vec<_> = estimates.iter().map(|(_, e)| e.std_m.clone()).collect();
+    let vehicle_m = match pooled_inertia(&vehicle_m, &m_std) {
+        Some(m) => vec![m; vehicle_m.len()],
+        None => vehicle_m,
+    };
     let lpv = LpvModel::new(speeds.clone(), models)
         .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
         .with_scheduling(scheduling);

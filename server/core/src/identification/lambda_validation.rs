@@ -106,7 +106,7 @@ pub(crate) fn choose_second_order(
         return Ok((linear, without, false));
     }
     notes.push(format!(
-        "the model carries the second-order Coriolis–centripetal force C(δ)δ of its M (δ = ν about straight-ahead motion at the scheduled speed: the centripetal forces of turning, heaving and rolling that the linear sub-models cannot hold; no parameter added); held-out free-run fit summed over runs and channels {with_fit:.3} with it, {without_fit:.3} without"
+        "the model carries the second-order Coriolis–centripetal force C(δ)δ of one vehicle M, its grid points' M pooled by inverse variance (δ = ν about straight-ahead motion at the scheduled speed: the centripetal forces of turning, heaving and rolling that the linear sub-models cannot hold; no parameter added); held-out free-run fit summed over runs and channels {with_fit:.3} with it, {without_fit:.3} without"
     ));
     Ok((lpv, validation, true))
 }

@@ -112,6 +112,10 @@ pub(crate) fn baseline_lpv(doc: &ModelDocument) -> Result<LpvModel, IdentifyErro
     let model = LpvModel::new(speeds, models)
         .map_err(|e| IdentifyError::invalid("document.lpv", e.to_string()))?;
     let model = if lpv.coriolis_second_order {
+        let vehicle_m = match super::lambda_coriolis::document_inertia(lpv) {
+            Some(m) => vec![m; vehicle_m.len()],
+            None => vehicle_m,
+        };
         model.with_second_order_coriolis(vehicle_m).map_err(|e| {
             IdentifyError::invalid("document.lpv.coriolis_second_order", e.to_string())
         })?
