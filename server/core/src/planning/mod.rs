@@ -8,11 +8,14 @@ pub mod campaign;
 pub mod deciding;
 pub mod design;
 pub mod dof;
+mod dp_manoeuvres;
+mod dynamic_runs;
 pub mod error;
 pub mod examples;
 pub mod plan;
 pub mod revision;
 pub mod statics;
+mod validation_run;
 pub mod vessel;
 pub mod waveform;
 

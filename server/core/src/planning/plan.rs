@@ -7,13 +7,13 @@ use serde::{Deserialize, Serialize};
 
 use super::analysis::{ChannelAnalysis, analyse};
 use super::campaign::{CampaignSpec, ExperimentFamily, Quantity, SignalKind, SpeedUnit};
-use super::design::{ChannelRequest, MAX_SEED, SQUARE_HOLD_TIME_CONSTANTS, design_channel};
+use super::design::{ChannelRequest, MAX_SEED, design_channel};
 use super::dof::{Dof, KNOT};
 use super::error::PlanError;
 use super::statics::{
     ATTITUDE_LOOP_TIME_CONSTANTS, attitude_column, attitude_limit, holds_attitude, static_angle,
 };
-use super::vessel::{ThrusterKind, VesselKind, VesselProfile};
+use super::vessel::{VesselKind, VesselProfile};
 use super::waveform::Waveform;
 use crate::rng::mix;
 use crate::signals;
@@ -166,7 +166,13 @@ impl Plan {
     }
 }
 
-fn run_seed(seed: u64, family: ExperimentFamily, grid: usize, dof: usize, rep: u32) -> u64 {
+pub(super) fn run_seed(
+    seed: u64,
+    family: ExperimentFamily,
+    grid: usize,
+    dof: usize,
+    rep: u32,
+) -> u64 {
     let mut h = mix(seed);
     for v in [family as u64, grid as u64, dof as u64, u64::from(rep)] {
         h = mix(h ^ v);
@@ -206,7 +212,7 @@ impl Ctx<'_> {
         self.spec.excitation.per_dof.get(&d)
     }
 
-    fn signal_for(&self, d: Dof) -> SignalKind {
+    pub(super) fn signal_for(&self, d: Dof) -> SignalKind {
         self.override_of(d)
             .and_then(|o| o.signal)
             .unwrap_or(self.spec.excitation.signal)
@@ -338,7 +344,7 @@ impl Ctx<'_> {
 
     /// Designs an excited DOF channel.
     #[allow(clippy::too_many_arguments)]
-    fn dynamic_dof(
+    pub(super) fn dynamic_dof(
         &self,
         d: Dof,
         u0: f64,
@@ -408,7 +414,7 @@ fn check_amplitude(field: &str, a: f64, limit: f64, unit: &str) -> Result<f64, P
 /// PE order an experiment needs per excited channel: two per DOF its data
 /// must identify (a first-order response per DOF: A_λ and B_λ entries), one
 /// for a static run (a steady-state gain).
-fn pe_required(family: ExperimentFamily, n_dofs: usize) -> usize {
+pub(super) fn pe_required(family: ExperimentFamily, n_dofs: usize) -> usize {
     use ExperimentFamily::*;
     match family {
         Static => 1,
@@ -446,10 +452,10 @@ pub fn generate_plan(vessel: &VesselProfile, spec: &CampaignSpec) -> Result<Plan
                     super::statics::rov_static(&ctx, gi, reps, &mut out)?;
                 }
                 if has(ExperimentFamily::Dynamic) {
-                    rov_dynamic(&ctx, gi, reps, &mut out)?;
+                    super::dynamic_runs::rov_dynamic(&ctx, gi, reps, &mut out)?;
                 }
                 if has(ExperimentFamily::Recursive) {
-                    rov_recursive(&ctx, gi, reps, &mut out)?;
+                    super::dynamic_runs::rov_recursive(&ctx, gi, reps, &mut out)?;
                 }
             }
         }
@@ -462,14 +468,14 @@ pub fn generate_plan(vessel: &VesselProfile, spec: &CampaignSpec) -> Result<Plan
             ] {
                 if has(fam) {
                     for gi in 0..ctx.speeds.len() {
-                        dp_manoeuvre(&ctx, fam, gi, reps, &mut out)?;
+                        super::dp_manoeuvres::dp_manoeuvre(&ctx, fam, gi, reps, &mut out)?;
                     }
                 }
             }
         }
     }
     if has(ExperimentFamily::Validation) {
-        validation(&ctx, reps, &mut out)?;
+        super::validation_run::validation(&ctx, reps, &mut out)?;
     }
     super::deciding::deciding_runs(&ctx, &mut out)?;
     let mut per_family = BTreeMap::new();
@@ -641,461 +647,4 @@ pub(super) fn fmt_speed(ctx: &Ctx<'_>, gi: usize) -> String {
             .replace("m/s", " m/s"),
         ctx.speeds[gi]
     )
-}
-
-/// What the pilot does in a dynamic roll or pitch run excited by attitude:
-/// hold +A, then −A, switching as the schedule says.
-fn attitude_words(d: Dof, p: &ChannelPlan) -> String {
-    let (name, col, a) = (d.name(), &p.column, p.amplitude);
-    let deg = a.to_degrees();
-    let switching = match &p.waveform {
-        Waveform::Square { period_s } => format!("switching every {:.0} s", period_s / 2.0),
-        Waveform::Prbs { clock_period_s, .. } => format!(
-            "switching as the {col} schedule says (a PRBS: each level held a whole number of {clock_period_s:.0} s chips)"
-        ),
-        Waveform::RandomBinary { clock_period_s, .. } => format!(
-            "switching as the {col} schedule says (random levels, each held a whole number of {clock_period_s:.0} s chips)"
-        ),
-        _ => format!("moving between them as the {col} schedule says"),
-    };
-    let slew = p.rate_limit.map_or(String::new(), |r| {
-        format!(", bringing it over at no more than {r:.2} rad/s")
-    });
-    format!(
-        "hold {name} at +{deg:.0}°, then −{deg:.0}° (±{a:.3} rad about level) by attitude control, {switching}{slew}: the {name} rate moves at every switch, the attitude stays within about ±{deg:.0}°"
-    )
-}
-
-/// The run sheet's note on roll and pitch in runs that excite every DOF.
-fn attitude_note(ctx: &Ctx<'_>) -> String {
-    let parts: Vec<String> = ctx
-        .vessel
-        .dofs
-        .iter()
-        .filter(|&&d| ctx.excites_attitude(d))
-        .map(|&d| {
-            let deg = ctx.amplitude(d).unwrap_or(0.0).to_degrees();
-            format!("{} between +{deg:.0}° and −{deg:.0}°", d.name())
-        })
-        .collect();
-    if parts.is_empty() {
-        return String::new();
-    }
-    format!(
-        " Roll and pitch references are attitudes ({}): hold them there by attitude control, never as a rate.",
-        parts.join(", ")
-    )
-}
-
-/// Dynamic runs (Tables 3.4–3.5): one DOF excited about the grid speed.
-fn rov_dynamic(
-    ctx: &Ctx<'_>,
-    gi: usize,
-    reps: u32,
-    out: &mut Vec<PlannedExperiment>,
-) -> Result<(), PlanError> {
-    let u0 = ctx.speeds[gi];
-    for &d in &ctx.vessel.dofs {
-        for rep in 1..=reps {
-            let seed = run_seed(ctx.spec.seed, ExperimentFamily::Dynamic, gi, d.index(), rep);
-            let signal = ctx.signal_for(d);
-            let ex = ctx.dynamic_dof(d, u0, ctx.spec.durations.dynamic_s, signal, seed, (0, 1))?;
-            let duration = ex.duration_s;
-            let instruction = if d == Dof::Surge {
-                format!(
-                    "Alternate the forward speed about {} following the u_ref schedule (±{:.3} m/s); no other motion.",
-                    fmt_speed(ctx, gi),
-                    ex.plan.amplitude
-                )
-            } else if ctx.excites_attitude(d) {
-                format!(
-                    "At a constant {}, {}; no other motion.",
-                    fmt_speed(ctx, gi),
-                    attitude_words(d, &ex.plan)
-                )
-            } else {
-                format!(
-                    "At a constant {}, follow the {} schedule on {} (±{:.3} {} about 0); no other motion.",
-                    fmt_speed(ctx, gi),
-                    ex.plan.column,
-                    d.name(),
-                    ex.plan.amplitude,
-                    ex.plan.unit
-                )
-            };
-            let mut channels = Vec::new();
-            let mut ex = Some(ex);
-            for &c in &ctx.vessel.dofs {
-                if c == d {
-                    channels.push(ex.take().expect("one excited channel"));
-                } else {
-                    channels.push(ChannelSpec {
-                        plan: ctx.held(c, u0),
-                        duration_s: duration,
-                    });
-                }
-            }
-            out.push(assemble(
-                ctx,
-                ExperimentHead {
-                    code: format!("DYN-{}-{}-r{rep}", ctx.speed_label(gi), d.name()),
-                    family: ExperimentFamily::Dynamic,
-                    grid_index: Some(gi),
-                    dofs: vec![d],
-                    sign: None,
-                    repetition: rep,
-                    instruction,
-                    pe_required: pe_required(ExperimentFamily::Dynamic, 1),
-                    field: format!("excitation.per_dof.{}", d.name()),
-                },
-                channels,
-            )?);
-        }
-    }
-    Ok(())
-}
-
-/// Recursive runs (Table 3.1): every DOF excited at once about the grid speed.
-fn rov_recursive(
-    ctx: &Ctx<'_>,
-    gi: usize,
-    reps: u32,
-    out: &mut Vec<PlannedExperiment>,
-) -> Result<(), PlanError> {
-    let u0 = ctx.speeds[gi];
-    let dofs = &ctx.vessel.dofs;
-    for rep in 1..=reps {
-        let seed = run_seed(ctx.spec.seed, ExperimentFamily::Recursive, gi, 0, rep);
-        let mut channels = Vec::new();
-        for (i, &d) in dofs.iter().enumerate() {
-            channels.push(ctx.dynamic_dof(
-                d,
-                u0,
-                ctx.spec.durations.recursive_s,
-                ctx.signal_for(d),
-                seed,
-                (i, dofs.len()),
-            )?);
-        }
-        out.push(assemble(
-            ctx,
-            ExperimentHead {
-                code: format!("REC-{}-r{rep}", ctx.speed_label(gi)),
-                family: ExperimentFamily::Recursive,
-                grid_index: Some(gi),
-                dofs: dofs.clone(),
-                sign: None,
-                repetition: rep,
-                instruction: format!(
-                    "Fly about {} and follow the references on all DOFs at once (Table 3.1).{}",
-                    fmt_speed(ctx, gi),
-                    attitude_note(ctx)
-                ),
-                pe_required: pe_required(ExperimentFamily::Recursive, dofs.len()),
-                field: "excitation".into(),
-            },
-            channels,
-        )?);
-    }
-    Ok(())
-}
-
-/// The thruster groups of a DP manoeuvre: thrusters in one group share a signal.
-fn dp_groups(vessel: &VesselProfile, fam: ExperimentFamily) -> Vec<Vec<usize>> {
-    let thr = vessel.thrusters();
-    let of_kind =
-        |k: ThrusterKind| -> Vec<usize> { (0..thr.len()).filter(|&i| thr[i].kind == k).collect() };
-    let yaw_arm = |i: usize| -> f64 {
-        match &vessel.inputs {
-            super::vessel::InputChannels::Thrusters { configuration, .. } => vessel
-                .dofs
-                .iter()
-                .position(|d| *d == Dof::Yaw)
-                .map_or(0.0, |r| configuration[r][i]),
-            _ => 0.0,
-        }
-    };
-    let nonempty = |g: Vec<Vec<usize>>| g.into_iter().filter(|v| !v.is_empty()).collect();
-    match fam {
-        // Main propellers together: K₁ = K₂ (eq. 31).
-        ExperimentFamily::DpSurge => nonempty(vec![of_kind(ThrusterKind::Main)]),
-        // Stern and bow tunnels driven independently, so sway and yaw are both excited.
-        ExperimentFamily::DpSwayYaw => {
-            let t = of_kind(ThrusterKind::Tunnel);
-            let (stern, bow): (Vec<usize>, Vec<usize>) =
-                t.into_iter().partition(|&i| yaw_arm(i) < 0.0);
-            nonempty(vec![stern, bow])
-        }
-        ExperimentFamily::DpAzimuth => nonempty(vec![of_kind(ThrusterKind::Azimuth)]),
-        _ => nonempty(vec![
-            of_kind(ThrusterKind::Main),
-            of_kind(ThrusterKind::Tunnel),
-            of_kind(ThrusterKind::Azimuth),
-        ]),
-    }
-}
-
-/// DP time constant that sets the clock of a manoeuvre.
-fn dp_time_constant(vessel: &VesselProfile, fam: ExperimentFamily) -> f64 {
-    let t = |d: Dof| {
-        vessel
-            .limits
-            .get(&d)
-            .map_or(f64::INFINITY, |l| l.time_constant_s)
-    };
-    let v = match fam {
-        ExperimentFamily::DpSurge => t(Dof::Surge),
-        ExperimentFamily::DpSwayYaw => t(Dof::Sway).min(t(Dof::Yaw)),
-        _ => t(Dof::Yaw).min(t(Dof::Sway)),
-    };
-    if v.is_finite() {
-        v
-    } else {
-        vessel.limit(Dof::Surge).time_constant_s
-    }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn thruster_channels(
-    ctx: &Ctx<'_>,
-    groups: &[Vec<usize>],
-    fam: ExperimentFamily,
-    min_duration: f64,
-    seed: u64,
-) -> Result<Vec<ChannelSpec>, PlanError> {
-    let thr = ctx.vessel.thrusters();
-    let t = dp_time_constant(ctx.vessel, fam);
-    let mut specs: Vec<Option<ChannelSpec>> = (0..thr.len()).map(|_| None).collect();
-    for (gi, group) in groups.iter().enumerate() {
-        // The group's amplitude and rate are set by its weakest thruster.
-        let max_cmd = group
-            .iter()
-            .map(|&i| thr[i].max_command)
-            .fold(f64::INFINITY, f64::min);
-        let rate = group
-            .iter()
-            .map(|&i| thr[i].max_rate)
-            .fold(f64::INFINITY, f64::min);
-        let amplitude = ctx.spec.excitation.amplitude_fraction * max_cmd;
-        let field = format!("inputs.thrusters[{}]", group[0]);
-        let design = design_channel(&ChannelRequest {
-            field: "excitation",
-            signal: if fam == ExperimentFamily::Validation {
-                SignalKind::RandomBinary
-            } else {
-                ctx.spec.excitation.signal
-            },
-            time_constant_s: t,
-            amplitude,
-            rate_limit: Some(rate),
-            rate_field: &format!("{field}.max_rate"),
-            clock_period_s: None,
-            prbs_order: None,
-            min_duration_s: min_duration,
-            logger_rate_hz: ctx.vessel.logger_rate_hz,
-            seed,
-            channel: (gi, groups.len()),
-        })?;
-        for &i in group {
-            specs[i] = Some(ChannelSpec {
-                plan: ChannelPlan {
-                    column: format!("thr_{}", i + 1),
-                    unit: "1".into(),
-                    dof: None,
-                    thruster: Some(i),
-                    excited: true,
-                    waveform: design.waveform.clone(),
-                    offset: 0.0,
-                    amplitude,
-                    limit: thr[i].max_command,
-                    rate_limit: Some(thr[i].max_rate),
-                    analysis: None,
-                },
-                duration_s: design.duration_s,
-            });
-        }
-    }
-    let duration = specs
-        .iter()
-        .flatten()
-        .map(|s| s.duration_s)
-        .fold(0.0, f64::max);
-    Ok(specs
-        .into_iter()
-        .enumerate()
-        .map(|(i, s)| {
-            s.unwrap_or_else(|| ChannelSpec {
-                plan: ChannelPlan {
-                    column: format!("thr_{}", i + 1),
-                    unit: "1".into(),
-                    dof: None,
-                    thruster: Some(i),
-                    excited: false,
-                    waveform: Waveform::Constant,
-                    offset: 0.0,
-                    amplitude: 0.0,
-                    limit: thr[i].max_command,
-                    rate_limit: Some(thr[i].max_rate),
-                    analysis: None,
-                },
-                duration_s: duration,
-            })
-        })
-        .collect())
-}
-
-/// Decoupled DP manoeuvres (Fossen et al. sec. 4.2), N ≥ 2 each.
-fn dp_manoeuvre(
-    ctx: &Ctx<'_>,
-    fam: ExperimentFamily,
-    gi: usize,
-    reps: u32,
-    out: &mut Vec<PlannedExperiment>,
-) -> Result<(), PlanError> {
-    let groups = dp_groups(ctx.vessel, fam);
-    let thr = ctx.vessel.thrusters();
-    if groups.is_empty() {
-        let kind = match fam {
-            ExperimentFamily::DpSurge => "main propeller",
-            ExperimentFamily::DpSwayYaw => "tunnel thruster",
-            _ => "azimuth thruster",
-        };
-        return Err(PlanError::invalid(
-            "families",
-            format!(
-                "'{}' needs at least one {kind}; the vessel has none",
-                fam.name()
-            ),
-        ));
-    }
-    let names: Vec<&str> = groups
-        .iter()
-        .flatten()
-        .map(|&i| thr[i].name.as_str())
-        .collect();
-    let (dofs, instruction) = match fam {
-        ExperimentFamily::DpSurge => (
-            vec![Dof::Surge],
-            format!(
-                "Uncoupled surge (SI1): drive {} with the schedule; hold heading with a bow thruster on the heading autopilot; no sway command.",
-                names.join(" and ")
-            ),
-        ),
-        ExperimentFamily::DpSwayYaw => (
-            vec![Dof::Sway, Dof::Yaw],
-            format!(
-                "Coupled sway–yaw (SI2): drive {} with the schedules (stern and bow independent); the heading is free to change; main propellers idle.",
-                names.join(", ")
-            ),
-        ),
-        _ => (
-            vec![Dof::Sway, Dof::Yaw],
-            format!(
-                "Azimuth test (SI3): run {} alone with the schedule; all other thrusters idle.",
-                names.join(", ")
-            ),
-        ),
-    };
-    for rep in 1..=reps {
-        let seed = run_seed(ctx.spec.seed, fam, gi, 0, rep);
-        let channels =
-            thruster_channels(ctx, &groups, fam, ctx.spec.durations.dp_manoeuvre_s, seed)?;
-        out.push(assemble(
-            ctx,
-            ExperimentHead {
-                code: format!("{}-{}-r{rep}", fam.code(), ctx.speed_label(gi)),
-                family: fam,
-                grid_index: Some(gi),
-                dofs: dofs.clone(),
-                sign: None,
-                repetition: rep,
-                instruction: format!("At {}: {instruction}", fmt_speed(ctx, gi)),
-                pe_required: pe_required(fam, dofs.len()),
-                field: "excitation".into(),
-            },
-            channels,
-        )?);
-    }
-    Ok(())
-}
-
-/// Validation (thesis sec. 3.5): ≥ 300 s over the whole grid, constant and
-/// changing speeds in every DOF.
-fn validation(ctx: &Ctx<'_>, reps: u32, out: &mut Vec<PlannedExperiment>) -> Result<(), PlanError> {
-    let total = ctx.spec.durations.validation_s;
-    let n_grid = ctx.speeds.len();
-    let dofs = &ctx.vessel.dofs;
-    for rep in 1..=reps {
-        let seed = run_seed(ctx.spec.seed, ExperimentFamily::Validation, 0, 0, rep);
-        let channels = match ctx.vessel.kind {
-            VesselKind::Dp3 => {
-                let groups = dp_groups(ctx.vessel, ExperimentFamily::Validation);
-                thruster_channels(ctx, &groups, ExperimentFamily::Validation, total, seed)?
-            }
-            VesselKind::Rov6 => {
-                let t_max = dofs
-                    .iter()
-                    .map(|&d| ctx.vessel.limit(d).time_constant_s)
-                    .fold(0.0, f64::max);
-                let segment = (total / n_grid as f64).max(2.0 * SQUARE_HOLD_TIME_CONSTANTS * t_max);
-                let duration = segment * n_grid as f64;
-                let mut channels = Vec::new();
-                for (i, &d) in dofs.iter().enumerate() {
-                    let mut p = ctx.held(d, ctx.speeds[0]);
-                    p.excited = true;
-                    let mut clock = ctx.vessel.limit(d).time_constant_s;
-                    if ctx.excites_attitude(d) {
-                        let (column, unit, limit, rate, _) = ctx.excitation_channel(d);
-                        (p.column, p.unit, p.limit, p.rate_limit) = (column, unit, limit, rate);
-                        clock = ctx.excitation_time_constant(d);
-                    }
-                    if d == Dof::Surge {
-                        p.waveform = Waveform::Staircase {
-                            levels: ctx.speeds.clone(),
-                            segment_s: segment,
-                        };
-                    } else {
-                        p.amplitude = ctx.amplitude(d)?;
-                        p.offset = 0.0;
-                        p.waveform = Waveform::ConstantThenRandom {
-                            segment_s: segment,
-                            constant_fraction: 0.4,
-                            clock_period_s: clock,
-                            seed: mix(seed ^ i as u64) & MAX_SEED,
-                        };
-                    }
-                    channels.push(ChannelSpec {
-                        plan: p,
-                        duration_s: duration,
-                    });
-                }
-                channels
-            }
-        };
-        let instruction = match ctx.vessel.kind {
-            VesselKind::Rov6 => format!(
-                "Validation (never used for fitting): step the forward speed through every grid speed; in each step hold all other DOFs still for the first 40 %, then follow their changing references. Covers {:.3}–{:.3} m/s.{}",
-                ctx.speeds[0],
-                ctx.speeds[n_grid - 1],
-                attitude_note(ctx)
-            ),
-            VesselKind::Dp3 => "Validation (never used for fitting): drive all thruster groups together with independent random-binary schedules.".to_string(),
-        };
-        out.push(assemble(
-            ctx,
-            ExperimentHead {
-                code: format!("VAL-r{rep}"),
-                family: ExperimentFamily::Validation,
-                grid_index: None,
-                dofs: dofs.clone(),
-                sign: None,
-                repetition: rep,
-                instruction,
-                pe_required: 2,
-                field: "durations.validation_s".into(),
-            },
-            channels,
-        )?);
-    }
-    Ok(())
 }

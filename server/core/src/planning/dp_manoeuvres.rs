@@ -1,0 +1,233 @@
+//! Decoupled DP manoeuvres (Fossen et al. sec. 4.2): thruster groups that
+//! share a schedule, the clock from the vessel's time constants, and the
+//! SI1 → SI2 → SI3 run sheets.
+
+use super::campaign::{ExperimentFamily, SignalKind};
+use super::design::{ChannelRequest, design_channel};
+use super::dof::Dof;
+use super::error::PlanError;
+use super::plan::{
+    ChannelPlan, ChannelSpec, Ctx, ExperimentHead, PlannedExperiment, assemble, fmt_speed,
+    pe_required, run_seed,
+};
+use super::vessel::{ThrusterKind, VesselProfile};
+use super::waveform::Waveform;
+
+/// The thruster groups of a DP manoeuvre: thrusters in one group share a signal.
+pub(super) fn dp_groups(vessel: &VesselProfile, fam: ExperimentFamily) -> Vec<Vec<usize>> {
+    let thr = vessel.thrusters();
+    let of_kind =
+        |k: ThrusterKind| -> Vec<usize> { (0..thr.len()).filter(|&i| thr[i].kind == k).collect() };
+    let yaw_arm = |i: usize| -> f64 {
+        match &vessel.inputs {
+            super::vessel::InputChannels::Thrusters { configuration, .. } => vessel
+                .dofs
+                .iter()
+                .position(|d| *d == Dof::Yaw)
+                .map_or(0.0, |r| configuration[r][i]),
+            _ => 0.0,
+        }
+    };
+    let nonempty = |g: Vec<Vec<usize>>| g.into_iter().filter(|v| !v.is_empty()).collect();
+    match fam {
+        // Main propellers together: K₁ = K₂ (eq. 31).
+        ExperimentFamily::DpSurge => nonempty(vec![of_kind(ThrusterKind::Main)]),
+        // Stern and bow tunnels driven independently, so sway and yaw are both excited.
+        ExperimentFamily::DpSwayYaw => {
+            let t = of_kind(ThrusterKind::Tunnel);
+            let (stern, bow): (Vec<usize>, Vec<usize>) =
+                t.into_iter().partition(|&i| yaw_arm(i) < 0.0);
+            nonempty(vec![stern, bow])
+        }
+        ExperimentFamily::DpAzimuth => nonempty(vec![of_kind(ThrusterKind::Azimuth)]),
+        _ => nonempty(vec![
+            of_kind(ThrusterKind::Main),
+            of_kind(ThrusterKind::Tunnel),
+            of_kind(ThrusterKind::Azimuth),
+        ]),
+    }
+}
+
+/// DP time constant that sets the clock of a manoeuvre.
+fn dp_time_constant(vessel: &VesselProfile, fam: ExperimentFamily) -> f64 {
+    let t = |d: Dof| {
+        vessel
+            .limits
+            .get(&d)
+            .map_or(f64::INFINITY, |l| l.time_constant_s)
+    };
+    let v = match fam {
+        ExperimentFamily::DpSurge => t(Dof::Surge),
+        ExperimentFamily::DpSwayYaw => t(Dof::Sway).min(t(Dof::Yaw)),
+        _ => t(Dof::Yaw).min(t(Dof::Sway)),
+    };
+    if v.is_finite() {
+        v
+    } else {
+        vessel.limit(Dof::Surge).time_constant_s
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn thruster_channels(
+    ctx: &Ctx<'_>,
+    groups: &[Vec<usize>],
+    fam: ExperimentFamily,
+    min_duration: f64,
+    seed: u64,
+) -> Result<Vec<ChannelSpec>, PlanError> {
+    let thr = ctx.vessel.thrusters();
+    let t = dp_time_constant(ctx.vessel, fam);
+    let mut specs: Vec<Option<ChannelSpec>> = (0..thr.len()).map(|_| None).collect();
+    for (gi, group) in groups.iter().enumerate() {
+        // The group's amplitude and rate are set by its weakest thruster.
+        let max_cmd = group
+            .iter()
+            .map(|&i| thr[i].max_command)
+            .fold(f64::INFINITY, f64::min);
+        let rate = group
+            .iter()
+            .map(|&i| thr[i].max_rate)
+            .fold(f64::INFINITY, f64::min);
+        let amplitude = ctx.spec.excitation.amplitude_fraction * max_cmd;
+        let field = format!("inputs.thrusters[{}]", group[0]);
+        let design = design_channel(&ChannelRequest {
+            field: "excitation",
+            signal: if fam == ExperimentFamily::Validation {
+                SignalKind::RandomBinary
+            } else {
+                ctx.spec.excitation.signal
+            },
+            time_constant_s: t,
+            amplitude,
+            rate_limit: Some(rate),
+            rate_field: &format!("{field}.max_rate"),
+            clock_period_s: None,
+            prbs_order: None,
+            min_duration_s: min_duration,
+            logger_rate_hz: ctx.vessel.logger_rate_hz,
+            seed,
+            channel: (gi, groups.len()),
+        })?;
+        for &i in group {
+            specs[i] = Some(ChannelSpec {
+                plan: ChannelPlan {
+                    column: format!("thr_{}", i + 1),
+                    unit: "1".into(),
+                    dof: None,
+                    thruster: Some(i),
+                    excited: true,
+                    waveform: design.waveform.clone(),
+                    offset: 0.0,
+                    amplitude,
+                    limit: thr[i].max_command,
+                    rate_limit: Some(thr[i].max_rate),
+                    analysis: None,
+                },
+                duration_s: design.duration_s,
+            });
+        }
+    }
+    let duration = specs
+        .iter()
+        .flatten()
+        .map(|s| s.duration_s)
+        .fold(0.0, f64::max);
+    Ok(specs
+        .into_iter()
+        .enumerate()
+        .map(|(i, s)| {
+            s.unwrap_or_else(|| ChannelSpec {
+                plan: ChannelPlan {
+                    column: format!("thr_{}", i + 1),
+                    unit: "1".into(),
+                    dof: None,
+                    thruster: Some(i),
+                    excited: false,
+                    waveform: Waveform::Constant,
+                    offset: 0.0,
+                    amplitude: 0.0,
+                    limit: thr[i].max_command,
+                    rate_limit: Some(thr[i].max_rate),
+                    analysis: None,
+                },
+                duration_s: duration,
+            })
+        })
+        .collect())
+}
+
+/// Decoupled DP manoeuvres (Fossen et al. sec. 4.2), N ≥ 2 each.
+pub(super) fn dp_manoeuvre(
+    ctx: &Ctx<'_>,
+    fam: ExperimentFamily,
+    gi: usize,
+    reps: u32,
+    out: &mut Vec<PlannedExperiment>,
+) -> Result<(), PlanError> {
+    let groups = dp_groups(ctx.vessel, fam);
+    let thr = ctx.vessel.thrusters();
+    if groups.is_empty() {
+        let kind = match fam {
+            ExperimentFamily::DpSurge => "main propeller",
+            ExperimentFamily::DpSwayYaw => "tunnel thruster",
+            _ => "azimuth thruster",
+        };
+        return Err(PlanError::invalid(
+            "families",
+            format!(
+                "'{}' needs at least one {kind}; the vessel has none",
+                fam.name()
+            ),
+        ));
+    }
+    let names: Vec<&str> = groups
+        .iter()
+        .flatten()
+        .map(|&i| thr[i].name.as_str())
+        .collect();
+    let (dofs, instruction) = match fam {
+        ExperimentFamily::DpSurge => (
+            vec![Dof::Surge],
+            format!(
+                "Uncoupled surge (SI1): drive {} with the schedule; hold heading with a bow thruster on the heading autopilot; no sway command.",
+                names.join(" and ")
+            ),
+        ),
+        ExperimentFamily::DpSwayYaw => (
+            vec![Dof::Sway, Dof::Yaw],
+            format!(
+                "Coupled sway–yaw (SI2): drive {} with the schedules (stern and bow independent); the heading is free to change; main propellers idle.",
+                names.join(", ")
+            ),
+        ),
+        _ => (
+            vec![Dof::Sway, Dof::Yaw],
+            format!(
+                "Azimuth test (SI3): run {} alone with the schedule; all other thrusters idle.",
+                names.join(", ")
+            ),
+        ),
+    };
+    for rep in 1..=reps {
+        let seed = run_seed(ctx.spec.seed, fam, gi, 0, rep);
+        let channels =
+            thruster_channels(ctx, &groups, fam, ctx.spec.durations.dp_manoeuvre_s, seed)?;
+        out.push(assemble(
+            ctx,
+            ExperimentHead {
+                code: format!("{}-{}-r{rep}", fam.code(), ctx.speed_label(gi)),
+                family: fam,
+                grid_index: Some(gi),
+                dofs: dofs.clone(),
+                sign: None,
+                repetition: rep,
+                instruction: format!("At {}: {instruction}", fmt_speed(ctx, gi)),
+                pe_required: pe_required(fam, dofs.len()),
+                field: "excitation".into(),
+            },
+            channels,
+        )?);
+    }
+    Ok(())
+}
