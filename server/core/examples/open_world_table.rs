@@ -2,11 +2,13 @@
 //! the λ-filter identification's parameter errors in σ and its validation
 //! fits against the true model and an affine least-squares baseline.
 //!
-//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--noise-free] [--controller-hz 20] [--projected-m] [--quadratic-damping] [--held-above]`
+//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--noise-free] [--zero-noise vl,va,rp,pos] [--controller-hz 20] [--projected-m] [--quadratic-damping] [--held-above]`
 //!
 //! `--in-grid` flies the validation staircase at speeds inside the grid
 //! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it;
-//! `--noise-free` flies without measurement noise; `--controller-hz` tells the identification the controller's rate (the
+//! `--noise-free` flies without measurement noise, `--zero-noise` without
+//! the listed part of it (linear velocities, angular rates, roll and pitch,
+//! positions with depth and heading); `--controller-hz` tells the identification the controller's rate (the
 //! truth's loop runs at 20 Hz, logged at 10 Hz); `--projected-m` fits M's
 //! rows freely and stores the nearest symmetric M (`symmetric_inertia:
 //! false`); `--quadratic-damping` estimates quadratic damping
@@ -46,6 +48,12 @@ fn main() {
             above = false;
         } else if a == "--noise-free" {
             spec.noise = seatrial_truth::NoiseSpec::none();
+        } else if a == "--zero-noise" {
+            for part in it.next().map(String::as_str).unwrap_or("").split(',') {
+                for noise in [&mut spec.noise, &mut spec.nav_noise] {
+                    zero_noise(noise, part);
+                }
+            }
         } else if a == "--in-grid" {
             spec.validation_speeds = Some(vec![0.5, 0.75, 1.25, 1.75, 2.0]);
         } else if let Ok(s) = a.parse::<u64>() {
@@ -104,5 +112,17 @@ fn main() {
         for s in r.findings.iter().chain(&r.notes) {
             println!("  - {s}");
         }
+    }
+}
+
+/// `noise` without one part: `vl` linear velocities, `va` angular rates,
+/// `rp` roll and pitch, `pos` positions, depth and heading.
+fn zero_noise(noise: &mut seatrial_truth::NoiseSpec, part: &str) {
+    match part {
+        "vl" => noise.velocity_linear = 0.0,
+        "va" => noise.velocity_angular = 0.0,
+        "rp" => noise.roll_pitch = 0.0,
+        "pos" => (noise.position_xy, noise.depth, noise.heading) = (0.0, 0.0, 0.0),
+        other => panic!("--zero-noise: unknown part '{other}' (vl, va, rp, pos)"),
     }
 }
