@@ -221,16 +221,15 @@ pub(crate) fn widen(
     if rows <= n + 1 {
         return;
     }
-    let x = DMatrix::from_fn(rows, n + 1, |k, c| {
-        let mut k = k;
-        for e in exps {
-            if k < e.nu.nrows() {
-                return if c < n { e.nu[(k, c)] } else { 1.0 };
-            }
-            k -= e.nu.nrows();
-        }
-        0.0
-    });
+    // [ν, 1] of every run, stacked.
+    let mut x = DMatrix::from_element(rows, n + 1, 1.0);
+    let mut start = 0;
+    for e in exps {
+        let k = e.nu.nrows();
+        x.view_mut((start, 0), (k, n))
+            .copy_from(&e.nu.columns(0, n));
+        start += k;
+    }
     let svd = x.clone().svd(true, true);
     let m_inv = est.m.clone().try_inverse();
     let constant = est

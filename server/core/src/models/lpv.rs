@@ -186,15 +186,7 @@ impl LpvModel {
                 reason: "the second-order Coriolis force is taken about the forward speed: surge must be modelled".into(),
             });
         }
-        if m.len() != self.points.len() {
-            return Err(ModelError::Grid {
-                reason: format!(
-                    "one M per grid point is needed for the Coriolis force: got {} for {} points",
-                    m.len(),
-                    self.points.len()
-                ),
-            });
-        }
+        self.one_per_point(m.len(), "M", "the Coriolis force")?;
         let n = self.dofs().len();
         for (k, mk) in m.iter().enumerate() {
             if mk.shape() != (n, n) {
@@ -208,6 +200,19 @@ impl LpvModel {
         }
         self.coriolis = Some(m);
         Ok(self)
+    }
+
+    /// `Err` unless `got` (matrices `what` for `purpose`) is one per grid point.
+    fn one_per_point(&self, got: usize, what: &str, purpose: &str) -> Result<(), ModelError> {
+        if got == self.points.len() {
+            return Ok(());
+        }
+        Err(ModelError::Grid {
+            reason: format!(
+                "one {what} per grid point is needed for {purpose}: got {got} for {} points",
+                self.points.len()
+            ),
+        })
     }
 
     /// The same model without the second-order Coriolis force.
@@ -234,15 +239,7 @@ impl LpvModel {
     /// [`ModelError::Shape`] for a wrong length; an invalid-parameter error
     /// for a negative or non-finite entry (D_q must dissipate).
     pub fn with_quadratic_damping(mut self, d_q: Vec<DVector<f64>>) -> Result<Self, ModelError> {
-        if d_q.len() != self.points.len() {
-            return Err(ModelError::Grid {
-                reason: format!(
-                    "one D_q per grid point is needed for the quadratic damping: got {} for {} points",
-                    d_q.len(),
-                    self.points.len()
-                ),
-            });
-        }
+        self.one_per_point(d_q.len(), "D_q", "the quadratic damping")?;
         let n = self.dofs().len();
         for (k, d) in d_q.iter().enumerate() {
             if d.len() != n {
