@@ -3,8 +3,9 @@
 //! γ = τ − g(η) and g(η) estimated jointly from the runs themselves;
 //! physical structure enforced; validated on the held-out runs.
 
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
+use super::attitude_fusion::attitude_noise_std;
 use super::dataset::Segment;
 use super::dataset::{RunInput, segments};
 use super::document::{
@@ -13,7 +14,9 @@ use super::document::{
 };
 use super::error::IdentifyError;
 use super::intersample::{correct_estimates, inertia_offset, logged_equivalent, logged_gains};
-use super::joint_restoring::{Functions, PooledRestoring, load, specification};
+use super::joint_restoring::{
+    COS_THETA_SIN_PHI, Functions, PooledRestoring, SIN_THETA, load, specification,
+};
 use super::lambda_consistency::{inflate_inertia_std, symmetry_note};
 use super::lambda_coriolis::{fit_points, pooled_inertia};
 use super::lambda_data::{experiment, per_point, regression_columns, static_holds};
@@ -25,10 +28,13 @@ use super::lambda_structure::choose_structure;
 use super::lambda_validation::{HeldOut, choose_second_order};
 use super::outcome::Identified;
 use super::roles::assign_roles;
-use crate::estimation::lambda::{Experiment, LambdaEstimate, LambdaSettings, MIN_T_OVER_H, Prior};
+use crate::estimation::lambda::{
+    Experiment, LambdaEstimate, LambdaSettings, MIN_T_OVER_H, Prior, RegressorNoise,
+};
 use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
 use crate::estimation::{Progress, SubProgress};
 use crate::models::{LinearVesselModel, LpvModel, Scheduling};
+use crate::numbers::sig3;
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
 use crate::validation::ValidationSettings;
@@ -203,6 +209,21 @@ pub fn identify_lambda_campaign(
         .and_then(|g| g.as_ref())
         .map(|(g, c)| inertia_offset(g, *c));
 
+    // The attitude's noise, which g(η) of the measured attitude carries
+    // into the regressors (discounted: bias-compensated least squares).
+    let attitude_std = if with_restoring {
+        attitude_noise_std(&logged)
+    } else {
+        None
+    };
+    if let Some([sp, st]) = attitude_std {
+        notes.push(format!(
+            "the measured attitude carries noise of {} mrad in roll and {} mrad in pitch (from each sample against its neighbours and the rates); g(η) of it is a force the vehicle never felt, and the sub-models' regression discounts its variance (bias-compensated least squares; the joint fit for g(η) too, unless D_q is fitted with it), which would otherwise shrink the input gains and inflate M",
+            sig3(1e3 * sp),
+            sig3(1e3 * st)
+        ));
+    }
+
     let second_order = settings.coriolis_second_order && dofs.contains(&Dof::Surge);
     let quad_cols = if settings.quadratic_damping {
         lambda_quadratic::columns(&dofs)
@@ -241,6 +262,18 @@ pub fn identify_lambda_campaign(
             &dofs,
             &quad_cols,
         );
+        // Not with D_q's columns: a barely moved roll's D_q takes up the
+        // restoring shapes' shift (vessel 2 of the independent truth: roll
+        // D_q 32.7 ± 6.1 against 8.8 N·m·s²/rad²).
+        lambda_settings.regressor_noise =
+            attitude_std
+                .filter(|_| quad_cols.is_empty())
+                .and_then(|sd| {
+                    lambda_settings
+                        .exogenous
+                        .as_ref()
+                        .map(|x| attitude_shape_noise(n, &x.names, sd))
+                });
         let mut sub = SubProgress::new(progress, 0.05, 0.4);
         fit_points(
             &points_of(with_quadratic(build(None, joint_functions)?)),
@@ -274,6 +307,18 @@ pub fn identify_lambda_campaign(
 
     // 2. The sub-models with g(η) and D_q fixed at the pooled values.
     lambda_settings.exogenous = loads.map(|f| specification(profile, &dofs, f));
+    lambda_settings.regressor_noise = match (g, attitude_std) {
+        (Some(g), Some(sd)) => Some(restoring_noise(
+            n,
+            lambda_settings
+                .exogenous
+                .as_ref()
+                .map_or(0, |x| x.names.len()),
+            g,
+            sd,
+        )),
+        _ => None,
+    };
     let exps: Vec<Vec<Experiment>> = build(g, loads)?
         .into_iter()
         .map(|point| {
@@ -551,6 +596,51 @@ pub fn identify_lambda_campaign(
 }
 
 /// The constant load b and its std of an estimate (zero without loads).
+/// The errors of the restoring shapes [1, sin θ, cos θ sin φ] among the
+/// exogenous columns `names` (after 2n columns of ν and γ): e_θ and e_φ of
+/// std `sd` = [σ_φ, σ_θ], held over each step.
+fn attitude_shape_noise(n: usize, names: &[String], sd: [f64; 2]) -> RegressorNoise {
+    let p = 2 * n + names.len();
+    let mut cov = DMatrix::zeros(p, p);
+    for (j, name) in names.iter().enumerate() {
+        let var = match name.as_str() {
+            COS_THETA_SIN_PHI => sd[0] * sd[0],
+            SIN_THETA => sd[1] * sd[1],
+            _ => 0.0,
+        };
+        cov[(2 * n + j, 2 * n + j)] = var;
+    }
+    RegressorNoise::held_over_step(cov)
+}
+
+/// The errors of γ = τ − g(η) (six DOFs, in [`Dof::ALL`] order) from the
+/// attitude noise `sd` = [σ_φ, σ_θ] through g's slopes at level attitude:
+/// ∂g/∂φ = (0, −(W−B), 0, z_G W − z_B B, 0, 0), ∂g/∂θ = (W−B, 0, 0, 0,
+/// z_G W − z_B B, 0); held over each step. q exogenous columns follow.
+fn restoring_noise(n: usize, q: usize, g: &RestoringParams, sd: [f64; 2]) -> RegressorNoise {
+    let p = 2 * n + q;
+    let mut cov = DMatrix::zeros(p, p);
+    if n == 6 {
+        let (wb, bg) = (g.weight_minus_buoyancy_n, g.zg_weight_minus_zb_buoyancy_nm);
+        let slopes = [
+            (
+                DVector::from_column_slice(&[0.0, -wb, 0.0, bg, 0.0, 0.0]),
+                sd[0],
+            ),
+            (
+                DVector::from_column_slice(&[wb, 0.0, 0.0, 0.0, bg, 0.0]),
+                sd[1],
+            ),
+        ];
+        for (j, s) in slopes {
+            let block = &j * j.transpose() * (s * s);
+            let mut view = cov.view_mut((n, n), (n, n));
+            view += block;
+        }
+    }
+    RegressorNoise::held_over_step(cov)
+}
+
 fn joint_load(est: &LambdaEstimate, n: usize) -> (DVector<f64>, DVector<f64>) {
     load(est).unwrap_or_else(|| (DVector::zeros(n), DVector::zeros(n)))
 }

@@ -24,6 +24,7 @@
 //!   predictor state.
 //! - [`outcome`], [`error`]: what an identification returns.
 
+mod attitude_fusion;
 pub mod attitude_loop;
 pub mod augmented;
 pub mod bis;

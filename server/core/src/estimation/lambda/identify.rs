@@ -6,6 +6,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::error::{LambdaError, require_finite_matrix};
+use super::errors_in_variables::{compensate, expected_excess};
 use super::estimate::{LambdaEstimate, UncertaintyMethod};
 use super::experiment::{Experiment, validate_runs};
 use super::filter::LambdaFilter;
@@ -204,6 +205,21 @@ pub fn identify_with_progress(
         let reg = RunRegressors::new(run, &f, settings.filter_init);
         stats.add(&reg, settings.estimate_transient);
         filtered.push(reg);
+    }
+    if let Some(noise) = settings.regressor_noise.as_ref().filter(|_| !kf) {
+        let p_all = noise.lag0.nrows();
+        if p_all != p || noise.lag0.ncols() != p || noise.lag1.shape() != (p, p) {
+            return Err(LambdaError::invalid(
+                "settings.regressor_noise",
+                format!(
+                    "must be {p} × {p} (2n + q), got {p_all} × {}",
+                    noise.lag0.ncols()
+                ),
+            ));
+        }
+        let lengths: Vec<usize> = runs.iter().map(|r| r.nu.nrows()).collect();
+        let excess = expected_excess(noise, &f, &lengths, settings.filter_init);
+        compensate(&mut stats, &excess);
     }
     let lag = (LAG_IN_T * settings.t_lambda / h).ceil() as usize;
     let free: Vec<Vec<usize>> = (0..n)

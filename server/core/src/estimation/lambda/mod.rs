@@ -18,6 +18,7 @@
 
 mod coupling;
 mod error;
+mod errors_in_variables;
 mod estimate;
 mod experiment;
 pub mod filter;
@@ -43,6 +44,7 @@ pub use coupling::{
     BAND_FRACTION, CouplingProposal, MIN_COHERENCE_SAMPLES, PairEvidence, propose_coupling,
 };
 pub use error::LambdaError;
+pub use errors_in_variables::RegressorNoise;
 pub use estimate::{LambdaEstimate, UncertaintyMethod};
 pub use experiment::Experiment;
 pub use filter::{FilterInit, LambdaFilter};

@@ -2,6 +2,7 @@
 
 use nalgebra::DMatrix;
 
+use super::errors_in_variables::RegressorNoise;
 use super::filter::FilterInit;
 use super::structure::Structure;
 use super::transform::Inversion;
@@ -114,6 +115,11 @@ pub struct LambdaSettings {
     /// a fit to logged commands that miss a faster controller's c·K_ν ν̇
     /// returns M − c K_ν (see `identification::intersample`).
     pub inertia_offset: Option<DMatrix<f64>>,
+    /// Covariance of the errors in the regressor signals [ν, γ, e], taken
+    /// out of the Gram matrix (bias-compensated least squares, see
+    /// `errors_in_variables`; the constant-parameter path only). `None`:
+    /// the regressors are taken as exact.
+    pub regressor_noise: Option<RegressorNoise>,
 }
 
 impl LambdaSettings {
@@ -135,6 +141,7 @@ impl LambdaSettings {
             exogenous: None,
             symmetric_inertia: false,
             inertia_offset: None,
+            regressor_noise: None,
         }
     }
 }

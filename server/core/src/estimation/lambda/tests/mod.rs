@@ -3,6 +3,7 @@
 mod analytic;
 mod calibration;
 mod errors;
+mod errors_in_variables;
 mod exogenous;
 mod multi;
 mod rov;
