@@ -84,17 +84,35 @@ pub(crate) fn specification(
     })
 }
 
-/// `exp` with the columns |ν_i|ν_i (i in `cols`) appended, held over each
-/// step like γ as the model applies the force (linearly implicit,
-/// [`crate::models::LpvModel`]): row k is |ν_i(k)|ν_i(k+1) (the last row
-/// |ν_i|ν_i).
+/// ν_i at the middle of step k extrapolated from samples k and k−1,
+/// 1.5 ν_i(k) − 0.5 ν_i(k−1) (ν_i(0) at the first): second-order like the
+/// model's |δ(k)|δ(k+1), without ν(k+1).
+fn midstep(nu: &DMatrix<f64>, k: usize, i: usize) -> f64 {
+    if k == 0 {
+        nu[(0, i)]
+    } else {
+        1.5 * nu[(k, i)] - 0.5 * nu[(k - 1, i)]
+    }
+}
+
+/// `exp` with the columns |ν_i|ν_i (i in `cols`) appended, over step k
+/// |ν_i(k)|·ν_i(k+½) with ν_i(k+½) extrapolated from samples k and k−1
+/// ([`midstep`]). The model applies the force linearly implicit,
+/// |δ(k)|δ(k+1) ([`crate::models::LpvModel`], stable at any D_q), but as a
+/// regressor that column carries ν(k+1): filtered, row k holds
+/// |ν(k−1)|ν(k), whose noise is the regressand's own, and least squares
+/// pulls D_q toward it (independent truth, 5 mm/s of velocity noise:
+/// vessel 10 sway 104 ± 17 against 169 N·s²/m², σ not covering it on 2 of
+/// 12 vessels; extrapolated, 135 ± 16 and ≥ 97 % within ±3σ on all 12).
+/// |ν(k)|ν(k) alone lags the force by half a step: m came out 4 % high on
+/// a strongly quadratic hull (unit test below).
 pub(crate) fn append(exp: Experiment, cols: &[usize]) -> Experiment {
     if cols.is_empty() {
         return exp;
     }
     let rows = exp.nu.nrows();
     let q0 = exp.exogenous.ncols();
-    let f = |k: usize, i: usize| exp.nu[(k, i)].abs() * exp.nu[((k + 1).min(rows - 1), i)];
+    let f = |k: usize, i: usize| exp.nu[(k, i)].abs() * midstep(&exp.nu, k, i);
     let e = DMatrix::from_fn(rows, q0 + cols.len(), |k, j| {
         if j < q0 {
             exp.exogenous[(k, j)]
@@ -190,14 +208,13 @@ pub(crate) fn pool(
 }
 
 /// `exp` with the known D_q|δ|δ moved to the force side, γ' = γ − F, F
-/// over step k as the model applies it: D_q,i |δ_i(k)| δ_i(k+1).
+/// over step k as it was estimated ([`append`]): D_q,i |δ_i(k)| δ_i(k+½).
 pub(crate) fn subtract(exp: Experiment, d_q: &DVector<f64>, surge: Option<usize>) -> Experiment {
     let rows = exp.nu.nrows();
     let mut gamma = exp.gamma.clone();
     for k in 0..rows {
-        let next = (k + 1).min(rows - 1);
         for i in (0..gamma.ncols().min(d_q.len())).filter(|&i| Some(i) != surge) {
-            gamma[(k, i)] -= d_q[i] * exp.nu[(k, i)].abs() * exp.nu[(next, i)];
+            gamma[(k, i)] -= d_q[i] * exp.nu[(k, i)].abs() * midstep(&exp.nu, k, i);
         }
     }
     Experiment { gamma, ..exp }
@@ -286,9 +303,10 @@ mod tests {
             exogenous: DMatrix::zeros(2, 0),
         };
         let e = append(exp, &cols).exogenous;
-        // |v(0)| v(1) = 0.2 · 0.2; |r(0)| r(1) = 0.4 · 0; the last row its own
-        assert!((e[(0, 0)] - 0.04).abs() < 1e-12 && e[(0, 1)].abs() < 1e-12);
-        assert!((e[(1, 0)] - 0.04).abs() < 1e-12 && e[(1, 1)].abs() < 1e-12);
+        // |v(k)| times v extrapolated to mid-step: row 0 its own sample,
+        // |v(0)| v(0) = −0.04, |r(0)| r(0) = 0.16; row 1 0.2·(0.3 + 0.1), 0
+        assert!((e[(0, 0)] + 0.04).abs() < 1e-12 && (e[(0, 1)] - 0.16).abs() < 1e-12);
+        assert!((e[(1, 0)] - 0.08).abs() < 1e-12 && e[(1, 1)].abs() < 1e-12);
     }
 
     /// Sway of m v̇ + d v + q|v|v = τ flown with square waves of three
