@@ -595,7 +595,6 @@ pub fn identify_lambda_campaign(
     })
 }
 
-/// The constant load b and its std of an estimate (zero without loads).
 /// The errors of the restoring shapes [1, sin θ, cos θ sin φ] among the
 /// exogenous columns `names` (after 2n columns of ν and γ): e_θ and e_φ of
 /// std `sd` = [σ_φ, σ_θ], held over each step.
@@ -641,6 +640,7 @@ fn restoring_noise(n: usize, q: usize, g: &RestoringParams, sd: [f64; 2]) -> Reg
     RegressorNoise::held_over_step(cov)
 }
 
+/// The constant load b and its std of an estimate (zero without loads).
 fn joint_load(est: &LambdaEstimate, n: usize) -> (DVector<f64>, DVector<f64>) {
     load(est).unwrap_or_else(|| (DVector::zeros(n), DVector::zeros(n)))
 }
