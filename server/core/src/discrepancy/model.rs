@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::candidates::{Effect, ShapeKind, TermContext};
 use super::data::{Baseline, Record, Restoring};
 use super::svf::lag_zoh;
+use crate::identification::attitude_loop::euler_rates;
 use crate::planning::Dof;
 use crate::simulation::integrate::rk4_step;
 use crate::validation::{Predictor, ValidationRecord};
@@ -346,11 +347,9 @@ impl AugmentedModel {
             if att {
                 eta[3] = x[a0];
                 eta[4] = x[a0 + 1];
-                let (phi, theta) = (x[a0], x[a0 + 1]);
-                let (p, q, r) = (x[3], x[4], x[5]);
-                let (sp, cp) = phi.sin_cos();
-                dx[a0] = p + (q * sp + r * cp) * theta.tan();
-                dx[a0 + 1] = q * cp - r * sp;
+                let (phi_dot, theta_dot) = euler_rates(x[a0], x[a0 + 1], x[3], x[4], x[5]);
+                dx[a0] = phi_dot;
+                dx[a0 + 1] = theta_dot;
             }
             let mut tau_a = u.to_vec();
             for (s, &i) in lag_dofs.iter().enumerate() {

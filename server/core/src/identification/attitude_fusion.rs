@@ -15,6 +15,7 @@
 
 use nalgebra::DMatrix;
 
+use super::attitude_loop::euler_rates;
 use super::dataset::Segment;
 use crate::timeseries::median;
 
@@ -23,14 +24,8 @@ use crate::timeseries::median;
 /// noises for an INS-grade 2 mrad and 2 mrad/s).
 pub(crate) const CROSSOVER_S: f64 = 1.0;
 
-/// (φ̇, θ̇) at attitude (φ, θ) and rates (p, q, r).
-fn euler_rates(phi: f64, theta: f64, p: f64, q: f64, r: f64) -> (f64, f64) {
-    let (sp, cp) = phi.sin_cos();
-    ((p + (q * sp + r * cp) * theta.tan()), q * cp - r * sp)
-}
-
-/// One-step predictions of (φ, θ) at every sample from the filter run in
-/// the direction `dir` (+1 forward, −1 backward): the filtered attitude one
+/// One-step predictions of (φ, θ) at every sample from the filter run
+/// forward in time (`forward`) or backward: the filtered attitude one
 /// sample before, moved over the step by the rates' trapezoid mean. The
 /// first sample in that direction is its own measurement.
 fn predictions(eta: &DMatrix<f64>, nu: &DMatrix<f64>, h: f64, forward: bool) -> DMatrix<f64> {

@@ -105,7 +105,12 @@ impl AttitudeLoop {
 
 /// (φ̇, θ̇) from ν = [u v w p q r] (Fossen 2011, eq. 2.29).
 fn attitude_rate((phi, theta): Attitude, nu: &DVector<f64>) -> Attitude {
-    let (p, q, r) = (nu[3], nu[4], nu[5]);
+    euler_rates(phi, theta, nu[3], nu[4], nu[5])
+}
+
+/// (φ̇, θ̇) at attitude (φ, θ) and body rates (p, q, r) (Fossen 2011,
+/// eq. 2.29): φ̇ = p + (q sin φ + r cos φ) tan θ, θ̇ = q cos φ − r sin φ.
+pub(crate) fn euler_rates(phi: f64, theta: f64, p: f64, q: f64, r: f64) -> (f64, f64) {
     let (s, c) = phi.sin_cos();
     (p + (q * s + r * c) * theta.tan(), q * c - r * s)
 }
