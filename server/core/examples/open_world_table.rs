@@ -2,10 +2,11 @@
 //! the λ-filter identification's parameter errors in σ and its validation
 //! fits against the true model and an affine least-squares baseline.
 //!
-//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--noise-free] [--zero-noise vl,va,rp,pos] [--controller-hz 20] [--projected-m] [--quadratic-damping] [--held-above]`
+//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--validation-speeds 0.3,0.75] [--noise-free] [--zero-noise vl,va,rp,pos] [--controller-hz 20] [--projected-m] [--quadratic-damping] [--held-above]`
 //!
 //! `--in-grid` flies the validation staircase at speeds inside the grid
-//! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it;
+//! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it,
+//! `--validation-speeds` at the listed ones (m/s);
 //! `--noise-free` flies without measurement noise, `--zero-noise` without
 //! the listed part of it (linear velocities, angular rates, roll and pitch,
 //! positions with depth and heading); `--controller-hz` tells the identification the controller's rate (the
@@ -54,6 +55,10 @@ fn main() {
                     zero_noise(noise, part);
                 }
             }
+        } else if a == "--validation-speeds" {
+            spec.validation_speeds = it
+                .next()
+                .map(|v| v.split(',').filter_map(|x| x.parse::<f64>().ok()).collect());
         } else if a == "--in-grid" {
             spec.validation_speeds = Some(vec![0.5, 0.75, 1.25, 1.75, 2.0]);
         } else if let Ok(s) = a.parse::<u64>() {

@@ -86,15 +86,19 @@ pub fn effective_linearization(vessel: &Vessel, runs: &[&Run]) -> Linearization 
 }
 
 /// The statistical linearization of a model that carries diagonal
-/// quadratic damping `d_q` (surge entry unused): least squares of
-/// f(ν) − D_q|δ|δ on [ν, 1] over `runs` as [`effective_linearization`],
-/// δ = ν except u (whose quadratic damping is the forward-speed
-/// schedule's). Grade the D̄ of M ν̇ + D̄ν + D_q|δ|δ + b = γ with the
-/// truth's own D_q against this.
+/// quadratic damping `d_q` for a sub-model at forward speed `u0` (m/s):
+/// least squares of f(ν) − q(ν) on [ν, 1] over `runs` as
+/// [`effective_linearization`], q_i = d_q,i |ν_i|ν_i in sway … yaw and in
+/// surge d_q,0 times the part of |u|u beyond its tangent at u₀,
+/// |u|u − |u₀|u₀ − 2|u₀|(u − u₀) (the tangent is the sub-model's). Grade
+/// the D̄ and load of M ν̇ + D̄ν + q(ν) + b = γ with the truth's own
+/// quadratic coefficients against this (surge's is D_lu,0 + D_q,0: the
+/// speed-dependent linear damping D_lu|u| is quadratic in surge).
 pub fn effective_linearization_given_quadratic(
     vessel: &Vessel,
     runs: &[&Run],
     d_q: &Vector6<f64>,
+    u0: f64,
 ) -> Linearization {
     let nus = stacked(runs);
     fit_affine_of(vessel, &nus, |nu| {
@@ -102,6 +106,8 @@ pub fn effective_linearization_given_quadratic(
         for i in 1..6 {
             f[i] -= d_q[i] * nu[i].abs() * nu[i];
         }
+        let u = nu[0];
+        f[0] -= d_q[0] * (u.abs() * u - u0.abs() * u0 - 2.0 * u0.abs() * (u - u0));
         f
     })
 }

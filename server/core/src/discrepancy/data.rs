@@ -1,11 +1,12 @@
 //! What discovery works on: the baseline M ν̇ + D̄ ν = γ with γ = τ − g(η)
 //! (thesis eq. 2.7–2.9), and recorded runs on a uniform grid.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use super::error::DiscoveryError;
 use crate::models::LinearVesselModel;
+use crate::models::quadratic_damping::QuadraticDamping;
 use crate::planning::Dof;
 
 /// Restoring forces and moments g(η) of the baseline (thesis eq. 1.6):
@@ -60,9 +61,10 @@ pub struct Baseline {
     /// C(δ)δ the baseline carries (see
     /// [`crate::models::coriolis::second_order_force`]); `None`: linear.
     pub coriolis: Option<DMatrix<f64>>,
-    /// Diagonal quadratic damping D_q of D_q|δ|δ the baseline carries (see
+    /// Diagonal quadratic damping D_q of D_q|δ|δ the baseline carries, with
+    /// the speed its sub-model is linearized at (see
     /// [`crate::models::quadratic_damping`]); `None`: linear damping.
-    pub quadratic: Option<DVector<f64>>,
+    pub quadratic: Option<QuadraticDamping>,
 }
 
 impl Baseline {
@@ -89,8 +91,7 @@ impl Baseline {
             f.iter_mut().zip(r).for_each(|(a, b)| *a += b);
         }
         if let Some(d) = &self.quadratic {
-            let q =
-                crate::models::quadratic_damping::quadratic_force(d, nu, self.index_of(Dof::Surge));
+            let q = d.force(nu, self.index_of(Dof::Surge));
             f.iter_mut().zip(q).for_each(|(a, b)| *a += b);
         }
         f

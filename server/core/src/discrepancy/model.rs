@@ -12,6 +12,7 @@ use super::candidates::{Effect, ShapeKind, TermContext};
 use super::data::{Baseline, Record, Restoring};
 use super::svf::lag_zoh;
 use crate::identification::attitude_loop::euler_rates;
+use crate::models::quadratic_damping::QuadraticDamping;
 use crate::planning::Dof;
 use crate::simulation::integrate::rk4_step;
 use crate::validation::{Predictor, ValidationRecord};
@@ -66,7 +67,7 @@ pub struct AugmentedModel {
     /// The vehicle's M of the baseline's C(δ)δ, if it carries one.
     pub coriolis: Option<DMatrix<f64>>,
     /// D_q of the baseline's D_q|δ|δ, if it carries one.
-    pub quadratic: Option<nalgebra::DVector<f64>>,
+    pub quadratic: Option<QuadraticDamping>,
     m_inv: DMatrix<f64>,
     /// ‖M⁻¹D̄‖∞ (1/s), a bound on the fastest linear mode: a step of h is
     /// split so that h·rate ≤ 2, inside RK4's stability interval (−2.78, 0].
@@ -163,7 +164,7 @@ impl AugmentedModel {
 
     /// The same model carrying the quadratic damping D_q|δ|δ of `d_q`
     /// (`None`: without it).
-    pub fn with_quadratic(mut self, d_q: Option<nalgebra::DVector<f64>>) -> Self {
+    pub fn with_quadratic(mut self, d_q: Option<QuadraticDamping>) -> Self {
         self.quadratic = d_q;
         self
     }
@@ -261,7 +262,7 @@ impl AugmentedModel {
         }
         if let Some(d) = &self.quadratic {
             let surge = self.dofs.iter().position(|d| *d == Dof::Surge);
-            let q = crate::models::quadratic_damping::quadratic_force(d, &nu[..n], surge);
+            let q = d.force(&nu[..n], surge);
             for i in 0..n {
                 f[i] -= q[i];
             }
@@ -394,7 +395,7 @@ impl AugmentedModel {
                     .map(|j| {
                         self.m_inv[(i, j)].abs()
                             * 2.0
-                            * d.get(j).copied().unwrap_or(0.0)
+                            * d.d_q.get(j).copied().unwrap_or(0.0)
                             * nu.get(j).map_or(0.0, |v| v.abs())
                     })
                     .sum::<f64>()
@@ -633,7 +634,10 @@ mod tests {
             d_bar: DMatrix::from_element(1, 1, d),
             restoring: Restoring::default(),
             coriolis: None,
-            quadratic: Some(DVector::from_element(1, q)),
+            quadratic: Some(QuadraticDamping {
+                d_q: DVector::from_element(1, q),
+                u0: 0.0,
+            }),
         };
         let exact = |t: f64| d / ((d / v0 + q) * (t * d / m).exp() - q);
         let rec = Record {

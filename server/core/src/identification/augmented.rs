@@ -11,6 +11,7 @@ use super::intersample::logged_equivalent;
 use super::lambda_coriolis::document_inertia;
 use crate::discrepancy::model::{Drive, State, free_run, k_step};
 use crate::discrepancy::{AugmentedModel, Baseline, Record, Restoring};
+use crate::models::quadratic_damping::QuadraticDamping;
 use crate::models::{LpvModel, Scheduling};
 use crate::planning::dof::Dof;
 use crate::validation::{Predictor, ValidationRecord};
@@ -81,7 +82,10 @@ pub fn baseline_at(doc: &ModelDocument, point: &LpvPoint) -> Result<Baseline, Id
         .map(|l| document_inertia(l).unwrap_or_else(|| vehicle_m.clone()));
     let (m, d_bar) = logged_view(doc, vehicle_m, matrix(&point.d_bar, "D̄")?)?;
     let quadratic = match doc.lpv.as_ref() {
-        Some(l) => super::predictor::quadratic_of(l, doc.dofs.len())?,
+        Some(l) => super::predictor::quadratic_of(l, doc.dofs.len())?.map(|d_q| QuadraticDamping {
+            d_q,
+            u0: point.speed_mps,
+        }),
         None => None,
     };
     Ok(Baseline {
@@ -258,7 +262,11 @@ fn beyond(base: &LpvModel, end: &AugmentedModel, s: f64) -> Result<AugmentedMode
         end.terms.clone(),
     )
     .with_coriolis(end.coriolis.clone())
-    .with_quadratic(end.quadratic.clone()))
+    .with_quadratic(
+        end.quadratic
+            .clone()
+            .map(|q| QuadraticDamping { u0: s, ..q }),
+    ))
 }
 
 /// Maximal stretches [start, end) over which the forward speed `u`,
@@ -428,8 +436,9 @@ mod tests {
         assert!((tail - want).abs() < 3e-3, "{tail} vs {want}");
     }
 
-    /// A 6-DOF model with g(η), constant loads, three grid points and an
-    /// extension below the grid, on a run whose speed ramps through the
+    /// A 6-DOF model with g(η), constant loads, quadratic damping (surge's
+    /// as the remainder about each sub-model's speed), three grid points
+    /// and an extension below the grid, on a run whose speed ramps through the
     /// extension and the grid: with no terms, the augmented predictor
     /// (attitude in the loop, scheduled on its own speed) predicts as the
     /// baseline's LPV predictor does, so a gate comparing the two measures
@@ -469,6 +478,8 @@ mod tests {
             from_mps: 0.1,
             to_mps: 1.5,
         });
+        base.lpv.as_mut().unwrap().quadratic_damping =
+            Some(vec![150.0, 300.0, 250.0, 40.0, 50.0, 30.0]);
         base.restoring = Some(RestoringDoc {
             parameters: vec![],
             evidence: vec![],

@@ -189,8 +189,11 @@ pub struct LpvDoc {
     pub coriolis_second_order: bool,
     /// Diagonal quadratic damping D_q per DOF (N·s²/m², N·m·s²/rad²), one
     /// for the campaign: every sub-model is driven by γ − D_q|δ|δ, δ = ν
-    /// except the surge velocity (entry 0: the schedule follows u). Absent:
-    /// linear damping only.
+    /// except the surge velocity u: entry 0 is X_|u|u, and the sub-model at
+    /// grid speed u₀ (whose D̄ and load hold the tangent of X_|u|u|u|u)
+    /// is driven by X_|u|u(|u|u − |u₀|u₀ − 2|u₀|(u − u₀)), the rest of it.
+    /// 0 where the data did not determine an entry. Absent: linear damping
+    /// only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quadratic_damping: Option<Vec<f64>>,
     /// Std of `quadratic_damping`.

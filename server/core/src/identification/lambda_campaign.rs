@@ -230,12 +230,14 @@ pub fn identify_lambda_campaign(
     } else {
         Vec::new()
     };
+    let surge = dofs.iter().position(|d| *d == Dof::Surge);
     let with_quadratic = |exps: Vec<Vec<Experiment>>| -> Vec<Vec<Experiment>> {
         exps.into_iter()
-            .map(|point| {
+            .zip(grid.iter())
+            .map(|(point, &u0)| {
                 point
                     .into_iter()
-                    .map(|e| lambda_quadratic::append(e, &quad_cols))
+                    .map(|e| lambda_quadratic::append(e, &quad_cols, surge, u0))
                     .collect()
             })
             .collect()
@@ -303,7 +305,6 @@ pub fn identify_lambda_campaign(
     }
     let g = restoring.as_ref().map(|(p, _)| p);
     let quadratic = lambda_quadratic::pool(&joint, &dofs, &mut notes);
-    let surge = dofs.iter().position(|d| *d == Dof::Surge);
 
     // 2. The sub-models with g(η) and D_q fixed at the pooled values.
     lambda_settings.exogenous = loads.map(|f| specification(profile, &dofs, f));
@@ -321,11 +322,12 @@ pub fn identify_lambda_campaign(
     };
     let exps: Vec<Vec<Experiment>> = build(g, loads)?
         .into_iter()
-        .map(|point| {
+        .zip(grid.iter())
+        .map(|(point, &u0)| {
             point
                 .into_iter()
                 .map(|e| match &quadratic {
-                    Some((d_q, _)) => lambda_quadratic::subtract(e, d_q, surge),
+                    Some((d_q, _)) => lambda_quadratic::subtract(e, d_q, surge, u0),
                     None => e,
                 })
                 .collect()
@@ -351,7 +353,7 @@ pub fn identify_lambda_campaign(
                 .into_iter()
                 .map(|(u0, mut est)| {
                     if let Some((_, e)) = per_point.iter().find(|(s, _)| *s == u0) {
-                        lambda_quadratic::widen(&mut est, e, d_std, &dofs);
+                        lambda_quadratic::widen(&mut est, e, d_std, &dofs, u0);
                     }
                     (u0, est)
                 })

@@ -28,6 +28,7 @@ use super::error::{ModelError, check_finite};
 pub use super::lpv_schedule::{Blend, Extension, ScheduleWeights, Scheduling};
 use super::lpv_schedule::{blend as schedule_blend, schedule};
 use super::predict::{check_record, free_run, k_step, no_prediction};
+use super::quadratic_damping::surge_remainder;
 use super::state_space::DiscreteStateSpace;
 use super::vessel::LinearVesselModel;
 use crate::planning::dof::Dof;
@@ -70,7 +71,7 @@ pub struct DiscreteLpv {
 
 /// A discrete sub-model, its blending weight and the grid point whose M
 /// it has.
-type Weighted<'a> = (&'a DiscreteStateSpace, f64, usize);
+type Weighted<'a> = (&'a DiscreteStateSpace, f64, usize, f64);
 
 /// Speeds tabulated over each side of an extension. Φ = e^{Ah} is not
 /// linear in A: extrapolating the end points' Φ linearly can leave the
@@ -228,11 +229,12 @@ impl LpvModel {
     }
 
     /// The same model with diagonal quadratic damping D_q|δ|δ, one D_q per
-    /// grid point (n entries, N·s²/m² or N·m·s²/rad²; the surge entry is
-    /// unused when surge is modelled, the schedule following u): each
-    /// sub-model is driven by γ − D_q|δ|δ
-    /// ([`super::quadratic_damping::quadratic_force`]), taken linearly
-    /// implicit over each step. Beyond the grid the end point's D_q serves.
+    /// grid point (n entries, N·s²/m² or N·m·s²/rad²): each sub-model is
+    /// driven by γ − D_q|δ|δ ([`super::quadratic_damping::quadratic_force`]),
+    /// taken linearly implicit over each step; with surge modelled, its
+    /// entry is X_|u|u and the sub-model at u₀ is driven by its remainder
+    /// beyond the tangent ([`super::quadratic_damping::surge_remainder`]),
+    /// with Heun's rule. Beyond the grid the end point's D_q serves.
     ///
     /// # Errors
     /// [`ModelError::Grid`] with one D_q per grid point missing;
@@ -422,7 +424,7 @@ impl DiscreteLpv {
     /// nearest tabulated models).
     pub fn at(&self, speed: f64, scheduling: Scheduling) -> Result<DiscreteStateSpace, ModelError> {
         check_speed(speed)?;
-        let ((l, wl, _), (u, wu, _)) = self.pair(speed, scheduling);
+        let ((l, wl, _, _), (u, wu, _, _)) = self.pair(speed, scheduling);
         if wu == 0.0 {
             return Ok(l.clone());
         }
@@ -456,25 +458,34 @@ impl DiscreteLpv {
                 for (s, model) in table {
                     if d <= dist(*s) {
                         let w = (dist(*s) - d) / (dist(*s) - dist(prev.0));
-                        return ((prev.1, w, end), (model, 1.0 - w, end));
+                        return ((prev.1, w, end, prev.0), (model, 1.0 - w, end, *s));
                     }
                     prev = (*s, model);
                 }
-                return ((prev.1, 1.0, end), (prev.1, 0.0, end));
+                return ((prev.1, 1.0, end, prev.0), (prev.1, 0.0, end, prev.0));
             }
         }
         let w = schedule(g, speed, scheduling);
         (
-            (&self.points[w.lower], w.w_lower, w.lower),
-            (&self.points[w.upper], 1.0 - w.w_lower, w.upper),
+            (&self.points[w.lower], w.w_lower, w.lower, g[w.lower]),
+            (&self.points[w.upper], 1.0 - w.w_lower, w.upper, g[w.upper]),
         )
     }
 
-    /// γ − C(δ)δ with grid point `k`'s M (γ itself without C(δ)δ).
-    fn driving(&self, x: &DVector<f64>, u: &DVector<f64>, k: usize) -> DVector<f64> {
+    /// γ − C(δ)δ with grid point `k`'s M (γ itself without C(δ)δ), and
+    /// for the sub-model linearized at `u0` (m/s) the remainder of surge's
+    /// quadratic drag beyond its tangent, X_|u|u times
+    /// [`super::quadratic_damping::surge_remainder`].
+    fn driving(&self, x: &DVector<f64>, u: &DVector<f64>, k: usize, u0: f64) -> DVector<f64> {
         let mut out = u.clone();
         if let (Some(m), Some(i)) = (&self.coriolis, self.surge) {
             out -= DVector::from_vec(second_order_force(&self.dofs, &m[k], x.as_slice(), i));
+        }
+        if let (Some(d), Some(i)) = (&self.quadratic, self.surge) {
+            let x_uu = d[k].get(i).copied().unwrap_or(0.0);
+            if x_uu != 0.0 {
+                out[i] -= x_uu * surge_remainder(x[i], u0);
+            }
         }
         out
     }
@@ -516,28 +527,29 @@ impl DiscreteLpv {
     /// first grid point. A non-finite speed schedules on the first grid point
     /// too (its prediction is non-finite anyway).
     pub fn step(&self, x: &DVector<f64>, u: &DVector<f64>, scheduling: Scheduling) -> DVector<f64> {
-        let ((l, wl, kl), (m, wm, km)) = match self.surge {
+        let ((l, wl, kl, sl), (m, wm, km, sm)) = match self.surge {
             Some(i) if x[i].is_finite() => self.pair(x[i], scheduling),
             _ => self.pair(self.grid_speeds[0], Scheduling::Nearest),
         };
-        let blend = |force: &dyn Fn(usize) -> DVector<f64>| {
-            let lower = l.step(x, &force(kl));
+        let blend = |force: &dyn Fn(usize, f64) -> DVector<f64>| {
+            let lower = l.step(x, &force(kl, sl));
             if wm == 0.0 {
                 lower
             } else {
-                lower * wl + m.step(x, &force(km)) * wm
+                lower * wl + m.step(x, &force(km, sm)) * wm
             }
         };
         if self.coriolis.is_none() && self.quadratic.is_none() {
-            return blend(&|_| u.clone());
+            return blend(&|_, _| u.clone());
         }
-        // C(δ)δ over the step by Heun's rule: the mean of the start and the
-        // predicted end (held at the start it lags fast turns); D_q|δ|δ
-        // linearly implicit about |δ| of the start.
+        // C(δ)δ and surge's quadratic remainder over the step by Heun's
+        // rule: the mean of the start and the predicted end (held at the
+        // start it lags fast turns); D_q|δ|δ linearly implicit about |δ| of
+        // the start.
         let parts = [(l, wl, kl), (m, wm, km)];
-        let predicted = self.implicit_quadratic(blend(&|k| self.driving(x, u, k)), parts, x);
+        let predicted = self.implicit_quadratic(blend(&|k, s| self.driving(x, u, k, s)), parts, x);
         self.implicit_quadratic(
-            blend(&|k| (self.driving(x, u, k) + self.driving(&predicted, u, k)) * 0.5),
+            blend(&|k, s| (self.driving(x, u, k, s) + self.driving(&predicted, u, k, s)) * 0.5),
             parts,
             x,
         )

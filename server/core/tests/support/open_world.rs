@@ -181,6 +181,17 @@ fn column_fit(
 /// grades the result. `described`: the runs carry their role and grid
 /// speed (else the service must infer them).
 /// The truth's best linear-affine model over the runs named `run_ids`.
+/// The truth's coefficient of |ν_i|ν_i: D_q,i, and in surge also D_lu,0
+/// (D_lu|u_r| is the speed growth of the linear damping, quadratic in u).
+fn true_quadratic(vessel: &Vessel, i: usize) -> f64 {
+    vessel.damping_quadratic[i]
+        + if i == 0 {
+            vessel.damping_linear_per_speed[0]
+        } else {
+            0.0
+        }
+}
+
 fn fitted_linearization(
     vessel: &Vessel,
     campaign: &Campaign,
@@ -272,7 +283,7 @@ pub fn evaluate_with(
         let lin = if let Some(std) = &lpv.quadratic_damping_std {
             let d_q = nalgebra::Vector6::from_fn(|i, _| {
                 if std.get(i).is_some_and(|s| *s > 0.0) {
-                    vessel.damping_quadratic[i]
+                    true_quadratic(&vessel, i)
                 } else {
                     0.0
                 }
@@ -282,7 +293,7 @@ pub fn evaluate_with(
                 .iter()
                 .filter(|r| point.run_ids.contains(&r.meta.name))
                 .collect();
-            effective_linearization_given_quadratic(&vessel, &runs, &d_q)
+            effective_linearization_given_quadratic(&vessel, &runs, &d_q, point.speed_mps)
         } else {
             fitted_linearization(&vessel, &campaign, &point.run_ids)
         };
@@ -339,13 +350,13 @@ pub fn evaluate_with(
         }
     }
     if let (Some(d_q), Some(std)) = (&lpv.quadratic_damping, &lpv.quadratic_damping_std) {
-        for i in 1..6 {
+        for i in 0..6 {
             // An entry left out (0, no σ) is not an estimate to judge.
             if std[i] > 0.0 && std[i].is_finite() {
                 z.push(ZScore {
                     name: format!("D_q[{}]", Dof::ALL[i].name()),
                     estimate: d_q[i],
-                    truth: vessel.damping_quadratic[i],
+                    truth: true_quadratic(&vessel, i),
                     std: std[i],
                 });
             }
