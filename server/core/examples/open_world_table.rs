@@ -2,7 +2,7 @@
 //! the λ-filter identification's parameter errors in σ and its validation
 //! fits against the true model and an affine least-squares baseline.
 //!
-//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--validation-speeds 0.3,0.75] [--noise-free] [--zero-noise vl,va,rp,pos] [--controller-hz 20] [--projected-m] [--quadratic-damping] [--held-above]`
+//! `cargo run --release -p seatrial-core --example open_world_table [seeds…] [--structure diagonal|coupled|auto] [--in-grid] [--validation-speeds 0.3,0.75] [--noise-free] [--zero-noise vl,va,rp,pos] [--controller-hz 20] [--projected-m] [--linear-damping] [--held-above]`
 //!
 //! `--in-grid` flies the validation staircase at speeds inside the grid
 //! (0.5, 0.75, 1.25, 1.75, 2.0 m/s) instead of below, between and beyond it,
@@ -12,8 +12,8 @@
 //! positions with depth and heading); `--controller-hz` tells the identification the controller's rate (the
 //! truth's loop runs at 20 Hz, logged at 10 Hz); `--projected-m` fits M's
 //! rows freely and stores the nearest symmetric M (`symmetric_inertia:
-//! false`); `--quadratic-damping` estimates quadratic damping
-//! (`quadratic_damping: true`); `--held-above` holds the top sub-model
+//! false`); `--linear-damping` fits linear damping only
+//! (`quadratic_damping: false`); `--held-above` holds the top sub-model
 //! above the grid (`extend_above_grid: false`).
 
 #[path = "../tests/support/open_world.rs"]
@@ -27,7 +27,7 @@ fn main() {
     let mut structure = None;
     let mut controller_hz = None;
     let mut symmetric = true;
-    let mut quadratic = false;
+    let mut quadratic = true;
     let mut above = true;
     let mut spec = seatrial_truth::CampaignSpec::default();
     let mut it = args.iter();
@@ -43,8 +43,8 @@ fn main() {
             controller_hz = it.next().and_then(|v| v.parse::<f64>().ok());
         } else if a == "--projected-m" {
             symmetric = false;
-        } else if a == "--quadratic-damping" {
-            quadratic = true;
+        } else if a == "--linear-damping" {
+            quadratic = false;
         } else if a == "--held-above" {
             above = false;
         } else if a == "--noise-free" {

@@ -36,15 +36,16 @@ fn projected_reports() -> &'static [SeedReport] {
     })
 }
 
-/// With quadratic damping (`quadratic_damping: true`, opt-in).
-fn quadratic_reports() -> &'static [SeedReport] {
+/// With linear damping only (`quadratic_damping: false`, the thesis's
+/// model).
+fn linear_damping_reports() -> &'static [SeedReport] {
     static REPORTS: std::sync::OnceLock<Vec<SeedReport>> = std::sync::OnceLock::new();
-    REPORTS.get_or_init(|| evaluate_all(&with_quadratic()))
+    REPORTS.get_or_init(|| evaluate_all(&linear_damping()))
 }
 
-fn with_quadratic() -> LambdaCampaignSettings {
+fn linear_damping() -> LambdaCampaignSettings {
     LambdaCampaignSettings {
-        quadratic_damping: true,
+        quadratic_damping: false,
         ..LambdaCampaignSettings::default()
     }
 }
@@ -187,11 +188,11 @@ fn one_step_fits_beat_the_affine_baseline_and_approach_the_truth() {
 /// every vessel: the 20 Hz controller's unlogged commands corrected with
 /// their own σ (half the correction c·K), σ of M inflated by its spread
 /// across the grid and scaled by the rows' disagreement with M = Mᵀ
-/// (96–100 % measured on vessels 1–5, 95–100 % on 1–12; the same with
-/// quadratic damping on).
+/// (97–100 % measured on vessels 1–12; 96–100 % on 1–5 and 94.5–100 %
+/// on 1–12 with linear damping only).
 #[test]
 fn most_parameters_lie_within_three_reported_sigma() {
-    for (floor, reports) in [(0.95, reports()), (0.95, quadratic_reports())] {
+    for (floor, reports) in [(0.95, reports()), (0.95, linear_damping_reports())] {
         for r in reports {
             let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
             assert!(
@@ -357,7 +358,7 @@ fn the_extension_below_the_grid_improves_free_runs() {
     assert!(total > 0.4, "sum of free-run gains {total:.3}");
 }
 
-/// Quadratic damping D_q|δ|δ (opt-in), one per campaign (pooled over the grid
+/// Quadratic damping D_q|δ|δ (default), one per campaign (pooled over the grid
 /// points' joint estimates, the sub-models then fitted with it known):
 /// the truth's hulls damp 30–70 % quadratically, so a linear sub-model
 /// fitted to the estimation runs' amplitudes over- or under-damps the
@@ -369,7 +370,7 @@ fn the_extension_below_the_grid_improves_free_runs() {
 #[test]
 fn quadratic_damping_follows_the_amplitude_of_the_motion() {
     let mut gain = 0.0;
-    for (r, l) in quadratic_reports().iter().zip(reports()) {
+    for (r, l) in reports().iter().zip(linear_damping_reports()) {
         for (a, b) in r.fits.iter().zip(&l.fits) {
             let (fa, fb) = (a.free_run.unwrap(), b.free_run.unwrap());
             assert!(
@@ -386,8 +387,8 @@ fn quadratic_damping_follows_the_amplitude_of_the_motion() {
         assert!(off <= 1, "seed {}: {off} D_q beyond 3σ", r.seed);
     }
     assert!(gain > 0.05, "summed free-run gain {gain:.3}");
-    let with = evaluate(7, true, &with_quadratic());
-    let without = evaluate(7, true, &LambdaCampaignSettings::default());
+    let with = evaluate(7, true, &LambdaCampaignSettings::default());
+    let without = evaluate(7, true, &linear_damping());
     for (a, b) in with.fits.iter().zip(&without.fits) {
         let (fa, fb) = (a.free_run.unwrap(), b.free_run.unwrap());
         if ["v", "r"].contains(&a.channel.as_str()) {
@@ -402,30 +403,14 @@ fn quadratic_damping_follows_the_amplitude_of_the_motion() {
     }
 }
 
-/// The issue's fit criteria — 1-step within 0.02 and whole-run free run
-/// within 0.05 of the true model in every channel — on four of the five
-/// vessels (vessel 5, the small fast one, misses: free runs 0.06–0.11
-/// below in surge, sway, heave and pitch; its 1-step fits are within 0.001).
+/// The issue's criteria on the five vessels: ≥ 95 % of parameters within
+/// ±3σ, 1-step within 0.02 and whole-run free run within 0.05 of the true
+/// model in every channel (met on all 12 seeded vessels: `open_world_table
+/// 1 … 12`; closest, vessel 5 pitch free run 0.849 against 0.899). With
+/// linear damping only, vessel 5 misses (free runs 0.06–0.12 below in
+/// surge, sway, heave and pitch: the surge drag below the grid, see
+/// `identification/lambda_quadratic.rs`).
 #[test]
-fn the_fit_criteria_hold_on_four_of_five_vessels() {
-    let met: Vec<u64> = reports()
-        .iter()
-        .filter(|r| {
-            r.fits.iter().all(|c| {
-                c.one_step.unwrap() >= c.one_step_true.unwrap() - 0.02
-                    && c.free_run.unwrap() >= c.free_run_true.unwrap() - 0.05
-            })
-        })
-        .map(|r| r.seed)
-        .collect();
-    assert!(met.len() >= 4, "met on seeds {met:?}");
-}
-
-/// The issue's full criteria, not met yet (see the README's identification
-/// section): ≥ 95 % of parameters within ±3σ, 1-step within 0.02 and free
-/// run within 0.05 of the true model in every channel.
-#[test]
-#[ignore = "known gap: vessel 5 free runs 0.06–0.11 below the true model in u, v, w, q; vessel 7 yaw free run 0.087 below without the opt-in quadratic damping; all criteria met on vessels 1–4, 6, 8–12 of 12"]
 fn the_issue_criteria_on_five_vessels() {
     for r in reports() {
         let within = r.z.iter().filter(|z| z.z().abs() <= 3.0).count();
@@ -436,8 +421,14 @@ fn the_issue_criteria_on_five_vessels() {
             r.z.len()
         );
         for c in &r.fits {
-            assert!(c.one_step.unwrap() >= c.one_step_true.unwrap() - 0.02);
-            assert!(c.free_run.unwrap() >= c.free_run_true.unwrap() - 0.05);
+            let (one, one_true) = (c.one_step.unwrap(), c.one_step_true.unwrap());
+            let (free, free_true) = (c.free_run.unwrap(), c.free_run_true.unwrap());
+            assert!(
+                one >= one_true - 0.02 && free >= free_true - 0.05,
+                "seed {} {}: 1-step {one:.4} against {one_true:.4}, free run {free:.4} against {free_true:.4}",
+                r.seed,
+                c.channel
+            );
         }
     }
 }

@@ -34,6 +34,9 @@ pub struct PredictSettings {
     /// DP position/heading noise and bias (the supply vessel's trials by
     /// default); its seed is replaced per realisation.
     pub dp_flight: DpFlightSettings,
+    /// How an ROV's flights are identified (the campaign's default λ-filter
+    /// identification unless told otherwise).
+    pub lambda: LambdaCampaignSettings,
 }
 
 /// Most noise realisations of one prediction.
@@ -47,6 +50,7 @@ impl Default for PredictSettings {
             rov_noise: MeasurementNoise::default(),
             rov_feedback: Feedback::Measured,
             dp_flight: DpFlightSettings::supply_vessel(1),
+            lambda: LambdaCampaignSettings::default(),
         }
     }
 }
@@ -97,7 +101,7 @@ fn realise(
             &plan.grid_speeds(),
             &inputs,
             &runs,
-            &LambdaCampaignSettings::default(),
+            &settings.lambda,
             progress,
         ),
         Prior::Dp(_) => identify_ekf_campaign(

@@ -304,7 +304,7 @@ pub fn identify_lambda_campaign(
         }
     }
     let g = restoring.as_ref().map(|(p, _)| p);
-    let quadratic = lambda_quadratic::pool(&joint, &dofs, &mut notes);
+    let mut quadratic = lambda_quadratic::pool(&joint, &dofs, &mut notes);
 
     // 2. The sub-models with g(η) and D_q fixed at the pooled values.
     lambda_settings.exogenous = loads.map(|f| specification(profile, &dofs, f));
@@ -320,31 +320,67 @@ pub fn identify_lambda_campaign(
         )),
         _ => None,
     };
-    let exps: Vec<Vec<Experiment>> = build(g, loads)?
-        .into_iter()
-        .zip(grid.iter())
-        .map(|(point, &u0)| {
-            point
-                .into_iter()
-                .map(|e| match &quadratic {
-                    Some((d_q, _)) => lambda_quadratic::subtract(e, d_q, surge, u0),
-                    None => e,
-                })
-                .collect()
-        })
-        .collect();
-    let estimates = {
-        let from = if joint.is_empty() { 0.1 } else { 0.4 };
-        let mut sub = SubProgress::new(progress, from, 0.8);
+    let plain_exps = build(g, loads)?;
+    let known = |d_q: Option<&DVector<f64>>| -> Vec<Vec<Experiment>> {
+        plain_exps
+            .iter()
+            .zip(grid.iter())
+            .map(|(point, &u0)| {
+                point
+                    .iter()
+                    .cloned()
+                    .map(|e| match d_q {
+                        Some(d) => lambda_quadratic::subtract(e, d, surge, u0),
+                        None => e,
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    let mut exps = known(quadratic.as_ref().map(|(d, _)| d));
+    let from = if joint.is_empty() { 0.1 } else { 0.4 };
+    let mut fit_notes = Vec::new();
+    let mut estimates = {
+        let mut sub = SubProgress::new(progress, from, 0.6);
         fit_points(
             &points_of(exps.clone()),
             &lambda_settings,
             settings.coriolis_from_m,
             &mut sub,
-            &mut notes,
+            &mut fit_notes,
         )
         .map_err(lambda_error)?
     };
+    // Surge's X_|u|u from the drag curve over the grid, then the
+    // sub-models refitted with the remainder beyond each tangent known.
+    let drag = surge
+        .filter(|_| settings.quadratic_damping)
+        .and_then(|s| lambda_quadratic::surge_drag(&estimates, s).map(|x| (s, x)));
+    if let Some((s, (x, sd))) = drag {
+        let (mut d, mut d_std) = quadratic
+            .take()
+            .unwrap_or_else(|| (DVector::zeros(n), DVector::zeros(n)));
+        d[s] = x;
+        d_std[s] = sd;
+        quadratic = Some((d, d_std));
+        exps = known(quadratic.as_ref().map(|(d, _)| d));
+        fit_notes.clear();
+        let mut sub = SubProgress::new(progress, 0.6, 0.8);
+        estimates = fit_points(
+            &points_of(exps.clone()),
+            &lambda_settings,
+            settings.coriolis_from_m,
+            &mut sub,
+            &mut fit_notes,
+        )
+        .map_err(lambda_error)?;
+        notes.push(format!(
+            "surge's quadratic drag X_|u|u = {} ± {} N·s²/m² from the drag curve over the grid speeds (half the slope of D̄[surge,surge] over u₀: each sub-model's tangent of X_u·u + X_|u|u·|u|u); the sub-models were refitted with the rest of it beyond each tangent, X_|u|u(u − u₀)², which their load would otherwise absorb as X_|u|u times the surge runs' mean square excursion",
+            sig3(x),
+            sig3(sd)
+        ));
+    }
+    notes.append(&mut fit_notes);
 
     let estimates = match &quadratic {
         Some((_, d_std)) => {
@@ -479,10 +515,7 @@ pub fn identify_lambda_campaign(
         None => lpv,
     };
     if let Some((d_q, std)) = &quadratic {
-        for i in lambda_quadratic::columns(&dofs)
-            .into_iter()
-            .filter(|&i| std[i] > 0.0)
-        {
+        for i in (0..dofs.len()).filter(|&i| std[i] > 0.0) {
             parameters.push(ParameterRow {
                 group: "D_q".into(),
                 symbol: format!("D_q[{}]", dofs[i].name()),
