@@ -233,11 +233,10 @@ pub fn identify_lambda_campaign(
     let surge = dofs.iter().position(|d| *d == Dof::Surge);
     let with_quadratic = |exps: Vec<Vec<Experiment>>| -> Vec<Vec<Experiment>> {
         exps.into_iter()
-            .zip(grid.iter())
-            .map(|(point, &u0)| {
+            .map(|point| {
                 point
                     .into_iter()
-                    .map(|e| lambda_quadratic::append(e, &quad_cols, surge, u0))
+                    .map(|e| lambda_quadratic::append(e, &quad_cols))
                     .collect()
             })
             .collect()

@@ -36,6 +36,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::estimation::lambda::{Exogenous, Experiment, LambdaEstimate};
+use crate::models::quadratic_damping::{surge_remainder, surge_tangent};
 use crate::numbers::sig3;
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
@@ -170,8 +171,7 @@ fn function(nu: &DMatrix<f64>, k: usize, i: usize, surge: Option<usize>, u0: f64
     let mid = midstep(nu, k, i);
     let q = nu[(k, i)].abs() * mid;
     if Some(i) == surge {
-        // |u(k)|u(k+½) − |u₀|u₀ − 2|u₀|(u(k+½) − u₀).
-        q - u0.abs() * u0 - 2.0 * u0.abs() * (mid - u0)
+        q - surge_tangent(mid, u0)
     } else {
         q
     }
@@ -187,15 +187,14 @@ fn function(nu: &DMatrix<f64>, k: usize, i: usize, surge: Option<usize>, u0: f64
 /// vessel 10 sway 104 ± 17 against 169 N·s²/m², σ not covering it on 2 of
 /// 12 vessels; extrapolated, 135 ± 16 and ≥ 97 % within ±3σ on all 12).
 /// |ν(k)|ν(k) alone lags the force by half a step: m came out 4 % high on
-/// a strongly quadratic hull (unit test below). Surge (index `surge`) gets
-/// its remainder beyond the tangent at the grid speed `u0` (m/s).
-pub(crate) fn append(exp: Experiment, cols: &[usize], surge: Option<usize>, u0: f64) -> Experiment {
+/// a strongly quadratic hull (unit test below).
+pub(crate) fn append(exp: Experiment, cols: &[usize]) -> Experiment {
     if cols.is_empty() {
         return exp;
     }
     let rows = exp.nu.nrows();
     let q0 = exp.exogenous.ncols();
-    let f = |k: usize, i: usize| function(&exp.nu, k, i, surge, u0);
+    let f = |k: usize, i: usize| function(&exp.nu, k, i, None, 0.0);
     let e = DMatrix::from_fn(rows, q0 + cols.len(), |k, j| {
         if j < q0 {
             exp.exogenous[(k, j)]
@@ -355,7 +354,7 @@ pub(crate) fn widen(
         let q = DVector::from_fn(rows, |k, _| {
             let v = x[(k, i)];
             if Some(i) == surge {
-                v.abs() * v - u0.abs() * u0 - 2.0 * u0.abs() * (v - u0)
+                surge_remainder(v, u0)
             } else {
                 v.abs() * v
             }
@@ -391,35 +390,33 @@ mod tests {
     #[test]
     fn each_dof_gets_its_own_column_and_surge_its_remainder_about_the_grid_speed() {
         let dofs = vec![Dof::Surge, Dof::Sway, Dof::Yaw];
-        // The regression's columns leave surge to the drag curve; given
-        // one, surge's is the remainder about the grid speed.
-        assert_eq!(columns(&dofs), vec![1, 2]);
-        let cols = vec![0, 1, 2];
+        // The regression's columns leave surge to the drag curve.
+        let cols = columns(&dofs);
+        assert_eq!(cols, vec![1, 2]);
         let spec = specification(None, &surveyor_rov(), &dofs, &cols).unwrap();
-        assert_eq!(spec.names, vec!["|u|u", "|v|v", "|r|r"]);
-        assert!(spec.pattern[(0, 0)] && spec.pattern[(1, 1)] && spec.pattern[(2, 2)]);
-        assert!(!spec.pattern[(1, 0)] && !spec.pattern[(0, 1)] && !spec.pattern[(2, 1)]);
+        assert_eq!(spec.names, vec!["|v|v", "|r|r"]);
+        assert!(spec.pattern[(1, 0)] && spec.pattern[(2, 1)]);
+        assert!(!spec.pattern[(0, 0)] && !spec.pattern[(2, 0)] && !spec.pattern[(1, 1)]);
         let exp = Experiment {
             h: 0.1,
             nu: DMatrix::from_row_slice(2, 3, &[1.0, -0.2, 0.4, 1.4, 0.2, 0.0]),
             gamma: DMatrix::zeros(2, 3),
             exogenous: DMatrix::zeros(2, 0),
         };
-        let e = append(exp.clone(), &cols, Some(0), 1.0).exogenous;
+        let e = append(exp.clone(), &cols).exogenous;
         // |v(k)| times v extrapolated to mid-step: row 0 its own sample,
         // |v(0)| v(0) = −0.04, |r(0)| r(0) = 0.16; row 1 0.2·(0.3 + 0.1), 0
-        assert!((e[(0, 1)] + 0.04).abs() < 1e-12 && (e[(0, 2)] - 0.16).abs() < 1e-12);
-        assert!((e[(1, 1)] - 0.08).abs() < 1e-12 && e[(1, 2)].abs() < 1e-12);
-        // Surge about u₀ = 1: row 0 (1 − 1)² = 0; row 1 with u(k+½) = 1.6:
+        assert!((e[(0, 0)] + 0.04).abs() < 1e-12 && (e[(0, 1)] - 0.16).abs() < 1e-12);
+        assert!((e[(1, 0)] - 0.08).abs() < 1e-12 && e[(1, 1)].abs() < 1e-12);
+        // Subtracting D_q moves the same functions to the force side; surge
+        // about u₀ = 1: row 0 (1 − 1)² = 0; row 1 with u(k+½) = 1.6:
         // |u(k)|u(k+½) − |u₀|u₀ − 2|u₀|(u(k+½) − u₀) = 1.4·1.6 − 1 − 2·0.6.
-        assert!(e[(0, 0)].abs() < 1e-12);
-        assert!((e[(1, 0)] - 0.04).abs() < 1e-12, "{}", e[(1, 0)]);
-        // Subtracting D_q times the same functions leaves γ' = −F.
         let d_q = DVector::from_vec(vec![30.0, 50.0, 7.0]);
         let g = subtract(exp, &d_q, Some(0), 1.0).gamma;
+        let want = [[0.0, -0.04, 0.16], [0.04, 0.08, 0.0]];
         for k in 0..2 {
             for i in 0..3 {
-                assert!((g[(k, i)] + d_q[i] * e[(k, i)]).abs() < 1e-12);
+                assert!((g[(k, i)] + d_q[i] * want[k][i]).abs() < 1e-12, "{k} {i}");
             }
         }
     }
@@ -482,7 +479,7 @@ mod tests {
                 gamma: tau,
                 exogenous: DMatrix::zeros(n, 0),
             };
-            exps.push(append(exp, &columns(&dofs), None, 0.0));
+            exps.push(append(exp, &columns(&dofs)));
         }
         let mut settings = LambdaSettings::new(
             dofs.clone(),

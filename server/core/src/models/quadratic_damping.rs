@@ -61,7 +61,12 @@ pub fn quadratic_force(d_q: &DVector<f64>, nu: &[f64], surge: Option<usize>) -> 
 /// w(1 − w)Δ², which is exactly what that blend of the tangents' loads
 /// misses.
 pub fn surge_remainder(u: f64, u0: f64) -> f64 {
-    u.abs() * u - u0.abs() * u0 - 2.0 * u0.abs() * (u - u0)
+    u.abs() * u - surge_tangent(u, u0)
+}
+
+/// The tangent of |u|u at `u0`, evaluated at `u`: |u₀|u₀ + 2|u₀|(u − u₀).
+pub fn surge_tangent(u: f64, u0: f64) -> f64 {
+    u0.abs() * u0 + 2.0 * u0.abs() * (u - u0)
 }
 
 #[cfg(test)]
