@@ -8,7 +8,10 @@ use super::drift::current_drift;
 use super::error::DiscoveryError;
 use super::evidence::{effect_text, separating_evidence};
 use super::fit::{Prepared, Spec};
-use super::locate::{Predictions, channel_fits, locate, predict, residual};
+use super::lines::{SpectralLine, spectral_lines};
+use super::locate::{
+    Predictions, capital, channel_fits, force_residual, locate, predict, residual,
+};
 use super::lookalike::{Selection, look_alikes};
 use super::model::AugmentedModel;
 use super::narrate::{hypothesis, plot_series, rows_of, summary, unexplained};
@@ -16,6 +19,7 @@ use super::report::*;
 use super::residual::whiteness;
 use super::select::{Criteria, Scored, step};
 use crate::estimation::Progress;
+use crate::numbers::sig3;
 use crate::planning::VesselProfile;
 
 /// Settings of [`discover`]. Defaults suit a 10 Hz ROV log.
@@ -146,6 +150,24 @@ impl DiscoverySettings {
 
 fn check(p: &mut dyn Progress, f: f64, stage: &str) -> Result<(), DiscoveryError> {
     p.update(f, stage).map_err(DiscoveryError::from)
+}
+
+/// Every narrow line of every row's 1-step residual force.
+fn all_lines(model: &AugmentedModel, runs: &[&Record]) -> Vec<(usize, SpectralLine)> {
+    let h = runs.first().map_or(0.1, |r| r.h);
+    let preds: Vec<_> = runs.iter().map(|r| model.predict_k_step(r, 1)).collect();
+    (0..model.dofs.len())
+        .flat_map(|i| {
+            let forces: Vec<Vec<f64>> = runs
+                .iter()
+                .zip(&preds)
+                .map(|(r, p)| force_residual(model, r, p, i))
+                .collect();
+            spectral_lines(&forces, 1.0 / h)
+                .into_iter()
+                .map(move |l| (i, l))
+        })
+        .collect()
 }
 
 /// Runs missing-physics discovery (see the [module documentation](super)).
@@ -330,23 +352,24 @@ pub fn discover_from(
     }
 
     check(progress, 0.8, "fitting the augmented model")?;
-    let shape_std: Vec<Option<f64>> = start
-        .terms
-        .iter()
-        .map(|t| t.shape_std)
-        .chain(winners.iter().map(|w| w.shape_std))
-        .collect();
-    let model = if winners.is_empty() {
-        base_model.clone()
-    } else {
+    let fit_model = |chosen: &[Spec], winners: &[Scored]| -> AugmentedModel {
+        if winners.is_empty() {
+            return base_model.clone();
+        }
+        let shape_std: Vec<Option<f64>> = start
+            .terms
+            .iter()
+            .map(|t| t.shape_std)
+            .chain(winners.iter().map(|w| w.shape_std))
+            .collect();
         // Three fits of the chosen terms: couplings of the touched rows held,
         // free, or every row refitted (a baseline that absorbed the effect
         // through its couplings in other rows gives it back).
         let all_rows: Vec<usize> = (0..n).collect();
         let fit_variant = |v: usize, hac: bool| match v {
-            0 => prep.fit_for_model(&chosen, &runs, hac),
-            1 => prep.fit(&chosen, &[], &runs, hac),
-            _ => prep.fit(&chosen, &all_rows, &runs, hac),
+            0 => prep.fit_for_model(chosen, &runs, hac),
+            1 => prep.fit(chosen, &[], &runs, hac),
+            _ => prep.fit(chosen, &all_rows, &runs, hac),
         };
         let fitted: Vec<&Record> = est.iter().collect();
         let base_on_fitted: Vec<Predictions> =
@@ -358,7 +381,7 @@ pub fn discover_from(
             let Some(f) = fit_variant(v, false) else {
                 continue;
             };
-            let candidate = prep.model(&chosen, &f, &[]);
+            let candidate = prep.model(chosen, &f, &[]);
             let (harm, gain) = change_score(&base_on_fitted, &candidate, &fitted, k);
             let score = (candidate.inertia_positive(), harm, gain);
             if best.is_none_or(|(_, b)| score > b) {
@@ -367,9 +390,75 @@ pub fn discover_from(
         }
         best.and_then(|(v, _)| fit_variant(v, true)).map_or_else(
             || base_model.clone(),
-            |f| prep.model(&chosen, &f, &shape_std),
+            |f| prep.model(chosen, &f, &shape_std),
         )
     };
+    let mut model = fit_model(&chosen, &winners);
+
+    // A periodic force the chosen terms leave in a DOF — a narrow line of one
+    // size in every run's residual — comes from outside the model's physics
+    // (a term that caused it, as an actuator lag's closed-loop ringing,
+    // halves it at least). The terms named in that DOF were fitted through it and
+    // their gain is not evidence of them: they are withdrawn, the model
+    // refitted, and the line reported unexplained.
+    let mut withdrawn: Vec<String> = Vec::new();
+    if !winners.is_empty() {
+        let before = all_lines(&base_model, &all_runs);
+        let after = all_lines(&model, &all_runs);
+        // A term fits through a periodic force only where the force moves
+        // the vessel: up to ten times the DOF's corner frequency a_ii/2π.
+        let corner: Vec<f64> = match model.m.clone().try_inverse() {
+            Some(mi) => (0..n)
+                .map(|i| (mi.row(i) * model.d_bar.column(i))[(0, 0)].abs() / std::f64::consts::TAU)
+                .collect(),
+            None => vec![0.0; n],
+        };
+        let same = |a: &SpectralLine, b: &SpectralLine| {
+            (a.frequency_hz - b.frequency_hz).abs() <= 2.0 * a.resolution_hz.max(b.resolution_hz)
+        };
+        // Rows whose lines the terms removed or halved: the terms explain
+        // something periodic there (an actuator lag's ringing).
+        let explained: Vec<usize> = before
+            .iter()
+            .filter(|(i, b)| {
+                !after
+                    .iter()
+                    .any(|(j, l)| j == i && same(b, l) && l.amplitude >= 0.5 * b.amplitude)
+            })
+            .map(|(i, _)| *i)
+            .collect();
+        let lines: Vec<(usize, SpectralLine)> = after
+            .into_iter()
+            .filter(|(i, l)| !explained.contains(i) && l.frequency_hz <= 10.0 * corner[*i])
+            .collect();
+        let touches = |e: &Effect| {
+            let rows = e.rows(&baseline.dofs, &baseline.d_bar);
+            rows.len() < n && rows.iter().any(|r| lines.iter().any(|(i, _)| i == r))
+        };
+        if winners.iter().any(|w| touches(&w.spec.effect)) {
+            for w in winners.iter().filter(|w| touches(&w.spec.effect)) {
+                let (i, l) = lines
+                    .iter()
+                    .find(|(i, _)| {
+                        w.spec
+                            .effect
+                            .rows(&baseline.dofs, &baseline.d_bar)
+                            .contains(i)
+                    })
+                    .expect("a touched row has a line");
+                withdrawn.push(format!(
+                    "{} was fitted, then withdrawn: the {} residual keeps a periodic force at {} Hz that no term explains, and the term's gain came from fitting through it.",
+                    capital(&w.spec.effect.label()),
+                    baseline.dofs[*i].name(),
+                    sig3(l.frequency_hz)
+                ));
+            }
+            winners.retain(|w| !touches(&w.spec.effect));
+            chosen.truncate(n_carried);
+            chosen.extend(winners.iter().map(|w| w.spec));
+            model = fit_model(&chosen, &winners);
+        }
+    }
 
     // Before/after on validation runs (estimation runs if none were given).
     let val: Vec<&Record> = if validation_runs.is_empty() {
@@ -544,6 +633,7 @@ pub fn discover_from(
         &ambiguities,
         &unexplained,
     );
+    summary.extend(withdrawn);
     summary.extend(set_aside);
     check(progress, 1.0, "done")?;
     Ok(DiscoveryReport {

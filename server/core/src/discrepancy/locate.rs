@@ -44,6 +44,30 @@ pub(crate) fn residual(rec: &Record, pred: &DMatrix<f64>, i: usize) -> Vec<f64> 
         .collect()
 }
 
+/// The 1-step residual of channel `i` as a force in that DOF alone:
+/// e_i / (h·(M⁻¹)_ii) per sample. A force f_i slow against the sampling
+/// leaves e ≈ h·M⁻¹·f in the 1-step prediction, whatever the controller
+/// does with it (the logged τ carries the controller's answer); the other
+/// channels' misfit is kept out. N or N·m; empty when M is singular.
+pub(crate) fn force_residual(
+    model: &AugmentedModel,
+    rec: &Record,
+    pred: &DMatrix<f64>,
+    i: usize,
+) -> Vec<f64> {
+    let Some(mi) = model.m.clone().try_inverse() else {
+        return Vec::new();
+    };
+    let gain = mi[(i, i)] * rec.h;
+    if !(gain.is_finite() && gain > 0.0) {
+        return Vec::new();
+    }
+    residual(rec, pred, i)
+        .into_iter()
+        .map(|e| e / gain)
+        .collect()
+}
+
 /// Mean of the defined fits.
 pub(crate) fn mean_fit(v: &[Option<f64>]) -> Option<f64> {
     let d: Vec<f64> = v.iter().flatten().copied().collect();

@@ -33,7 +33,10 @@
 //!    fly (force columns within the profile's limits, one or four headings)
 //!    and the run that separates them most is proposed in planner terms.
 //! 6. **Be honest**: bands of the augmented model's residual still above the
-//!    noise floor are reported as unexplained, with their signature; a model
+//!    noise floor are reported as unexplained, with their signature; a narrow
+//!    line of one size in every run's residual force ([`lines`]) is reported
+//!    as a periodic force from outside the model, with its frequency and
+//!    size, and terms fitted through it in its DOF are withdrawn; a model
 //!    that already fits names nothing.
 //!
 //! # STATUS
@@ -129,6 +132,7 @@ pub mod error;
 pub mod evidence;
 pub mod experiment;
 pub mod fit;
+pub mod lines;
 pub mod locate;
 mod lookalike;
 pub mod model;

@@ -5,11 +5,15 @@
 use super::candidates::Effect;
 use super::data::Record;
 use super::fit::Spec;
-use super::locate::{BAND_EXCESS_DB, Predictions, capital, phi_diag, residual, signature_words};
+use super::lines::spectral_lines;
+use super::locate::{
+    BAND_EXCESS_DB, Predictions, capital, force_residual, phi_diag, residual, signature_words,
+};
 use super::model::AugmentedModel;
 use super::report::*;
-use super::residual::residual_spectrum;
+use super::residual::{BandPower, residual_spectrum};
 use super::select::{Criteria, Scored};
+use crate::numbers::sig3;
 
 pub(super) fn rows_of(m: &nalgebra::DMatrix<f64>) -> Vec<Vec<f64>> {
     (0..m.nrows())
@@ -85,7 +89,10 @@ pub(super) fn plot_series(
         .collect()
 }
 
-/// Bands of the augmented model's 1-step residual still above the noise floor.
+/// Structure of the augmented model's 1-step residual no candidate
+/// explains, per DOF: a narrow line ([`spectral_lines`]) in the residual
+/// force M·e/h — an exogenous periodic force, sized in N or N·m — and the
+/// octave band furthest above the noise floor.
 pub(super) fn unexplained(
     model: &AugmentedModel,
     runs: &[&Record],
@@ -96,6 +103,45 @@ pub(super) fn unexplained(
     let preds: Vec<_> = runs.iter().map(|r| model.predict_k_step(r, 1)).collect();
     let mut out = Vec::new();
     for (i, &dof) in model.dofs.iter().enumerate() {
+        let explained_here = chosen.iter().any(|c| c.effect.dof() == Some(dof));
+        let after = if explained_here {
+            " after the chosen terms"
+        } else {
+            ""
+        };
+        let forces: Vec<Vec<f64>> = runs
+            .iter()
+            .zip(&preds)
+            .map(|(r, p)| force_residual(model, r, p, i))
+            .collect();
+        if let Some(line) = spectral_lines(&forces, 1.0 / h).into_iter().next() {
+            let unit = dof.force_unit();
+            let text = format!(
+                "{}: a periodic force no candidate explains{after} — a line at {} Hz (period {} s), about {} {unit} in amplitude ({}–{} {unit} run by run), {:.0} dB over the residual around it, in {} of {} runs; it comes from outside the model's physics (waves, vortex shedding, machinery), and nothing physical is named for it.",
+                capital(dof.name()),
+                sig3(line.frequency_hz),
+                sig3(1.0 / line.frequency_hz),
+                sig3(line.amplitude),
+                sig3(line.run_amplitudes[0]),
+                sig3(line.run_amplitudes[1]),
+                line.excess_db,
+                line.runs_with_line,
+                line.runs
+            );
+            out.push(Unexplained {
+                dof,
+                band: BandPower {
+                    f_lo_hz: line.frequency_hz - 2.0 * line.resolution_hz,
+                    f_hi_hz: line.frequency_hz + 2.0 * line.resolution_hz,
+                    excess_db: line.excess_db,
+                    peak_hz: line.frequency_hz,
+                },
+                low_slope: 0.0,
+                signature: format!("narrow line at {} Hz", sig3(line.frequency_hz)),
+                text,
+                line: Some(line),
+            });
+        }
         let e: Vec<Vec<f64>> = runs
             .iter()
             .zip(&preds)
@@ -115,20 +161,19 @@ pub(super) fn unexplained(
         let signature = signature_words(spec.low_slope, b)
             .trim_start_matches(", ")
             .to_string();
-        let explained_here = chosen.iter().any(|c| c.effect.dof() == Some(dof));
         out.push(Unexplained {
             dof,
             band: b.clone(),
             low_slope: spec.low_slope,
             text: format!(
-                "{}: structure no candidate explains{} — 1-step residual {:.0} dB above the noise floor at {:.3}–{:.3} Hz, {signature}.",
+                "{}: structure no candidate explains{after} — 1-step residual {:.0} dB above the noise floor at {:.3}–{:.3} Hz, {signature}.",
                 capital(dof.name()),
-                if explained_here { " after the chosen terms" } else { "" },
                 b.excess_db,
                 b.f_lo_hz,
                 b.f_hi_hz
             ),
             signature,
+            line: None,
         });
     }
     out

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::candidates::{Effect, Family};
 use super::data::Restoring;
 use super::experiment::ExperimentProposal;
+use super::lines::SpectralLine;
 use super::locate::LocationReport;
 use super::model::ModelTerm;
 use super::residual::{BandPower, Whiteness};
@@ -165,6 +166,10 @@ pub struct Unexplained {
     pub signature: String,
     /// The sentence.
     pub text: String,
+    /// The narrow line this entry reports, if it is one (then `band` is
+    /// the line's main lobe).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line: Option<SpectralLine>,
 }
 
 /// The augmented model as numbers (row-major matrices).

@@ -17,6 +17,8 @@ use super::document::{ModelDocument, ModelKind};
 use super::error::IdentifyError;
 use super::outcome::Identified;
 use super::roles::nearest_grid_index;
+use crate::discrepancy::lines::SpectralLine;
+use crate::discrepancy::locate::capital;
 use crate::discrepancy::{
     DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, Record, Verdict, discover_from,
 };
@@ -530,8 +532,16 @@ fn summarize(
     // Unexplained structure, per DOF across the grid (the per-speed
     // signatures are in each point's report).
     let mut left: BTreeMap<Dof, (Vec<f64>, f64, f64)> = BTreeMap::new();
+    let mut periodic: BTreeMap<Dof, Vec<(f64, &SpectralLine)>> = BTreeMap::new();
     for p in points {
         for u in &p.report.unexplained {
+            if let Some(l) = &u.line {
+                periodic
+                    .entry(u.dof)
+                    .or_default()
+                    .push((p.grid_speed_mps, l));
+                continue;
+            }
             let e = left
                 .entry(u.dof)
                 .or_insert((vec![], f64::INFINITY, f64::NEG_INFINITY));
@@ -539,6 +549,36 @@ fn summarize(
             e.1 = e.1.min(u.band.excess_db);
             e.2 = e.2.max(u.band.excess_db);
         }
+    }
+    for (dof, lines) in &periodic {
+        let speeds: Vec<f64> = lines.iter().map(|(v, _)| *v).collect();
+        let range = |f: &dyn Fn(&SpectralLine) -> f64| {
+            let lo = lines
+                .iter()
+                .map(|(_, l)| f(l))
+                .fold(f64::INFINITY, f64::min);
+            let hi = lines
+                .iter()
+                .map(|(_, l)| f(l))
+                .fold(f64::NEG_INFINITY, f64::max);
+            if sig3(lo) == sig3(hi) {
+                sig3(lo)
+            } else {
+                format!("{}–{}", sig3(lo), sig3(hi))
+            }
+        };
+        let (shown, runs) = lines
+            .iter()
+            .fold((0, 0), |(a, b), (_, l)| (a + l.runs_with_line, b + l.runs));
+        out.push(format!(
+            "{}: a periodic force at {} Hz, about {} {} in amplitude, at {} m/s (in {shown} of {runs} runs): it comes from outside the model's physics (waves, vortex shedding, machinery), and nothing physical is named in {} at any speed.",
+            capital(dof.name()),
+            range(&|l| l.frequency_hz),
+            range(&|l| l.amplitude),
+            dof.force_unit(),
+            speeds_text(&speeds),
+            dof.name()
+        ));
     }
     for (dof, (speeds, lo, hi)) in &left {
         out.push(format!(

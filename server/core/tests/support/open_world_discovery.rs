@@ -25,10 +25,12 @@ fn discovery_baseline_settings() -> LambdaCampaignSettings {
         ..LambdaCampaignSettings::default()
     }
 }
+use seatrial_core::discrepancy::lines::SpectralLine;
 use seatrial_core::identification::discover_campaign::{
     DiscoverCampaignSettings, discover_campaign,
 };
 use seatrial_core::numbers::sig3;
+use seatrial_core::planning::Dof;
 use seatrial_core::validation::nrmse_fit;
 use seatrial_truth::plant::DelayLine;
 use seatrial_truth::{
@@ -97,6 +99,8 @@ pub struct DiscoveryCase {
     /// Structure left unexplained, per grid speed: "speed: DOF band
     /// (excess, peak)".
     pub unexplained: Vec<String>,
+    /// Periodic forces left unexplained: grid speed, DOF, line.
+    pub lines: Vec<(f64, Dof, SpectralLine)>,
     /// The window test of a chosen current, per grid speed that ran it.
     pub current_drift: Vec<String>,
 }
@@ -256,8 +260,19 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         .points
         .iter()
         .flat_map(|p| {
-            p.report.unexplained.iter().map(|u| {
-                format!(
+            p.report.unexplained.iter().map(|u| match &u.line {
+                Some(l) => format!(
+                    "{:.2} m/s: {} line at {:.4} Hz, {:.3} {} ({} of {} runs, +{:.0} dB)",
+                    p.grid_speed_mps,
+                    u.dof.name(),
+                    l.frequency_hz,
+                    l.amplitude,
+                    u.dof.force_unit(),
+                    l.runs_with_line,
+                    l.runs,
+                    l.excess_db
+                ),
+                None => format!(
                     "{:.2} m/s: {} {:.3}–{:.3} Hz +{:.0} dB (peak {:.3} Hz)",
                     p.grid_speed_mps,
                     u.dof.name(),
@@ -265,8 +280,19 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
                     u.band.f_hi_hz,
                     u.band.excess_db,
                     u.band.peak_hz
-                )
+                ),
             })
+        })
+        .collect();
+    let lines = out
+        .report
+        .points
+        .iter()
+        .flat_map(|p| {
+            p.report
+                .unexplained
+                .iter()
+                .filter_map(|u| u.line.clone().map(|l| (p.grid_speed_mps, u.dof, l)))
         })
         .collect();
     let current_drift = out
@@ -341,6 +367,7 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         gaps,
         secs: [t_flown, t_identified - t_flown, discovery_s],
         unexplained,
+        lines,
         current_drift,
     }
 }
