@@ -62,14 +62,19 @@ pub(crate) struct Prepared<'a> {
     /// Filtered regressors that depend on the data alone, by (term,
     /// coefficient, row, run).
     regressors: RegressorCache,
+    /// Baseline parts of the regression blocks, shared by every
+    /// hypothesis that frees the same entries of a row.
+    base_blocks: BaseCache,
 }
 
 /// Filtered regressors by (term, coefficient, row, run).
 type RegressorCache = RefCell<HashMap<(Effect, usize, usize, usize), Rc<Vec<f64>>>>;
 
+use blocks::{BaseCache, dot, weighted};
+
 /// One (row, run) block of the stacked regression: global parameter
 /// indices, their weighted columns, the weighted target.
-type Block = (Vec<usize>, Vec<Vec<f64>>, Vec<f64>);
+type Block = (Vec<usize>, Vec<Rc<Vec<f64>>>, Rc<Vec<f64>>);
 
 /// A fitted hypothesis.
 #[derive(Debug, Clone)]
@@ -175,6 +180,7 @@ impl<'a> Prepared<'a> {
             kappa: 1.0,
             hac_lags,
             regressors: RefCell::new(HashMap::new()),
+            base_blocks: RefCell::new(HashMap::new()),
         };
         let all: Vec<usize> = (0..records.len()).collect();
         let mut weights = vec![1.0; n];
@@ -364,42 +370,19 @@ impl<'a> Prepared<'a> {
                 let dof = dofs[r];
                 // Target [λτ_a] − [λg]: the applied force depends on the
                 // actuator hypotheses of this DOF.
-                let lam_tau_a = if shapes.iter().any(|(e, _)| e.acts_on(dof)) {
+                let lam_tau_a = shapes.iter().any(|(e, _)| e.acts_on(dof)).then(|| {
                     let (x, lag) = actuate(rec.tau.column(r).as_slice(), dof, &shapes);
                     match lag {
                         Some(t) => self.svf.foh(&lag_zoh(&x, t, rec.h)),
                         None => self.svf.zoh(&x),
                     }
-                } else {
-                    pr.lam_tau[r].clone()
-                };
+                });
                 let (mf, df) = &freed[ri];
-                let held = |k: usize| {
-                    let (m, d) = (&self.baseline.m, &self.baseline.d_bar);
-                    (0..dofs.len())
-                        .map(|j| {
-                            let mh = if mf.contains(&j) { 0.0 } else { m[(r, j)] };
-                            let dh = if df.contains(&j) { 0.0 } else { d[(r, j)] };
-                            mh * pr.dlam_nu[j][k] + dh * pr.lam_nu[j][k]
-                        })
-                        .sum::<f64>()
-                };
-                let y: Vec<f64> = (self.skip..len)
-                    .map(|k| w * (lam_tau_a[k] - pr.lam_g[r][k] - held(k)))
-                    .collect();
-                let mut idx = Vec::new();
-                let mut cols: Vec<Vec<f64>> = Vec::new();
-                let mut q = base_index[ri];
-                for &j in mf {
-                    idx.push(q);
-                    q += 1;
-                    cols.push(pr.dlam_nu[j][self.skip..].iter().map(|x| w * x).collect());
-                }
-                for &j in df {
-                    idx.push(q);
-                    q += 1;
-                    cols.push(pr.lam_nu[j][self.skip..].iter().map(|x| w * x).collect());
-                }
+                let bb = self.base_block(run, r, w, mf, df, lam_tau_a);
+                let nb = bb.cols.len();
+                let y = Rc::clone(&bb.y);
+                let mut idx: Vec<usize> = (base_index[ri]..base_index[ri] + nb).collect();
+                let mut cols: Vec<Rc<Vec<f64>>> = bb.cols.clone();
                 for (si, s) in specs.iter().enumerate() {
                     let nl = s.effect.n_linear();
                     if nl == 0 || !s.effect.rows(dofs, &self.baseline.d_bar).contains(&r) {
@@ -408,21 +391,40 @@ impl<'a> Prepared<'a> {
                     if let Effect::Coupling { from, .. } = s.effect {
                         let j = dofs.iter().position(|&d| d == from)?;
                         idx.push(theta_index[si]);
-                        cols.push(pr.dlam_nu[j][self.skip..].iter().map(|x| w * x).collect());
+                        cols.push(Rc::new(weighted(&pr.dlam_nu[j][self.skip..], w)));
                         idx.push(theta_index[si] + 1);
-                        cols.push(pr.lam_nu[j][self.skip..].iter().map(|x| w * x).collect());
+                        cols.push(Rc::new(weighted(&pr.lam_nu[j][self.skip..], w)));
                         continue;
                     }
                     for pi in 0..nl {
                         let f = self.filtered_regressor(s.effect, pi, r, run, &ctx);
                         idx.push(theta_index[si] + pi);
-                        cols.push(f[self.skip..].iter().map(|x| w * x).collect());
+                        cols.push(Rc::new(weighted(&f[self.skip..], w)));
                     }
                 }
+                // The baseline block's products come from the cache; the
+                // terms' columns are multiplied with every column.
+                let mut prods = vec![0.0; idx.len() + 1];
                 for a in 0..idx.len() {
-                    bvec[idx[a]] += dot(&cols[a], &y);
+                    if a < nb {
+                        bvec[idx[a]] += bb.by[a];
+                    }
+                    let from = a.max(nb);
+                    let ys: Vec<&[f64]> = std::iter::once(y.as_slice())
+                        .chain(cols[from..].iter().map(|c| c.as_slice()))
+                        .collect();
+                    let out = &mut prods[..ys.len()];
+                    out.fill(0.0);
+                    crate::kernels::dots(&cols[a], &ys, out);
+                    if a >= nb {
+                        bvec[idx[a]] += out[0];
+                    }
                     for b in a..idx.len() {
-                        let v = dot(&cols[a], &cols[b]);
+                        let v = if b < nb {
+                            bb.gram[a * nb + b]
+                        } else {
+                            out[1 + b - from]
+                        };
                         hmat[(idx[a], idx[b])] += v;
                         if a != b {
                             hmat[(idx[b], idx[a])] += v;
@@ -441,15 +443,15 @@ impl<'a> Prepared<'a> {
         let mut sse = 0.0;
         let mut resid = Vec::with_capacity(blocks.len());
         for (idx, cols, y) in &blocks {
-            let e: Vec<f64> = (0..y.len())
-                .map(|k| {
-                    y[k] - idx
-                        .iter()
-                        .zip(cols)
-                        .map(|(&i, c)| theta_all[i] * c[k])
-                        .sum::<f64>()
-                })
-                .collect();
+            // Σ_i θ_i c_i[k] column by column (the same order per sample).
+            let mut fitted = vec![0.0; y.len()];
+            for (&i, c) in idx.iter().zip(cols) {
+                let t = theta_all[i];
+                for (f, v) in fitted.iter_mut().zip(c.iter()) {
+                    *f += t * v;
+                }
+            }
+            let e: Vec<f64> = y.iter().zip(&fitted).map(|(y, f)| y - f).collect();
             sse += dot(&e, &e);
             resid.push(e);
         }
@@ -597,9 +599,9 @@ impl<'a> Prepared<'a> {
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
+/// Smallest Cholesky pivot of the Jacobi-scaled normal matrix accepted as
+/// non-singular (condition ≈ 10¹⁰).
+const PIVOT_FLOOR: f64 = 1e-10;
 
 /// Solves H θ = b with Jacobi scaling (columns span forces of 10⁴ N and
 /// velocities of 10⁻² m/s); returns θ and H⁻¹.
@@ -613,7 +615,15 @@ fn solve_scaled(h: &DMatrix<f64>, b: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>)>
         .collect();
     let mut hs = DMatrix::from_fn(p, p, |i, j| h[(i, j)] * s[i] * s[j]);
     let bs = nalgebra::DVector::from_fn(p, |i, _| b[i] * s[i]);
-    let inv = match hs.clone().cholesky() {
+    // A pivot below 1e-10 of the unit diagonal is a column the others
+    // determine to rounding (a term collinear with D̄): whether Cholesky
+    // then succeeds is chance, and its inverse is noise. The pseudo-inverse
+    // gives the minimum-norm fit instead.
+    let factor = hs
+        .clone()
+        .cholesky()
+        .filter(|c| (0..p).all(|i| c.l_dirty()[(i, i)].powi(2) > PIVOT_FLOOR));
+    let inv = match factor {
         Some(c) => c.inverse(),
         None => {
             for i in 0..p {
@@ -631,6 +641,7 @@ fn solve_scaled(h: &DMatrix<f64>, b: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>)>
     Some((theta, h_inv))
 }
 
+mod blocks;
 mod kstep;
 mod profile;
 mod regressors;

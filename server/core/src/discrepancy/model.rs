@@ -352,15 +352,20 @@ impl AugmentedModel {
                 dx[a0] = phi_dot;
                 dx[a0 + 1] = theta_dot;
             }
-            let mut tau_a = u.to_vec();
+            // n ≤ 6: the DOFs are distinct.
+            let mut tau_a = [0.0; 6];
+            tau_a[..n].copy_from_slice(u);
             for (s, &i) in lag_dofs.iter().enumerate() {
                 let t_a = input.lag[i].unwrap_or(1.0);
                 tau_a[i] = x[n + s];
                 dx[n + s] = (u[i] - x[n + s]) / t_a;
             }
-            let g = self.restoring.g(&eta);
-            let g: Vec<f64> = self.dofs.iter().map(|d| g[d.index()]).collect();
-            self.nu_dot(&x[..n], &tau_a, &g, &eta, &mut dx[..n]);
+            let g6 = self.restoring.g(&eta);
+            let mut g = [0.0; 6];
+            for (gi, d) in g.iter_mut().zip(&self.dofs) {
+                *gi = g6[d.index()];
+            }
+            self.nu_dot(&x[..n], &tau_a[..n], &g[..n], &eta, &mut dx[..n]);
         };
         for _ in 0..sub {
             rk4_step(&mut f, &mut x, &u, h);

@@ -9,24 +9,34 @@ where
     F: FnMut(&[f64], &[f64], &mut [f64]),
 {
     let n = x.len();
-    let mut k1 = vec![0.0; n];
-    let mut k2 = vec![0.0; n];
-    let mut k3 = vec![0.0; n];
-    let mut k4 = vec![0.0; n];
-    let mut tmp = vec![0.0; n];
-    f(x, u, &mut k1);
+    // Stages on the stack for the small systems stepped millions of times
+    // (a vehicle's ν with a few extra states), on the heap beyond.
+    const SMALL: usize = 16;
+    let mut stack = [0.0f64; 5 * SMALL];
+    let mut heap = Vec::new();
+    let buf: &mut [f64] = if n <= SMALL {
+        &mut stack[..5 * n]
+    } else {
+        heap.resize(5 * n, 0.0);
+        &mut heap
+    };
+    let (k1, rest) = buf.split_at_mut(n);
+    let (k2, rest) = rest.split_at_mut(n);
+    let (k3, rest) = rest.split_at_mut(n);
+    let (k4, tmp) = rest.split_at_mut(n);
+    f(x, u, k1);
     for i in 0..n {
         tmp[i] = x[i] + 0.5 * h * k1[i];
     }
-    f(&tmp, u, &mut k2);
+    f(tmp, u, k2);
     for i in 0..n {
         tmp[i] = x[i] + 0.5 * h * k2[i];
     }
-    f(&tmp, u, &mut k3);
+    f(tmp, u, k3);
     for i in 0..n {
         tmp[i] = x[i] + h * k3[i];
     }
-    f(&tmp, u, &mut k4);
+    f(tmp, u, k4);
     for i in 0..n {
         x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
     }

@@ -155,3 +155,54 @@ fn the_current_regressor_from_kept_signals_is_the_filtered_direct_one() {
         }
     }
 }
+
+/// The baseline blocks kept between fits (`fit/blocks.rs`) change no
+/// result: a fit whose actuator hypothesis reshapes the target, then one
+/// on the logged τ, give bit for bit what each gives on a fresh
+/// preparation, and a repeated fit gives the same again.
+#[test]
+fn fits_from_kept_baseline_blocks_equal_fresh_ones() {
+    let nu = |t: f64| {
+        (
+            0.6 * (0.3 * t).sin() + 0.2 * (1.1 * t).sin(),
+            0.18 * (0.3 * t).cos() + 0.22 * (1.1 * t).cos(),
+        )
+    };
+    let (baseline, records) = surge_record(nu, 400.0);
+    let quad = Spec {
+        effect: Effect::QuadraticDamping { dof: Dof::Surge },
+        shape: None,
+    };
+    let lag = Spec {
+        effect: Effect::ActuatorLag { dof: Dof::Surge },
+        shape: Some(0.3),
+    };
+    let fresh = |spec: Spec| {
+        let prep = Prepared::new(&baseline, &records, 0.5, 10, 5).expect("prepared");
+        prep.fit(&[spec], &[], &[0], true).expect("fit")
+    };
+    let same = |a: &FitOut, b: &FitOut| {
+        assert_eq!(a.theta, b.theta);
+        assert_eq!(a.base, b.base);
+        assert_eq!(a.sse.to_bits(), b.sse.to_bits());
+        assert_eq!(a.resid, b.resid);
+        assert_eq!(a.cov, b.cov);
+    };
+    let prep = Prepared::new(&baseline, &records, 0.5, 10, 5).expect("prepared");
+    let lagged = prep.fit(&[lag], &[], &[0], true).expect("lag");
+    let plain = prep.fit(&[quad], &[], &[0], true).expect("quad");
+    same(&lagged, &fresh(lag));
+    same(&plain, &fresh(quad));
+    same(
+        &prep.fit(&[lag], &[], &[0], true).expect("lag again"),
+        &lagged,
+    );
+    // The lag reshapes the target: its fit is not the plain one's.
+    assert_ne!(lagged.sse.to_bits(), plain.sse.to_bits());
+    // The quadratic term of the record is found.
+    assert!(
+        (plain.theta[0][0] / 400.0 - 1.0).abs() < 0.1,
+        "{:?}",
+        plain.theta
+    );
+}
