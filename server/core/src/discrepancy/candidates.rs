@@ -435,7 +435,7 @@ impl Effect {
             }
             Effect::CubicDamping { dof } if dof == row_dof => v(dof).powi(3),
             Effect::CrossDamping { dof, from } if dof == row_dof => v(from).abs() * v(dof),
-            Effect::CoriolisFromM => coriolis_force(ctx.dofs, ctx.m_ref, nu)[row],
+            Effect::CoriolisFromM => coriolis_force6(ctx.dofs, ctx.m_ref, nu)[row_dof.index()],
             Effect::CoriolisProduct { dof, a, b } if dof == row_dof => v(a) * v(b),
             Effect::Restoring { dof, shape } if dof == row_dof => {
                 let (sp, cp) = eta[3].sin_cos();
@@ -499,9 +499,9 @@ impl Effect {
     ) {
         match *self {
             Effect::CoriolisFromM => {
-                let c = coriolis_force(ctx.dofs, ctx.m_ref, nu);
-                for (o, ci) in out.iter_mut().zip(c) {
-                    *o += theta[0] * ci;
+                let c = coriolis_force6(ctx.dofs, ctx.m_ref, nu);
+                for (o, d) in out.iter_mut().zip(ctx.dofs) {
+                    *o += theta[0] * c[d.index()];
                 }
             }
             Effect::Current => {
@@ -553,6 +553,7 @@ impl TermContext<'_> {
 }
 
 pub use crate::models::coriolis::coriolis_force;
+use crate::models::coriolis::coriolis_force6;
 
 /// Which candidate families to try.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -91,12 +91,23 @@ pub fn coriolis(m: &DMatrix<f64>, nu: &DVector<f64>) -> Result<DMatrix<f64>, Mod
 /// velocities zero, so a horizontal model gets the 3-DOF C(ν)ν. Non-finite
 /// input propagates (no error: a diverging simulation shows as such).
 pub fn coriolis_force(dofs: &[Dof], m: &DMatrix<f64>, nu: &[f64]) -> Vec<f64> {
+    let f6 = coriolis_force6(dofs, m, nu);
+    dofs.iter().map(|d| f6[d.index()]).collect()
+}
+
+/// [`coriolis_force`] in the six DOFs' order ([`Dof::index`]), zero in the
+/// DOFs not modelled; nothing allocated (discovery evaluates it per RK4
+/// stage of every k-step prediction).
+pub fn coriolis_force6(dofs: &[Dof], m: &DMatrix<f64>, nu: &[f64]) -> [f64; 6] {
+    let n = dofs.len();
+    let ms = m.as_slice();
     let mut m6 = [[0.0; 6]; 6];
     let mut v6 = [0.0; 6];
     for (i, di) in dofs.iter().enumerate() {
         v6[di.index()] = nu[i];
         for (j, dj) in dofs.iter().enumerate() {
-            m6[di.index()][dj.index()] = 0.5 * (m[(i, j)] + m[(j, i)]);
+            // Column-major: M_ij at i + j·n.
+            m6[di.index()][dj.index()] = 0.5 * (ms[i + j * n] + ms[j + i * n]);
         }
     }
     let a: [f64; 6] = std::array::from_fn(|i| (0..6).map(|j| m6[i][j] * v6[j]).sum());
@@ -112,15 +123,14 @@ pub fn coriolis_force(dofs: &[Dof], m: &DMatrix<f64>, nu: &[f64]) -> Vec<f64> {
     let lin = cross(n2, a1);
     let ang1 = cross(n1, a1);
     let ang2 = cross(n2, a2);
-    let f6 = [
+    [
         lin[0],
         lin[1],
         lin[2],
         ang1[0] + ang2[0],
         ang1[1] + ang2[1],
         ang1[2] + ang2[2],
-    ];
-    dofs.iter().map(|d| f6[d.index()]).collect()
+    ]
 }
 
 /// The second-order part of C(ν)ν about straight-ahead motion at the
