@@ -47,6 +47,13 @@ pub fn quality_report(
     rec: &UniformRecord,
     spec: &QualitySpec,
 ) -> Result<QualityReport, QualityError> {
+    // On a thread of rayon's pool from the start, so that the buffers the
+    // spectra keep per thread are taken and given back on the same one
+    // (from a thread outside the pool, each hand-off would land elsewhere
+    // and every call would fault fresh pages in).
+    if rayon::current_thread_index().is_none() {
+        return rayon::join(|| quality_report(rec, spec), || ()).0;
+    }
     let prep = prepare(rec, spec)?;
     let fs = prep.fs;
     let no = prep.outputs.len();
@@ -63,8 +70,12 @@ pub fn quality_report(
     // The spectra and the time-domain analyses (the regressor's Gram
     // matrix with every channel's statistics, in one pass; then the PE
     // orders, which centre on the means) read the same samples and nothing
-    // of each other: on two threads. A non-finite sample is found by the
-    // second (the first does not look; its result is then dropped).
+    // of each other: on two threads. The time-domain part starts at once
+    // on the other thread, which then takes the Welch estimate's second
+    // part (the smaller, see `spectra::TIME_DOMAIN_SHARE`); the pairs' plotted
+    // spectra split finely, so the threads end together. A non-finite
+    // sample is found by the statistics (the spectra do not look; they are
+    // then dropped).
     let (spectral, time_domain) = crate::par::join(
         true,
         || compute(&prep),

@@ -23,19 +23,38 @@ pub(super) struct Batch {
 }
 
 /// The batches of every block, in order: a block's segments from its
-/// start, [`BATCH`] at a time.
-pub(super) fn batches(blocks: &[Range<usize>], cfg: &WelchConfig) -> Vec<Batch> {
-    blocks
-        .iter()
-        .flat_map(|block| {
-            let n_block = cfg.n_segments(block.len());
-            (0..n_block).step_by(BATCH).map(move |first| Batch {
+/// start, [`BATCH`] at a time, and a batch ends at the segment `cut`
+/// (counted over all blocks) when there is one, so that the estimate can
+/// be split there.
+pub(super) fn batches(
+    blocks: &[Range<usize>],
+    cfg: &WelchConfig,
+    cut: Option<usize>,
+) -> Vec<Batch> {
+    let mut out = Vec::new();
+    let mut before = 0;
+    for block in blocks {
+        let n_block = cfg.n_segments(block.len());
+        // The cut within this block, if it falls strictly inside it.
+        let inner = cut
+            .and_then(|c| c.checked_sub(before))
+            .filter(|&c| c > 0 && c < n_block);
+        let mut first = 0;
+        while first < n_block {
+            let end = match inner {
+                Some(c) if first < c => (first + BATCH).min(c),
+                _ => (first + BATCH).min(n_block),
+            };
+            out.push(Batch {
                 block: block.clone(),
                 first,
-                count: BATCH.min(n_block - first),
-            })
-        })
-        .collect()
+                count: end - first,
+            });
+            first = end;
+        }
+        before += n_block;
+    }
+    out
 }
 
 /// Most parts an estimate is split into (see [`run_parts`]).
@@ -82,12 +101,16 @@ pub(super) fn split_point(batches: &[Batch], share: (usize, usize)) -> usize {
 /// the pool, see `crate::par`) and adds them to `acc` (zeroed): each part
 /// sums into its own accumulators, added in order afterwards, so the
 /// result depends on `parts` and the sizes, not on the threads.
+/// `share` is the share of the segments in the first part of the first
+/// split (further splits halve): the batches should end at that segment
+/// (see [`batches`]).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn run_parts(
     engine: &SegmentFft,
     acc: &mut Accumulators,
     batches: &[Batch],
     parts: usize,
+    share: (usize, usize),
     channels: &[&[f64]],
     cfg: &WelchConfig,
     own_mean: bool,
@@ -96,7 +119,7 @@ pub(super) fn run_parts(
     let split = if parts < 2 {
         batches.len()
     } else {
-        split_point(batches, (parts / 2, parts))
+        split_point(batches, share)
     };
     if split >= batches.len() {
         let mut engine = engine.clone();
@@ -123,6 +146,7 @@ pub(super) fn run_parts(
                 acc,
                 head,
                 first,
+                (1, 2),
                 channels,
                 cfg,
                 own_mean,
@@ -136,6 +160,7 @@ pub(super) fn run_parts(
                 &mut second,
                 tail,
                 parts - first,
+                (1, 2),
                 channels,
                 cfg,
                 own_mean,
@@ -203,6 +228,7 @@ pub(super) fn run_batches(
 #[cfg(test)]
 #[allow(clippy::single_range_in_vec_init)] // vectors of blocks
 mod tests {
+    use super::super::multichannel::multi_welch_finite;
     use super::super::test_support::{Gaussian, assert_rel_close};
     use super::super::{Complex, Detrend, csd, multi_welch, welch};
     use super::*;
@@ -210,7 +236,7 @@ mod tests {
     #[test]
     fn splits_land_on_batch_boundaries_by_share() {
         let cfg = WelchConfig::hann(1.0, 4096);
-        let one = batches(&[0..36_000], &cfg);
+        let one = batches(&[0..36_000], &cfg, None);
         assert_eq!(one.iter().map(|b| b.count).sum::<usize>(), 16);
         assert_eq!(split_point(&one, (1, 2)), 2);
         assert_eq!(split_point(&one, (1, 4)), 1);
@@ -221,10 +247,31 @@ mod tests {
         assert_eq!(parts(PARALLEL_WORK), 2);
         assert_eq!(parts(16 * 12 * 4096), 2);
         assert_eq!(parts(usize::MAX), MAX_PARTS);
-        let two = batches(&[0..20_480, 30_000..50_480], &cfg);
+        let two = batches(&[0..20_480, 30_000..50_480], &cfg, None);
         let counts: Vec<usize> = two.iter().map(|b| b.count).collect();
         assert_eq!(counts, vec![4, 4, 1, 4, 4, 1]);
         assert_eq!(split_point(&two, (1, 2)), 3);
+    }
+
+    /// A cut ends a batch at that segment, in whichever block it falls, so
+    /// that the split by its share lands exactly on it.
+    #[test]
+    fn a_cut_ends_a_batch_where_the_share_splits() {
+        let cfg = WelchConfig::hann(1.0, 4096);
+        let counts = |b: &[Batch]| b.iter().map(|b| b.count).collect::<Vec<_>>();
+        let one = batches(&[0..36_000], &cfg, Some(10));
+        assert_eq!(counts(&one), vec![4, 4, 2, 4, 2]);
+        assert_eq!(split_point(&one, (5, 8)), 3);
+        let two = batches(&[0..20_480, 30_000..50_480], &cfg, Some(12));
+        assert_eq!(counts(&two), vec![4, 4, 1, 3, 4, 2]);
+        assert_eq!(two[3].first, 0);
+        assert_eq!(two[4].first, 3);
+        assert_eq!(split_point(&two, (2, 3)), 4);
+        // A cut at a block's edge or beyond the end changes nothing.
+        for cut in [0, 9, 18, 40] {
+            let b = batches(&[0..20_480, 30_000..50_480], &cfg, Some(cut));
+            assert_eq!(counts(&b), vec![4, 4, 1, 4, 4, 1], "cut {cut}");
+        }
     }
 
     /// The two-thread estimate (large enough to be split) equals the
@@ -248,20 +295,26 @@ mod tests {
             WelchConfig::hann(10.0, 256).with_detrend(Detrend::Linear),
         ] {
             let n_seg = cfg.n_segments(n);
-            let list = batches(&[0..n], &cfg);
+            let list = batches(&[0..n], &cfg, None);
             assert!(parts(n_seg * 6 * 256) >= 2);
             assert!(split_point(&list, (1, 2)) < list.len());
             let s = multi_welch(&refs, &[0..n], &pairs, &cfg).unwrap();
+            // The quality report's uneven split, as planes.
+            let planes = multi_welch_finite(&refs, &[0..n], &pairs, &cfg, (5, 8)).unwrap();
             for (c, x) in refs.iter().enumerate() {
                 let w = welch(x, &cfg).unwrap().values;
                 assert_rel_close(&s.auto[c], &w, 1e-12, "auto");
+                assert_rel_close(&planes.auto[c], &w, 1e-12, "auto, 5/8 split");
             }
             for (p, &(i, j)) in pairs.iter().enumerate() {
                 let e = csd(refs[i], refs[j], &cfg).unwrap().values;
                 let scale = e.iter().fold(0.0f64, |m, v| m.max(v.norm()));
-                for (a, e) in s.cross[p].iter().zip(&e) {
+                let (re, im) = planes.cross(p);
+                for (k, (a, e)) in s.cross[p].iter().zip(&e).enumerate() {
                     let d: Complex<f64> = a - e;
                     assert!(d.norm() <= 1e-12 * scale, "pair {p}: {a} vs {e}");
+                    let d = Complex::new(re[k], im[k]) - e;
+                    assert!(d.norm() <= 1e-12 * scale, "pair {p}, 5/8 split, bin {k}");
                 }
             }
         }

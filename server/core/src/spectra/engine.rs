@@ -1,13 +1,13 @@
 //! Shared Welch machinery: segment slicing, detrend, window, real FFT and the
 //! one-sided density scaling. One FFT plan and one set of buffers per call.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use realfft::num_complex::Complex;
 use realfft::{RealFftPlanner, RealToComplex};
 
 use super::detrend::detrend_in_place;
-use super::{Detrend, SpectraError, WelchConfig};
+use super::{Detrend, SpectraError, WelchConfig, Window};
 use crate::kernels::{fold8, has_avx2_fma, prefetch_line};
 
 /// Windowed, detrended real FFTs of the successive segments of a signal.
@@ -17,47 +17,98 @@ use crate::kernels::{fold8, has_avx2_fma, prefetch_line};
 /// plan (for a second thread) and has buffers of its own.
 #[derive(Clone)]
 pub(crate) struct SegmentFft {
-    fft: Arc<dyn RealToComplex<f64>>,
-    window: Vec<f64>,
-    window_power: f64,
+    plan: Arc<Plan>,
     detrend: Detrend,
     nperseg: usize,
     step: usize,
     n_segments: usize,
     input: Vec<f64>,
     scratch: Vec<Complex<f64>>,
+}
+
+/// What depends on the segment length and window only: the FFT plan, the
+/// window and its DFT. Kept between calls (see [`plan`]).
+struct Plan {
+    nperseg: usize,
+    window_kind: Window,
+    fft: Arc<dyn RealToComplex<f64>>,
+    window: Vec<f64>,
+    window_power: f64,
     /// `W = rfft(window)` at the bins where it is not zero to rounding
     /// (bins 0 and 1 of a periodic Hann): what a constant shifts.
     window_dft: Vec<(usize, Complex<f64>)>,
 }
 
+/// Plans kept for the last few segment lengths: planning a 4096-point FFT,
+/// its window and the window's DFT takes ~0.1 ms, a tenth of a 1-hour
+/// report's spectra.
+const KEPT_PLANS: usize = 8;
+
+/// Longest segment whose plan is kept (~1.5 MB of window and twiddles).
+const KEPT_NPERSEG: usize = 1 << 16;
+
+static PLANS: Mutex<Vec<Arc<Plan>>> = Mutex::new(Vec::new());
+
+/// The plan for `nperseg` and `window`, kept or made (and kept).
+fn plan(nperseg: usize, window_kind: Window) -> Arc<Plan> {
+    let found = |plans: &Vec<Arc<Plan>>| {
+        plans
+            .iter()
+            .find(|p| p.nperseg == nperseg && p.window_kind == window_kind)
+            .cloned()
+    };
+    // A poisoned lock only means another thread panicked while holding
+    // it: the list itself is always whole.
+    if let Some(p) = found(&PLANS.lock().unwrap_or_else(|e| e.into_inner())) {
+        return p;
+    }
+    let fft = RealFftPlanner::<f64>::new().plan_fft_forward(nperseg);
+    let window = window_kind.coefficients(nperseg);
+    let window_power = window.iter().map(|w| w * w).sum();
+    let mut input = fft.make_input_vec();
+    let mut scratch = fft.make_scratch_vec();
+    let window_dft = sparse_dft(&*fft, &window, &mut input, &mut scratch);
+    let made = Arc::new(Plan {
+        nperseg,
+        window_kind,
+        fft,
+        window,
+        window_power,
+        window_dft,
+    });
+    if nperseg > KEPT_NPERSEG {
+        return made;
+    }
+    let mut plans = PLANS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(p) = found(&plans) {
+        return p;
+    }
+    if plans.len() >= KEPT_PLANS {
+        plans.remove(0);
+    }
+    plans.push(Arc::clone(&made));
+    made
+}
+
 impl SegmentFft {
     /// Plans the FFT for a validated `cfg` applied to `n_samples` samples.
     pub(crate) fn new(cfg: &WelchConfig, n_samples: usize) -> Self {
-        let fft = RealFftPlanner::<f64>::new().plan_fft_forward(cfg.nperseg);
-        let window = cfg.window.coefficients(cfg.nperseg);
-        let window_power = window.iter().map(|w| w * w).sum();
-        let mut input = fft.make_input_vec();
-        let mut scratch = fft.make_scratch_vec();
-        let window_dft = sparse_dft(&*fft, &window, &mut input, &mut scratch);
+        let plan = plan(cfg.nperseg, cfg.window);
         SegmentFft {
-            fft,
-            window,
-            window_power,
+            input: plan.fft.make_input_vec(),
+            scratch: plan.fft.make_scratch_vec(),
+            plan,
             detrend: cfg.detrend,
             nperseg: cfg.nperseg,
             step: cfg.step(),
             n_segments: cfg.n_segments(n_samples),
-            input,
-            scratch,
-            window_dft,
         }
     }
 
     /// A zeroed buffer of the right length (`nperseg / 2 + 1`) for
     /// [`SegmentFft::transform`].
     pub(crate) fn make_output(&self) -> Vec<Complex<f64>> {
-        self.fft.make_output_vec()
+        self.plan.fft.make_output_vec()
     }
 
     /// Number of segments averaged.
@@ -87,7 +138,7 @@ impl SegmentFft {
         detrend_in_place(self.detrend, &mut self.input);
         self.input
             .iter_mut()
-            .zip(&self.window)
+            .zip(&self.plan.window)
             .for_each(|(v, w)| *v *= w);
         self.fft_of_input(out)
     }
@@ -121,10 +172,10 @@ impl SegmentFft {
                 ),
             ));
         }
-        let sum = window_shifted(&mut self.input, samples, &self.window, shift, prefetch);
+        let sum = window_shifted(&mut self.input, samples, &self.plan.window, shift, prefetch);
         self.fft_of_input(out)?;
         let offset = sum / self.nperseg as f64;
-        for &(k, w) in &self.window_dft {
+        for &(k, w) in &self.plan.window_dft {
             out[k] -= w * offset;
         }
         Ok(offset)
@@ -132,7 +183,8 @@ impl SegmentFft {
 
     /// `out = rfft(input)` (the input buffer is used as scratch).
     fn fft_of_input(&mut self, out: &mut [Complex<f64>]) -> Result<(), SpectraError> {
-        self.fft
+        self.plan
+            .fft
             .process_with_scratch(&mut self.input, out, &mut self.scratch)
             .map_err(|e| {
                 SpectraError::parameter(
@@ -147,7 +199,7 @@ impl SegmentFft {
     /// `c_k = 2` except for DC and, when `nperseg` is even, Nyquist.
     pub(crate) fn density_factors(&self, fs: f64) -> Vec<f64> {
         let nf = self.nperseg / 2 + 1;
-        let base = 1.0 / (fs * self.window_power) / self.n_segments.max(1) as f64;
+        let base = 1.0 / (fs * self.plan.window_power) / self.n_segments.max(1) as f64;
         (0..nf)
             .map(|k| {
                 let unpaired = k == 0 || (self.nperseg.is_multiple_of(2) && k == nf - 1);
@@ -256,6 +308,23 @@ mod tests {
     use super::*;
 
     #[test]
+    fn plans_are_kept_per_segment_length() {
+        // Lengths no other test uses: a plan is only dropped after eight
+        // other lengths were planned since.
+        let a = SegmentFft::new(&WelchConfig::hann(1.0, 96), 1000);
+        let b = SegmentFft::new(&WelchConfig::hann(5.0, 96).with_noverlap(10), 500);
+        let c = SegmentFft::new(&WelchConfig::hann(1.0, 98), 1000);
+        let big = KEPT_NPERSEG + 2;
+        let d = SegmentFft::new(&WelchConfig::hann(1.0, big), big);
+        let e = SegmentFft::new(&WelchConfig::hann(1.0, big), big);
+        assert!(!Arc::ptr_eq(&d.plan, &e.plan), "too long to keep");
+        assert!(Arc::ptr_eq(&a.plan, &b.plan));
+        assert!(!Arc::ptr_eq(&a.plan, &c.plan));
+        assert_eq!(c.plan.window.len(), 98);
+        assert_eq!((a.step, b.step, b.n_segments), (48, 86, 5));
+    }
+
+    #[test]
     fn transform_is_windowed_detrended_dft() {
         let cfg = WelchConfig::hann(1.0, 6).with_noverlap(2);
         let x: Vec<f64> = (0..14).map(|i| ((i * i) % 7) as f64 - 1.5).collect();
@@ -320,7 +389,11 @@ mod tests {
             }
             // The window's DFT is kept at Hann's two nonzero bins only.
             assert_eq!(
-                eng.window_dft.iter().map(|(k, _)| *k).collect::<Vec<_>>(),
+                eng.plan
+                    .window_dft
+                    .iter()
+                    .map(|(k, _)| *k)
+                    .collect::<Vec<_>>(),
                 vec![0, 1]
             );
         }

@@ -139,11 +139,11 @@ pub fn multi_welch(
             .map(|b| b.start + covered(cfg, b.len()).min(b.len())..b.end)
             .collect();
         require_finite(channels, &uncovered)?;
-        let (acc, factors) = compute(channels, blocks, pairs, cfg, n_segments, true)?;
+        let (acc, factors) = compute(channels, blocks, pairs, cfg, (n_segments, (1, 2)), true)?;
         Ok(acc.finish(pairs, &factors, cfg.frequencies(), n_segments))
     } else {
         require_finite(channels, blocks)?;
-        let (acc, factors) = compute(channels, blocks, pairs, cfg, n_segments, false)?;
+        let (acc, factors) = compute(channels, blocks, pairs, cfg, (n_segments, (1, 2)), false)?;
         Ok(acc.finish(pairs, &factors, cfg.frequencies(), n_segments))
     }
 }
@@ -160,16 +160,20 @@ fn covered(cfg: &WelchConfig, len: usize) -> usize {
 /// finite inside the blocks (the quality report does so while computing
 /// its statistics): skips that scan, one pass over every sample. A NaN
 /// left in gives NaN spectra, never a panic. The cross spectra stay in the
-/// accumulators' split planes (no copy into complex vectors); the values
-/// are those of [`multi_welch`] bit for bit.
+/// accumulators' split planes (no copy into complex vectors). A large
+/// estimate's first part, on the calling thread, holds `share` of the
+/// segments (a caller whose other thread starts with other work gives it
+/// more than half); with `(1, 2)` the values are those of [`multi_welch`]
+/// bit for bit, with another share they differ by rounding only.
 pub(crate) fn multi_welch_finite(
     channels: &[&[f64]],
     blocks: &[Range<usize>],
     pairs: &[(usize, usize)],
     cfg: &WelchConfig,
+    share: (usize, usize),
 ) -> Result<PlaneSpectra, SpectraError> {
     let n_segments = validate(channels, blocks, pairs, cfg)?;
-    let (acc, factors) = compute(channels, blocks, pairs, cfg, n_segments, false)?;
+    let (acc, factors) = compute(channels, blocks, pairs, cfg, (n_segments, share), false)?;
     Ok(acc.finish_planes(&factors, cfg.frequencies(), n_segments))
 }
 
@@ -188,7 +192,7 @@ fn compute(
     blocks: &[Range<usize>],
     pairs: &[(usize, usize)],
     cfg: &WelchConfig,
-    n_segments: usize,
+    (n_segments, share): (usize, (usize, usize)),
     check_finite: bool,
 ) -> Result<(Accumulators, Vec<f64>), SpectraError> {
     // `SegmentFft` scales by its own segment count: give it a length that
@@ -210,10 +214,12 @@ fn compute(
     let engine = SegmentFft::new(&engine_cfg, virtual_len);
     debug_assert_eq!(engine.n_segments(), n_segments);
 
-    let batches = batches(blocks, cfg);
     let work = n_segments
         .saturating_mul(channels.len())
         .saturating_mul(cfg.nperseg);
+    let parts = parts(work);
+    let cut = (parts >= 2).then(|| (n_segments * share.0 + share.1 / 2) / share.1);
+    let batches = batches(blocks, cfg, cut);
     let nf = cfg.n_freqs();
     let mut acc = Accumulators::new(channels.len(), pairs, nf);
     let factors = engine.density_factors(cfg.fs);
@@ -221,7 +227,8 @@ fn compute(
         &engine,
         &mut acc,
         &batches,
-        parts(work),
+        parts,
+        share,
         channels,
         cfg,
         own_mean,
