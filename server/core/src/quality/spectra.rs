@@ -7,7 +7,7 @@ use super::record::Prepared;
 use super::{PairSpectra, QualityError, WelchSummary};
 use crate::spectra::WelchConfig;
 use crate::spectra::multichannel::multi_welch_finite;
-use crate::spectra::unwrap_into;
+use crate::spectra::{cross_from_parts, unwrap_into};
 
 /// Pair bins (pairs × frequencies) from which the pairs' Bode data are
 /// spread over the pool: 8 pairs of 2049 bins take ~0.2 ms, many times a
@@ -72,7 +72,7 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
         pair_spectra(
             prep.input_names[i],
             prep.output_names[o - ni],
-            ms.cross(p),
+            ms.pair_sums(p),
             (&ms.auto[i], &inv[i]),
             &inv[o],
             scratch,
@@ -109,7 +109,8 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
     })
 }
 
-/// The plotted spectra of one pair from its CSD, its input PSD and the
+/// The plotted spectra of one pair from its Welch sums (the parts, added
+/// in order, times the density factors: its CSD), its input PSD and the
 /// reciprocals of both PSDs (0 where a PSD is 0).
 ///
 /// Same definitions as [`crate::spectra::CrossSpectra::coherence`] and
@@ -124,7 +125,7 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
 fn pair_spectra(
     input: &str,
     output: &str,
-    planes: (&[f64], &[f64]),
+    planes: (Vec<&[f64]>, &[f64]),
     pxx: (&[f64], &[f64]),
     inv_pyy: &[f64],
     scratch: &mut Scratch,
@@ -142,7 +143,7 @@ fn pair_spectra(
 fn pair_spectra_avx2(
     input: &str,
     output: &str,
-    planes: (&[f64], &[f64]),
+    planes: (Vec<&[f64]>, &[f64]),
     pxx: (&[f64], &[f64]),
     inv_pyy: &[f64],
     scratch: &mut Scratch,
@@ -154,14 +155,21 @@ fn pair_spectra_avx2(
 fn pair_spectra_body(
     input: &str,
     output: &str,
-    (re, im): (&[f64], &[f64]),
+    (parts, factors): (Vec<&[f64]>, &[f64]),
     (pxx, inv_pxx): (&[f64], &[f64]),
     inv_pyy: &[f64],
     scratch: &mut Scratch,
 ) -> PairSpectra {
+    let Scratch {
+        re,
+        im,
+        norm_sqr,
+        phase,
+    } = scratch;
+    cross_from_parts(&parts, factors, re, im);
+    let (re, im) = (&re[..], &im[..]);
     let nf = re.len();
     // |Pxy|² as `Complex::norm_sqr`: re² + im².
-    let norm_sqr = &mut scratch.norm_sqr;
     norm_sqr.clear();
     norm_sqr.extend(re.iter().zip(im).map(|(r, i)| r * r + i * i));
     let csd_magnitude: Vec<f64> = norm_sqr.iter().map(|v| v.sqrt()).collect();
@@ -178,7 +186,6 @@ fn pair_spectra_body(
     let mut h1_magnitude_db = vec![0.0; nf];
     log10_into(&h1_magnitude, &mut h1_magnitude_db);
     h1_magnitude_db.iter_mut().for_each(|d| *d *= 20.0);
-    let phase = &mut scratch.phase;
     phase.resize(nf, 0.0);
     atan2_into(im, re, phase);
     for (p, &a) in phase.iter_mut().zip(pxx) {
@@ -202,6 +209,9 @@ fn pair_spectra_body(
 /// Buffers reused from pair to pair.
 #[derive(Default)]
 struct Scratch {
+    /// `Re P_xy`, `Im P_xy`.
+    re: Vec<f64>,
+    im: Vec<f64>,
     norm_sqr: Vec<f64>,
     phase: Vec<f64>,
 }

@@ -28,6 +28,8 @@ pub(super) struct Accumulators {
     auto: Vec<f64>,
     /// Cross sums, `[pair][re | im][bin]`.
     cross: Vec<f64>,
+    /// Absorbed parts' cross sums, still to be added (see `absorb`).
+    held: Vec<Vec<f64>>,
     pairs: Vec<(usize, usize)>,
 }
 
@@ -52,6 +54,7 @@ impl Accumulators {
             planes: scratch::reused(n_channels * slots * 2 * nf),
             auto: scratch::reused(n_channels * nf),
             cross: scratch::reused(pairs.len() * 2 * nf),
+            held: Vec::new(),
             pairs: pairs.to_vec(),
         }
     }
@@ -158,19 +161,32 @@ impl Accumulators {
     }
 
     /// Adds the sums of `other` (same channels, pairs and bins) to these,
-    /// and keeps its buffers for the next call on this thread.
-    pub(super) fn absorb(&mut self, other: Accumulators) {
+    /// and keeps its buffers for the next call on this thread. The PSD
+    /// sums are added at once; `other`'s cross sums (with what it absorbed
+    /// added to them) are held apart and added where they are read
+    /// ([`PlaneSpectra::pair_sums`], [`Accumulators::finish`]): the pairs'
+    /// own pass then does it on every thread, not one pass on one thread.
+    pub(super) fn absorb(&mut self, mut other: Accumulators) {
         for (a, b) in self.auto.iter_mut().zip(&other.auto) {
             *a += b;
         }
-        let chunk = PARALLEL_VALUES / 2;
-        par_zip(&mut self.cross, &other.cross, chunk, |a, b| {
-            for (a, b) in a.iter_mut().zip(b) {
-                *a += b;
-            }
-        });
-        for buffer in [other.planes, other.auto, other.cross] {
+        other.fold_held();
+        self.held.push(other.cross);
+        for buffer in [other.planes, other.auto] {
             scratch::give_back(buffer);
+        }
+    }
+
+    /// Adds the held cross sums to the cross sums, in the order they were
+    /// absorbed.
+    fn fold_held(&mut self) {
+        for held in std::mem::take(&mut self.held) {
+            par_zip(&mut self.cross, &held, PARALLEL_VALUES / 2, |a, b| {
+                for (a, b) in a.iter_mut().zip(b) {
+                    *a += b;
+                }
+            });
+            scratch::give_back(held);
         }
     }
 
@@ -182,32 +198,16 @@ impl Accumulators {
             .collect()
     }
 
-    /// [`Accumulators::finish`] with the cross spectra left in their planes
-    /// (scaled in place: the same products as there).
+    /// [`Accumulators::finish`] with the cross sums left in their planes,
+    /// with the parts they are still to be added to and the density
+    /// factors: see [`PlaneSpectra::pair_sums`].
     pub(super) fn finish_planes(
-        mut self,
+        self,
         factors: &[f64],
         freqs: Vec<f64>,
         n_segments: usize,
     ) -> PlaneSpectra {
-        let nf = self.nf;
         let auto = self.scaled_auto(factors);
-        let planes_per_task = (PARALLEL_VALUES / nf.max(1)).max(1);
-        let scale = |planes: &mut [f64]| {
-            for plane in planes.chunks_exact_mut(nf.max(1)) {
-                for (v, f) in plane.iter_mut().zip(factors) {
-                    *v *= f;
-                }
-            }
-        };
-        if self.cross.len() >= 2 * PARALLEL_VALUES {
-            use rayon::prelude::*;
-            self.cross
-                .par_chunks_mut(planes_per_task * nf.max(1))
-                .for_each(scale);
-        } else {
-            scale(&mut self.cross);
-        }
         for buffer in [self.planes, self.auto] {
             scratch::give_back(buffer);
         }
@@ -216,18 +216,21 @@ impl Accumulators {
             auto,
             n_segments,
             cross: self.cross,
-            nf,
+            held: self.held,
+            factors: factors.to_vec(),
+            nf: self.nf,
         }
     }
 
     /// The spectra: sums times the density `factors`.
     pub(super) fn finish(
-        self,
+        mut self,
         pairs: &[(usize, usize)],
         factors: &[f64],
         freqs: Vec<f64>,
         n_segments: usize,
     ) -> MultiSpectra {
+        self.fold_held();
         let nf = self.nf;
         let auto = self.scaled_auto(factors);
         let cross = self
@@ -255,9 +258,9 @@ impl Accumulators {
     }
 }
 
-/// Values from which a pass over the cross sums (adding two parts,
-/// scaling) is spread over the pool, in tasks of about this many: a 6 × 6
-/// report's 1.2 MB of sums take ~0.08 ms per pass on one core.
+/// Values from which a pass adding two parts' cross sums is spread over
+/// the pool, in tasks of about this many: a 6 × 6 report's 1.2 MB of sums
+/// take ~0.06 ms per pass on one core.
 const PARALLEL_VALUES: usize = 1 << 16;
 
 /// `f(a_chunk, b_chunk)` over matching chunks of `chunk` values of `a` and
@@ -283,25 +286,74 @@ pub(crate) struct PlaneSpectra {
     pub auto: Vec<Vec<f64>>,
     /// Segments averaged.
     pub n_segments: usize,
-    /// Cross spectra, `[pair][re | im][bin]`.
+    /// Cross sums, `[pair][re | im][bin]`, and the other parts' sums of
+    /// the same shape, to be added in order, then scaled by `factors`.
     cross: Vec<f64>,
+    held: Vec<Vec<f64>>,
+    factors: Vec<f64>,
     nf: usize,
 }
 
 impl PlaneSpectra {
-    /// `(Re P_ij, Im P_ij)` of the `p`-th requested pair (empty when out of
-    /// range).
-    pub(crate) fn cross(&self, p: usize) -> (&[f64], &[f64]) {
-        let nf = self.nf;
-        self.cross
-            .get(p * 2 * nf..(p + 1) * 2 * nf)
-            .map_or((&[][..], &[][..]), |c| c.split_at(nf))
+    /// The sums of the `p`-th requested pair, `[re | im][bin]`: this
+    /// part's first, then the held parts' (empty when out of range), and
+    /// the density factors per bin. `P_ij = (Σ parts in order) · factor`,
+    /// see [`cross_from_parts`].
+    pub(crate) fn pair_sums(&self, p: usize) -> (Vec<&[f64]>, &[f64]) {
+        let span = p * 2 * self.nf..(p + 1) * 2 * self.nf;
+        let parts = std::iter::once(&self.cross)
+            .chain(&self.held)
+            .filter_map(|c| c.get(span.clone()))
+            .collect();
+        (parts, &self.factors)
+    }
+
+    /// `(Re P_ij, Im P_ij)` of the `p`-th requested pair into `re` and
+    /// `im` (resized to the bins; emptied when out of range): the parts'
+    /// sums added in order, times the density factor, the values
+    /// [`Accumulators::finish`] gives.
+    #[cfg(test)]
+    pub(crate) fn cross_into(&self, p: usize, re: &mut Vec<f64>, im: &mut Vec<f64>) {
+        let (parts, factors) = self.pair_sums(p);
+        cross_from_parts(&parts, factors, re, im);
+    }
+}
+
+/// `re, im` = (Σ `parts` in order) · `factors`, each part `[re | im][bin]`.
+#[inline(always)]
+pub(crate) fn cross_from_parts(
+    parts: &[&[f64]],
+    factors: &[f64],
+    re: &mut Vec<f64>,
+    im: &mut Vec<f64>,
+) {
+    let Some((first, rest)) = parts.split_first() else {
+        re.clear();
+        im.clear();
+        return;
+    };
+    let nf = first.len() / 2;
+    re.clear();
+    im.clear();
+    re.extend_from_slice(&first[..nf]);
+    im.extend_from_slice(&first[nf..]);
+    for part in rest {
+        let (r, i) = part.split_at(nf);
+        re.iter_mut().zip(r).for_each(|(a, b)| *a += b);
+        im.iter_mut().zip(i).for_each(|(a, b)| *a += b);
+    }
+    for ((r, i), f) in re.iter_mut().zip(im.iter_mut()).zip(factors) {
+        *r *= f;
+        *i *= f;
     }
 }
 
 impl Drop for PlaneSpectra {
     fn drop(&mut self) {
         scratch::give_back(std::mem::take(&mut self.cross));
+        for held in std::mem::take(&mut self.held) {
+            scratch::give_back(held);
+        }
     }
 }
 

@@ -309,7 +309,8 @@ mod tests {
             for (p, &(i, j)) in pairs.iter().enumerate() {
                 let e = csd(refs[i], refs[j], &cfg).unwrap().values;
                 let scale = e.iter().fold(0.0f64, |m, v| m.max(v.norm()));
-                let (re, im) = planes.cross(p);
+                let (mut re, mut im) = (Vec::new(), Vec::new());
+                planes.cross_into(p, &mut re, &mut im);
                 for (k, (a, e)) in s.cross[p].iter().zip(&e).enumerate() {
                     let d: Complex<f64> = a - e;
                     assert!(d.norm() <= 1e-12 * scale, "pair {p}: {a} vs {e}");

@@ -47,6 +47,7 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
+pub(crate) use accumulators::cross_from_parts;
 pub use config::{Detrend, WelchConfig, default_nperseg};
 pub use cross::{CrossSpectra, coherence, cross_spectra, csd};
 pub use multichannel::{MultiSpectra, multi_welch};

@@ -42,10 +42,25 @@ pub(crate) fn unwrap_into(phase: &[f64], out: &mut Vec<f64>) {
     }
 }
 
+/// `a % b` (C's `fmod`, exact), without the software division loop when
+/// `|a| < 2|b|`: the remainder is then `a` (|a| < |b|) or `a ∓ |b|`, which
+/// is exact because `|b| ≤ |a| < 2|b|` (Sterbenz). Phase differences of
+/// an unwrap are always such (|a| < 3π against 2π).
+fn fmod(a: f64, b: f64) -> f64 {
+    let (x, y) = (a.abs(), b.abs());
+    if x < y {
+        a
+    } else if x < 2.0 * y {
+        (x - y).copysign(a)
+    } else {
+        a % b
+    }
+}
+
 /// Floor-division remainder with the sign of `b` (numpy's `np.mod` for
 /// floats, including its `fmod`-then-adjust rounding).
 fn py_mod(a: f64, b: f64) -> f64 {
-    let m = a % b;
+    let m = fmod(a, b);
     if m != 0.0 {
         if (b < 0.0) != (m < 0.0) { m + b } else { m }
     } else {
@@ -56,6 +71,31 @@ fn py_mod(a: f64, b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The fast remainder is `%` bit for bit, signs of zero included.
+    #[test]
+    fn fast_remainder_is_fmod() {
+        let mut rng = crate::rng::SplitMix64::new(3);
+        let b = 2.0 * PI;
+        let mut cases = vec![
+            0.0,
+            -0.0,
+            b,
+            -b,
+            2.0 * b,
+            -2.0 * b,
+            b.next_up(),
+            (2.0 * b).next_down(),
+        ];
+        cases.extend((0..20_000).map(|_| 4.0 * b * (rng.uniform() - 0.5)));
+        cases.extend((0..1000).map(|_| 1e6 * rng.normal()));
+        for a in cases {
+            for b in [b, -b, 0.7, 3.0] {
+                assert_eq!(fmod(a, b).to_bits(), (a % b).to_bits(), "{a} % {b}");
+            }
+        }
+        assert!(fmod(f64::NAN, b).is_nan() && fmod(f64::INFINITY, b).is_nan());
+    }
 
     /// numpy's loop as written: the modulo for every sample, discarded below π.
     fn unwrap_reference(phase: &[f64]) -> Vec<f64> {
