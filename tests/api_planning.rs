@@ -266,6 +266,106 @@ async fn bad_input_gets_a_clear_4xx_on_every_route() {
         (422, Some("limits.heave.max_force"))
     );
 
+    // A declared autopilot: every modeled DOF needs a loop; a rate gain is
+    // for roll and pitch only; gains are finite and ≥ 0; DOF keys are names.
+    let loops = |skip: &str| {
+        let mut l = serde_json::Map::new();
+        for d in ["surge", "sway", "heave", "roll", "pitch", "yaw"] {
+            if d != skip {
+                l.insert(d.into(), json!({ "kp": 100.0, "ki": 10.0 }));
+            }
+        }
+        Value::Object(l)
+    };
+    for (autopilot, status, field) in [
+        (
+            json!({ "loops": loops("heave") }),
+            422,
+            "autopilot.loops.heave",
+        ),
+        (
+            json!({ "loops": { "yaw": { "kp": 1.0, "kd": 2.0 } } }),
+            422,
+            "autopilot.loops.surge",
+        ),
+        (
+            {
+                let mut l = loops("");
+                l["yaw"]["kd"] = json!(5.0);
+                json!({ "loops": l })
+            },
+            422,
+            "autopilot.loops.yaw.kd",
+        ),
+        (
+            {
+                let mut l = loops("");
+                l["roll"]["kp"] = json!(-3.0);
+                json!({ "loops": l })
+            },
+            422,
+            "autopilot.loops.roll.kp",
+        ),
+        (
+            json!({ "loops": loops(""), "restoring_feed_forward": { "w_minus_b": 1e300, "zg_w_minus_zb_b": 1.0 } }),
+            422,
+            "autopilot.restoring_feed_forward.w_minus_b",
+        ),
+    ] {
+        let mut p = rov_profile();
+        p["autopilot"] = autopilot;
+        let r = app.call("POST", "/api/vessels", &[], Some(p)).await;
+        app.check_contract("POST", "/api/vessels", &r);
+        assert_eq!(
+            (r.status.as_u16(), r.json["field"].as_str()),
+            (status, Some(field)),
+            "{}",
+            r.text
+        );
+    }
+    let mut p = rov_profile();
+    let mut l = loops("");
+    l["rol"] = json!({ "kp": 1.0 });
+    p["autopilot"] = json!({ "loops": l });
+    let r = app.call("POST", "/api/vessels", &[], Some(p)).await;
+    assert_eq!(r.status, 400, "{}", r.text);
+    assert!(
+        r.json["message"]
+            .as_str()
+            .unwrap()
+            .contains("unknown DOF 'rol'"),
+        "{}",
+        r.text
+    );
+    let mut p = dp_profile();
+    p["autopilot"] = json!({ "loops": { "surge": { "kp": 1.0 } } });
+    let r = app.call("POST", "/api/vessels", &[], Some(p)).await;
+    assert_eq!(
+        (r.status.as_u16(), r.json["field"].as_str()),
+        (422, Some("autopilot"))
+    );
+    // Declared, it is stored and read back as given.
+    let mut p = rov_profile();
+    let mut l = loops("");
+    l["roll"] = json!({ "kp": 400.0, "kd": 250.0 });
+    let autopilot = json!({ "loops": l, "restoring_feed_forward": { "w_minus_b": 12.5, "zg_w_minus_zb_b": 310.0 } });
+    p["autopilot"] = autopilot.clone();
+    let id = create_vessel(&app, p).await;
+    let r = app.call("GET", "/api/vessels/{id}", &[&id], None).await;
+    app.check_contract("GET", "/api/vessels/{id}", &r);
+    assert_eq!(
+        r.json["profile"]["autopilot"]["restoring_feed_forward"],
+        autopilot["restoring_feed_forward"]
+    );
+    assert_eq!(
+        r.json["profile"]["autopilot"]["loops"]["roll"],
+        json!({ "kp": 400.0, "ki": 0.0, "kd": 250.0 })
+    );
+    assert_eq!(
+        r.json["profile"]["autopilot"]["loops"]["surge"],
+        json!({ "kp": 100.0, "ki": 10.0 })
+    );
+
     let mut p = rov_profile();
     p["limits"]["heave"]["max_forse"] = json!(5.0);
     let r = app.call("POST", "/api/vessels", &[], Some(p)).await;

@@ -71,6 +71,31 @@ export function limitsTable(v) {
     })));
 }
 
+/** The declared autopilot's gains, or null without one. */
+export function autopilotTable(v) {
+  const a = v.autopilot;
+  if (!a) return null;
+  const gain = (x, unit) => (x == null ? '–' : `${fmt(x)} ${unit}`);
+  const ff = a.restoring_feed_forward;
+  return h('div', { 'data-testid': 'autopilot-table' },
+    h('h2', null, 'Autopilot'),
+    h('p', { class: 'hint' }, 'The team’s own loops: simulated flights of the plan (predicted precision, experiment design) fly through them.'),
+    h('table', { class: 'grid-table' },
+      h('thead', null, h('tr', null, h('th', null, 'DOF'), h('th', null, 'Loop'), h('th', null, 'K_p'), h('th', null, 'K_i'), h('th', null, 'K_d'))),
+      h('tbody', null, v.dofs.filter((d) => a.loops[d]).map((d) => {
+        const l = a.loops[d];
+        const u = dofUnits(d);
+        const att = l.kd != null;
+        return h('tr', null, h('th', { scope: 'row' }, d),
+          h('td', null, att ? 'attitude PD' : 'velocity PI'),
+          h('td', null, gain(l.kp, att ? `${u.force}/rad` : `${u.force}/(${u.velocity})`)),
+          h('td', null, gain(l.ki ?? 0, att ? `${u.force}/(rad·s)` : `${u.force}/${u.velocity.split('/')[0]}`)),
+          h('td', null, att ? gain(l.kd, `${u.force}/(${u.velocity})`) : '–'));
+      }))),
+    ff ? h('p', null, `Restoring feed-forward ĝ(η): W − B = ${fmtU(ff.w_minus_b, 'N')}, z_G W − z_B B = ${fmtU(ff.zg_w_minus_zb_b, 'N·m')}`)
+      : h('p', { class: 'hint' }, 'No restoring feed-forward.'));
+}
+
 export function thrusterTables(v) {
   if (!v.inputs || v.inputs.kind !== 'thrusters') return null;
   const th = v.inputs.thrusters;
@@ -108,6 +133,7 @@ export async function vesselPage(view, id) {
       h('dt', null, 'Id'), h('dd', { class: 'mono' }, v.id)),
     h('h2', null, 'Limits'),
     limitsTable(v),
+    autopilotTable(v),
     thrusterTables(v),
     thrusterLayout(v),
     h('h2', null, 'Campaigns'),
@@ -136,7 +162,19 @@ function modelFrom(profile) {
     inputKind: p.inputs && p.inputs.kind === 'thrusters' ? 'thrusters' : 'generalized_forces',
     thrusters: [],
     tmatrix: {},
+    // Fields the form does not edit, carried over from the template.
+    keep: Object.fromEntries(['dp_prior', 'heading_unit'].filter((k) => p[k] != null).map((k) => [k, p[k]])),
+    autopilotOn: p.autopilot != null,
+    autopilot: {},
+    feedForward: {
+      w_minus_b: p.autopilot?.restoring_feed_forward?.w_minus_b ?? null,
+      zg_w_minus_zb_b: p.autopilot?.restoring_feed_forward?.zg_w_minus_zb_b ?? null,
+    },
   };
+  for (const d of DOFS) {
+    const l = (p.autopilot?.loops || {})[d] || {};
+    m.autopilot[d] = { kp: l.kp ?? null, ki: l.ki ?? null, kd: l.kd ?? null };
+  }
   for (const d of DOFS) {
     const l = (p.limits || {})[d] || {};
     m.limits[d] = Object.fromEntries(LIMIT_COLS.map((c) => [c.key, l[c.key] ?? null]));
@@ -201,7 +239,7 @@ export async function vesselForm(view, query) {
   });
 
   function render() {
-    fill(sections, general(), dofsBox(), limitsBox(), inputsBox());
+    fill(sections, general(), dofsBox(), limitsBox(), autopilotBox(), inputsBox());
   }
 
   function general() {
@@ -269,6 +307,40 @@ export async function vesselForm(view, query) {
         h('thead', null, h('tr', null, h('th', null, 'DOF'), LIMIT_COLS.map((c) => h('th', null, c.label, c.required ? '' : ' (opt.)')))),
         h('tbody', null, rows)),
       h('p', { class: 'hint' }, 'Surge max velocity is the vessel’s top forward speed: no grid speed may exceed it. Max accel slew-limits velocity references; the time constant T ≈ m/d sets PRBS clocks and settling times.'));
+  }
+
+  function autopilotBox() {
+    if (m.kind !== 'rov6') return null;
+    const on = h('input', {
+      type: 'checkbox', checked: m.autopilotOn, 'data-testid': 'autopilot-on',
+      onChange: (e) => { m.autopilotOn = e.target.checked; render(); },
+    });
+    const head = h('label', { class: 'check' }, on, ' Declare the ROV’s autopilot (its gains), so simulated flights of the plan fly through it');
+    if (!m.autopilotOn) {
+      return h('fieldset', { 'data-field': 'autopilot', 'data-error-host': '' }, h('legend', null, 'Autopilot (optional)'), head,
+        h('p', { class: 'hint' }, 'Without it, predictions fly generic PI loops designed from the limits; how stiffly the real loops hold each DOF decides how much sensor noise becomes thrust, and so the spread of the estimates.'));
+    }
+    const rows = m.dofs.map((d) => {
+      const g = m.autopilot[d];
+      const att = d === 'roll' || d === 'pitch';
+      const base = `autopilot.loops.${d}`;
+      const cell = (key, label) => h('td', { 'data-error-host': '' },
+        numInput(g[key], `${base}.${key}`, `${d} ${label}`, (x) => { g[key] = x; }, { min: '0', placeholder: key === 'kp' ? '' : (key === 'kd' ? 'velocity loop' : '0') }));
+      return h('tr', { 'data-field': base },
+        h('th', { scope: 'row' }, d),
+        cell('kp', 'K_p'), cell('ki', 'K_i'),
+        att ? cell('kd', 'K_d') : h('td', null, '–'));
+    });
+    const ff = (key, label, unit) => labelled(`${label} [${unit}]`,
+      numInput(m.feedForward[key], `autopilot.restoring_feed_forward.${key}`, label, (x) => { m.feedForward[key] = x; }, { placeholder: 'none' }));
+    return h('fieldset', { 'data-field': 'autopilot', 'data-error-host': '', 'data-testid': 'autopilot-editor' }, h('legend', null, 'Autopilot (optional)'), head,
+      h('table', { class: 'grid-table edit' },
+        h('thead', null, h('tr', null, h('th', null, 'DOF'), h('th', null, 'K_p'), h('th', null, 'K_i (opt.)'), h('th', null, 'K_d (roll, pitch)'))),
+        h('tbody', null, rows)),
+      h('p', { class: 'hint' }, 'Velocity loops: τ = K_p (ν_ref − ν) + K_i ∫(ν_ref − ν) dt (N per m/s, N·m per rad/s). With K_d, roll or pitch holds attitude: τ = K_p (η_ref − η) + K_d (ω_ref − ω) + K_i ∫(η_ref − η) dt (N·m per rad).'),
+      h('div', { class: 'row' },
+        ff('w_minus_b', 'Feed-forward W − B', 'N'),
+        ff('zg_w_minus_zb_b', 'Feed-forward z_G W − z_B B', 'N·m')));
   }
 
   function addThruster() {
@@ -349,6 +421,27 @@ export async function vesselForm(view, query) {
         else if (x != null) l[c.key] = need(x, `limits.${d}.${c.key}`);
       }
       body.limits[d] = l;
+    }
+    Object.assign(body, m.keep);
+    if (m.kind !== 'dp3') delete body.dp_prior;
+    if (m.kind === 'rov6' && m.autopilotOn) {
+      const loops = {};
+      for (const d of m.dofs) {
+        const g = m.autopilot[d];
+        const base = `autopilot.loops.${d}`;
+        const l = { kp: need(g.kp, `${base}.kp`) };
+        if (g.ki != null) l.ki = need(g.ki, `${base}.ki`);
+        if ((d === 'roll' || d === 'pitch') && g.kd != null) l.kd = need(g.kd, `${base}.kd`);
+        loops[d] = l;
+      }
+      body.autopilot = { loops };
+      const f = m.feedForward;
+      if (f.w_minus_b != null || f.zg_w_minus_zb_b != null) {
+        body.autopilot.restoring_feed_forward = {
+          w_minus_b: need(f.w_minus_b, 'autopilot.restoring_feed_forward.w_minus_b'),
+          zg_w_minus_zb_b: need(f.zg_w_minus_zb_b, 'autopilot.restoring_feed_forward.zg_w_minus_zb_b'),
+        };
+      }
     }
     if (m.inputKind === 'thrusters') {
       body.inputs = {

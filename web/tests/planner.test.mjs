@@ -263,3 +263,57 @@ test('impossible grid: 5 kn above the ROV’s 4.3 kn shows the server’s 422 on
     assert.equal(await page.locator('.field-error').count(), 0);
   });
 });
+
+test('ROV autopilot: declared in the form, a negative rate gain is the server’s 422 on that cell, then stored, shown and copied', async () => {
+  const VESSEL_422 = { method: 'POST', status: 422, path: /^\/api\/vessels$/ };
+  await withPage([VESSEL_422], async (page) => {
+    await page.goto(`${H.base}/`);
+    await page.click(tid('nav-vessels'));
+    await page.click(tid('new-vessel'));
+    await page.click(tid('template-rov'));
+    await page.fill(tid('vessel-name'), 'Surveyor ROV (autopilot)');
+    assert.equal(await page.locator(tid('autopilot-editor')).count(), 0);
+    await page.check(tid('autopilot-on'));
+    const gains = {
+      surge: [900, 180], sway: [1200, 320], heave: [1500, 400], roll: [420, 0, 310], pitch: [650, 0, 480], yaw: [300, 80],
+    };
+    for (const [d, [kp, ki, kd]] of Object.entries(gains)) {
+      await page.fill(`[data-field="autopilot.loops.${d}.kp"]`, String(kp));
+      await page.fill(`[data-field="autopilot.loops.${d}.ki"]`, String(ki));
+      if (kd != null) await page.fill(`[data-field="autopilot.loops.${d}.kd"]`, String(kd));
+    }
+    // Yaw has no attitude loop: no K_d cell in the form; the server's 422
+    // names the field when a client sends one anyway.
+    assert.equal(await page.locator('[data-field="autopilot.loops.yaw.kd"]').count(), 0);
+    await page.fill('[data-field="autopilot.restoring_feed_forward.w_minus_b"]', '45');
+    // One feed-forward term without the other is caught before sending.
+    await page.click(tid('create-vessel'));
+    const missing = page.locator('[data-testid="field-error"][data-for="autopilot.restoring_feed_forward.zg_w_minus_zb_b"]');
+    await missing.waitFor();
+    assert.match(await missing.textContent(), /required/);
+    await page.fill('[data-field="autopilot.restoring_feed_forward.zg_w_minus_zb_b"]', '1200');
+    // A negative gain is the server's 422 on that cell.
+    await page.fill('[data-field="autopilot.loops.pitch.kd"]', '-5');
+    await page.click(tid('create-vessel'));
+    const err = page.locator('[data-testid="field-error"][data-for="autopilot.loops.pitch.kd"]');
+    await err.waitFor();
+    assert.match(await err.textContent(), /gain between 0 and/);
+    await page.fill('[data-field="autopilot.loops.pitch.kd"]', '480');
+    await page.click(tid('create-vessel'));
+    await page.waitForURL(/#\/vessels\/[0-9a-f-]{36}$/);
+    const table = page.locator(tid('autopilot-table'));
+    await table.waitFor();
+    const text = await table.textContent();
+    assert.match(text, /roll.*attitude PD.*420/);
+    assert.match(text, /yaw.*velocity PI.*300/);
+    assert.match(text, /W − B = 45/);
+    const id = page.url().split('/').pop();
+    const stored = await (await page.request.get(`${H.base}/api/vessels/${id}`)).json();
+    assert.deepEqual(stored.profile.autopilot.loops.pitch, { kp: 650, ki: 0, kd: 480 });
+    assert.deepEqual(stored.profile.autopilot.loops.surge, { kp: 900, ki: 180 });
+    // Copy as new keeps it.
+    await page.click('a:has-text("Copy as new vessel")');
+    await page.locator(tid('autopilot-editor')).waitFor();
+    assert.equal(await page.inputValue('[data-field="autopilot.loops.roll.kd"]'), '310');
+  });
+});

@@ -11,11 +11,17 @@
 //! `--designed` flies the campaign as `design::design_campaign` designs it
 //! within the rule-based plan's hours; `--repeat N` flies the rule-based
 //! plan with every run repeated N times (the design's rule-based front).
+//! The profile declares the truth's autopilot (the team's gains and ĝ
+//! feed-forward), so the prediction flies the plan through it;
+//! `--generic-autopilot` leaves it out (the project's loops designed from
+//! the profile's limits fly the prediction), `--tune-seed N` tunes the
+//! truth's autopilot from another seed, `--linear` identifies with linear
+//! damping only (both sides).
 //! `--tsv PATH` writes each parameter's predicted and empirical std with
 //! the plan's ship hours, for `ship_hours.py` (the ship-hour ratio of a
 //! designed campaign against the rule-based plan repeated, on the truth).
 //!
-//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--designed] [--repeat N] [--tsv PATH] [--grid-kn 0.5,2,3.5]`
+//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--designed] [--generic-autopilot] [--linear] [--tune-seed N] [--repeat N] [--tsv PATH] [--grid-kn 0.5,2,3.5]`
 
 #[path = "../tests/support/precision_truth.rs"]
 mod precision_truth;
@@ -38,6 +44,15 @@ fn main() {
             "--retune" => retune = true,
             "--no-recursive" => variant.no_recursive = true,
             "--designed" => variant.designed = true,
+            "--generic-autopilot" => variant.generic_autopilot = true,
+            "--linear" => variant.linear_damping = true,
+            "--tune-seed" => {
+                variant.tune_seed = Some(
+                    it.next()
+                        .and_then(|v| v.parse().ok())
+                        .expect("--tune-seed N"),
+                )
+            }
             "--tsv" => tsv = Some(it.next().expect("--tsv PATH").clone()),
             "--repeat" => {
                 variant.repeat = it.next().and_then(|v| v.parse().ok()).expect("--repeat N")

@@ -6,26 +6,26 @@
 //! empirical spread of every parameter against the std
 //! `design::predict_precision` predicts with a prior equal to the vessel.
 //!
-//! Measured (20 seeds): the prediction is the spread of 20 flights of the
-//! plan by the project's own simulator, its controller reading noisy
-//! sensors. 57 % of the 255 parameters (M fitted symmetric: an
-//! off-diagonal pair is one parameter) have an empirical spread within 1.5×
-//! of it (median empirical/predicted 0.77), and for 91 % the spread is at
-//! most 1.5× the prediction: the prediction rarely promises more precision
-//! than the truth delivers. The issue's goal (≥ 90 % within 1.5× either
-//! way) is not met. The two closed loops differ: the truth's 20 Hz
-//! autopilot (PI on u, v, w, r; PD on φ, θ without an integral and with a
-//! nominal ĝ 20–40 % off; commands logged every second sample) is not the
-//! project's PI/attitude loop, and the noise that feeds back through each
-//! moves the vehicle differently — most of the parameters under-predicted
-//! are the pitch row (D̄[pitch,·], b[pitch]) that the truth's pitch loop
-//! holds least stiffly (b[pitch], D̄[pitch,surge], D̄[pitch,heave] and the
-//! M entries coupling pitch). The std the identification reports on the
-//! truth's runs is 9× the prediction (median): the linear LPV model's misfit to the
-//! truth's nonlinear plant, which the prediction shows as the *reported*
-//! std beside its spread.
-//! `cargo run --release -p seatrial-core --example precision_table -- 20 [--own] [--no-recursive]`
-//! prints the table.
+//! The team declares its autopilot in the vessel profile (`autopilot`: the
+//! PI gains of u, v, w, r, the PD gains of φ, θ, the nominal W − B and
+//! z_G W − z_B B it feeds forward — the truth's `ControllerConfig` as plain
+//! numbers), and the prediction flies the plan through those loops in the
+//! project's own simulator, reading noisy sensors; the truth's 20 Hz
+//! autopilot, plant and 10 Hz logger are its own.
+//!
+//! Measured (20 seeds, the service's default identification with quadratic
+//! damping): 240 of 262 parameters (91.6 %; M fitted symmetric: an
+//! off-diagonal pair is one parameter) have an empirical spread within
+//! 1.5× of the prediction, median empirical/predicted 1.02. Without the
+//! declared autopilot the prediction flies the project's generic loops
+//! (designed from the limits, ≈ 9× the truth's roll gain) and only 57 % are
+//! within 1.5× (median 0.77): how stiffly each loop holds its DOF decides
+//! how much sensor noise becomes thrust and motion. The std the
+//! identification reports on the truth's runs is ≈ 11× the spread (median):
+//! the linear LPV model's misfit to the truth's nonlinear plant, which the
+//! prediction shows as the *reported* std beside its spread.
+//! `cargo run --release -p seatrial-core --example precision_table -- 20
+//! [--generic-autopilot] [--linear] [--tune-seed N]` prints the table.
 
 #[path = "support/precision_truth.rs"]
 mod precision_truth;
@@ -64,8 +64,8 @@ fn comparisons() -> &'static Vec<Comparison> {
     })
 }
 
-/// What holds: the prediction is centred on the truth's spread (median
-/// empirical/predicted within [1/1.5, 1.5]) and rarely promises more
+/// The prediction is centred on the truth's spread (median
+/// empirical/predicted within [1/1.2, 1.2]) and rarely promises more
 /// precision than the truth gives (spread ≤ 1.5× the prediction for ≥ 90 %
 /// of the parameters); the std the identification reports on the truth's
 /// runs never understates the spread.
@@ -78,7 +78,7 @@ fn prediction_is_centred_and_does_not_overstate_the_truths_precision() {
     ratios.sort_by(f64::total_cmp);
     let median = ratios[ratios.len() / 2];
     assert!(
-        (1.0 / FACTOR..=FACTOR).contains(&median),
+        (1.0 / 1.2..=1.2).contains(&median),
         "median empirical/predicted {median}"
     );
     let bounded = live.iter().filter(|c| c.ratio() <= FACTOR).count();
@@ -98,9 +98,8 @@ fn prediction_is_centred_and_does_not_overstate_the_truths_precision() {
 }
 
 /// Issue 15's goal: empirical spread within 1.5× of the predicted std for
-/// ≥ 90 % of the parameters. Not met (see the module docs).
+/// ≥ 90 % of the parameters.
 #[test]
-#[ignore = "issue 15's goal is not met (57 % within 1.5×): the truth's autopilot and the project's controller pass the sensor noise through differently (see the module docs)"]
 fn empirical_spread_matches_the_predicted_std() {
     let c = comparisons();
     let live: Vec<&Comparison> = c.iter().filter(|c| !c.structural_zero()).collect();

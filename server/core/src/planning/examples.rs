@@ -51,6 +51,7 @@ pub fn surveyor_rov() -> VesselProfile {
         logger_rate_hz: 10.0,
         dp_prior: None,
         heading_unit: None,
+        autopilot: None,
     }
 }
 
@@ -113,6 +114,7 @@ pub fn supply_vessel() -> VesselProfile {
             ]),
         }),
         heading_unit: None,
+        autopilot: None,
     }
 }
 

@@ -4,6 +4,7 @@
 //! and trial time.
 
 pub mod analysis;
+pub mod autopilot;
 pub mod campaign;
 pub mod deciding;
 pub mod design;
@@ -19,6 +20,7 @@ mod validation_run;
 pub mod vessel;
 pub mod waveform;
 
+pub use autopilot::{Autopilot, AutopilotLoop, RestoringFeedForward};
 pub use campaign::{CampaignSpec, ExperimentFamily, Quantity, SignalKind, SpeedGrid, SpeedUnit};
 pub use dof::{Dof, KNOT};
 pub use error::{MAX_NAME_LEN, PlanError, check_name};

@@ -208,6 +208,12 @@ pub struct VesselProfile {
     /// `meta.heading_unit` overrides it for that run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub heading_unit: Option<HeadingUnit>,
+    /// ROVs: the vessel's own autopilot (its loops' gains and restoring
+    /// feed-forward). Given, simulated flights of the plan (predicted
+    /// precision, the demo) fly through it instead of loops designed from
+    /// the limits.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub autopilot: Option<super::autopilot::Autopilot>,
 }
 
 impl VesselProfile {
@@ -325,6 +331,15 @@ impl VesselProfile {
                 ));
             }
             prior.validate()?;
+        }
+        if let Some(a) = &self.autopilot {
+            if self.kind != VesselKind::Rov6 {
+                return Err(PlanError::invalid(
+                    "autopilot",
+                    "only ROV profiles declare an autopilot (a DP vessel's plan is flown by thruster commands)",
+                ));
+            }
+            a.validate(&self.dofs)?;
         }
         if let InputChannels::Thrusters {
             thrusters,

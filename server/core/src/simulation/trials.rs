@@ -49,7 +49,10 @@ use crate::planning::{Dof, Experiment, ExperimentFamily, Plan, PlannedExperiment
 use crate::rng::{SplitMix64, mix};
 
 mod control;
-pub use control::{ATTITUDE_TIME_CONSTANTS, AttitudeLoop, BANDWIDTH_PER_TIME_CONSTANT, VelocityPi};
+pub use control::{
+    ATTITUDE_TIME_CONSTANTS, AttitudeLoop, BANDWIDTH_PER_TIME_CONSTANT, DeclaredAutopilot,
+    Setpoint, VelocityPi,
+};
 
 /// Default lead-in in units of the largest modeled time constant T̂ (≈ 99 %
 /// settled).
@@ -318,6 +321,10 @@ pub fn fly_experiment(
         })
         .collect();
 
+    // The vessel's own autopilot, when the profile declares one, flies
+    // instead of the loops above.
+    let mut declared = DeclaredAutopilot::of(profile, h);
+
     // Plant: the truth's own right-hand side.
     let mut f = truth.plant().map_err(sim_err)?;
     let acts = &truth.actuators;
@@ -364,7 +371,29 @@ pub fn fly_experiment(
             (nu, eta)
         };
         let mut rate_ref = [0.0; 6];
+        if let Some(ap) = declared.as_mut() {
+            let setpoints: [Setpoint; 6] = std::array::from_fn(|i| match drives[i] {
+                Drive::Velocity(c) => Setpoint::Velocity(reference(c, k)),
+                Drive::Attitude(c) => Setpoint::Attitude(reference(c, k)),
+                Drive::Force(_) | Drive::Passive => Setpoint::Idle,
+            });
+            let (nu_a, eta_a): ([f64; 6], [f64; 6]) = (nu_m.into(), eta_m.into());
+            let (tau, rate) = ap.step(&setpoints, &nu_a, &eta_a, k >= n_lead);
+            rate_ref = rate;
+            for (i, d) in drives.iter().enumerate() {
+                tau_cmd[(k, i)] = match *d {
+                    Drive::Force(c) => {
+                        let l = profile.limit(Dof::ALL[i]).max_force;
+                        reference(c, k).clamp(-l, l)
+                    }
+                    _ => tau[i].unwrap_or(0.0),
+                };
+            }
+        }
         for (i, d) in drives.iter().enumerate() {
+            if declared.is_some() {
+                break;
+            }
             rate_ref[i] = match (*d, &attitude[i]) {
                 (Drive::Velocity(c), _) => reference(c, k),
                 (Drive::Attitude(c), Some(a)) => a.rate_reference(reference(c, k), eta_m[i]),

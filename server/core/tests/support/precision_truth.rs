@@ -23,7 +23,8 @@ use seatrial_core::identification::document::ParameterRow;
 use seatrial_core::identification::{LambdaCampaignSettings, RunInput, identify_lambda_campaign};
 use seatrial_core::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
 use seatrial_core::planning::{
-    CampaignSpec, ExperimentFamily, Plan, PlannedExperiment, VesselProfile, examples,
+    Autopilot, AutopilotLoop, CampaignSpec, Dof, ExperimentFamily, Plan, PlannedExperiment,
+    RestoringFeedForward, VesselProfile, examples,
 };
 use seatrial_core::simulation::rov::{LinearDamping, Restoring, RovTruth};
 use seatrial_core::simulation::trials::MeasurementNoise;
@@ -54,6 +55,9 @@ pub struct Setup {
     pub controller: ControllerConfig,
     pub runs: Vec<ExternalRun>,
     pub noise: NoiseSpec,
+    /// How both sides identify (the service's λ-filter defaults unless
+    /// [`PlanVariant::linear_damping`]).
+    pub lambda: LambdaCampaignSettings,
 }
 
 /// Which plan to fly.
@@ -71,6 +75,15 @@ pub struct PlanVariant {
     /// Repeats every run of the rule-based plan this many times (0 or 1:
     /// once), as the design's rule-based front does (`repetitions`).
     pub repeat: u32,
+    /// Leaves the truth's autopilot out of the profile, so the prediction
+    /// flies the project's generic loops (designed from the limits alone)
+    /// instead of the team's declared gains and ĝ feed-forward.
+    pub generic_autopilot: bool,
+    /// Identifies with linear damping only (both sides), not the service's
+    /// default quadratic damping.
+    pub linear_damping: bool,
+    /// Seed of the truth's autopilot tuning (default [`TUNE_SEED`]).
+    pub tune_seed: Option<u64>,
 }
 
 /// The service's rule-based Surveyor plan, as `variant` asks.
@@ -105,8 +118,12 @@ pub fn setup(variant: &PlanVariant) -> Setup {
     let (profile, plan) = plan(variant);
     let vessel = Vessel::surveyor_like();
     let runs: Vec<ExternalRun> = plan.experiments.iter().map(to_external).collect();
-    let mut rng = Rng::new(derive_seed(TUNE_SEED, 0xCA3B));
+    let mut rng = Rng::new(derive_seed(variant.tune_seed.unwrap_or(TUNE_SEED), 0xCA3B));
     let controller = ControllerConfig::tune(&vessel, &external_envelope(&runs), &mut rng);
+    let mut profile = profile;
+    if !variant.generic_autopilot {
+        profile.autopilot = Some(autopilot_of(&controller, &profile));
+    }
     Setup {
         profile,
         plan,
@@ -114,6 +131,40 @@ pub fn setup(variant: &PlanVariant) -> Setup {
         controller,
         runs,
         noise: NoiseSpec::default(),
+        lambda: LambdaCampaignSettings {
+            quadratic_damping: !variant.linear_damping,
+            ..LambdaCampaignSettings::default()
+        },
+    }
+}
+
+/// The truth's autopilot as the team would declare it in the profile:
+/// PI gains of the velocity loops, PD gains of the attitude loops, the
+/// nominal W − B and z_G W − z_B B it feeds forward (plain numbers; the
+/// truth's limits stay its own).
+pub fn autopilot_of(c: &ControllerConfig, profile: &VesselProfile) -> Autopilot {
+    let loops = profile
+        .dofs
+        .iter()
+        .map(|&d| {
+            let i = d.index();
+            let attitude = matches!(d, Dof::Roll | Dof::Pitch);
+            (
+                d,
+                AutopilotLoop {
+                    kp: c.kp[i],
+                    ki: c.ki[i],
+                    kd: attitude.then_some(c.kd[i]),
+                },
+            )
+        })
+        .collect();
+    Autopilot {
+        loops,
+        restoring_feed_forward: Some(RestoringFeedForward {
+            w_minus_b: c.nominal_w_minus_b,
+            zg_w_minus_zb_b: c.nominal_zg_w_minus_zb_b,
+        }),
     }
 }
 
@@ -252,7 +303,7 @@ fn identify_flown(s: &Setup, flown: &[seatrial_truth::Run]) -> Estimates {
         &grid(&s.plan),
         &input_columns(&s.profile),
         &inputs,
-        &identification(),
+        &s.lambda,
         &mut NoProgress,
     )
     .expect("the truth's campaign identifies");
@@ -292,17 +343,6 @@ pub fn fly_seeds_with(
     out.into_iter().map(|(_, e)| e).collect()
 }
 
-/// The identification both sides use: linear damping only. With the
-/// default quadratic damping the prediction is as centred (median
-/// empirical/predicted 0.767) but bounds the spread of 89.2 % of 259
-/// parameters rather than ≥ 90 % — not yet calibrated for it.
-pub fn identification() -> LambdaCampaignSettings {
-    LambdaCampaignSettings {
-        quadratic_damping: false,
-        ..LambdaCampaignSettings::default()
-    }
-}
-
 /// The prediction: the plan flown by the project's simulator with the
 /// vessel as prior and the truth's noise.
 pub fn predict(s: &Setup) -> PrecisionPrediction {
@@ -334,7 +374,7 @@ pub fn predict_noise(
         &PredictSettings {
             rov_noise: noise,
             seed,
-            lambda: identification(),
+            lambda: s.lambda.clone(),
             ..PredictSettings::default()
         },
         &mut NoProgress,

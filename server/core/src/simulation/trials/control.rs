@@ -3,6 +3,7 @@
 //! reference.
 
 use crate::planning::vessel::DofLimits;
+use crate::planning::{AutopilotLoop, Dof, RestoringFeedForward, VesselProfile};
 
 /// Closed-loop bandwidth ω_c of the velocity PI in units of 1/T̂: the nominal
 /// loop settles twice as fast as the open-loop DOF. Kept modest because the
@@ -117,5 +118,122 @@ impl AttitudeLoop {
     /// The rate reference for attitude reference `eta_ref` at attitude `eta`.
     pub fn rate_reference(&self, eta_ref: f64, eta: f64) -> f64 {
         (self.gain * (eta_ref - eta)).clamp(-self.max_rate, self.max_rate)
+    }
+}
+
+/// What one DOF's declared loop is asked to fly this interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Setpoint {
+    /// A velocity (roll, pitch: rate) reference; an attitude loop flies
+    /// η_ref = ∫ν_ref dt from the run's start with ν_ref fed forward.
+    Velocity(f64),
+    /// A roll or pitch attitude reference.
+    Attitude(f64),
+    /// Open loop or passive: the loop is idle.
+    Idle,
+}
+
+/// The vessel's declared autopilot ([`Autopilot`](crate::planning::Autopilot)) in flight: every DOF's
+/// loop on the measured state, the restoring feed-forward ĝ(η_measured),
+/// τ clipped at the profile's `max_force` with conditional integration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeclaredAutopilot {
+    loops: [Option<AutopilotLoop>; 6],
+    feed_forward: Option<RestoringFeedForward>,
+    max_force: [f64; 6],
+    /// The DOF's own attitude loop, for a roll/pitch attitude schedule
+    /// flown by a declared velocity (rate) loop.
+    outer: [Option<AttitudeLoop>; 6],
+    h: f64,
+    integral: [f64; 6],
+    /// ∫ν_ref dt of a rate-driven attitude loop.
+    attitude_ref: [f64; 6],
+}
+
+impl DeclaredAutopilot {
+    /// The autopilot of `profile` (`None` without one) at interval `h`.
+    pub fn of(profile: &VesselProfile, h: f64) -> Option<Self> {
+        let a = profile.autopilot.as_ref()?;
+        let loops = std::array::from_fn(|i| a.loops.get(&Dof::ALL[i]).copied());
+        let max_force = std::array::from_fn(|i| {
+            profile
+                .limits
+                .get(&Dof::ALL[i])
+                .map_or(0.0, |l| l.max_force)
+        });
+        let outer =
+            std::array::from_fn(|i| profile.limits.get(&Dof::ALL[i]).map(AttitudeLoop::design));
+        Some(DeclaredAutopilot {
+            loops,
+            feed_forward: a.restoring_feed_forward,
+            max_force,
+            outer,
+            h,
+            integral: [0.0; 6],
+            attitude_ref: [0.0; 6],
+        })
+    }
+
+    /// τ of the DOFs with a set-point (`None` where idle) and the rate
+    /// reference each loop flies, from the measured ν and η. `running`:
+    /// past the lead-in (rate-driven attitude references integrate from
+    /// the run's start).
+    pub fn step(
+        &mut self,
+        setpoints: &[Setpoint; 6],
+        nu_m: &[f64; 6],
+        eta_m: &[f64; 6],
+        running: bool,
+    ) -> ([Option<f64>; 6], [f64; 6]) {
+        let ff = self
+            .feed_forward
+            .map_or([0.0; 6], |g| g.force(eta_m[3], eta_m[4]));
+        let mut tau = [None; 6];
+        let mut rate = [0.0; 6];
+        for i in 0..6 {
+            let Some(l) = self.loops[i] else { continue };
+            let attitude = if l.holds_attitude() {
+                match setpoints[i] {
+                    Setpoint::Velocity(w) => {
+                        if running {
+                            self.attitude_ref[i] += w * self.h;
+                        }
+                        Some((self.attitude_ref[i], if running { w } else { 0.0 }))
+                    }
+                    Setpoint::Attitude(a) => Some((a, 0.0)),
+                    Setpoint::Idle => None,
+                }
+            } else {
+                None
+            };
+            // e: the error the integral sums; raw: the loop's output.
+            let (e, raw) = match (attitude, setpoints[i]) {
+                (Some((eta_ref, w)), _) => {
+                    rate[i] = w;
+                    let e = eta_ref - eta_m[i];
+                    let kd = l.kd.unwrap_or(0.0);
+                    (e, l.kp * e + kd * (w - nu_m[i]) + l.ki * self.integral[i])
+                }
+                (None, Setpoint::Idle) => continue,
+                (None, sp) => {
+                    let nu_ref = match (sp, &self.outer[i]) {
+                        (Setpoint::Attitude(a), Some(o)) => o.rate_reference(a, eta_m[i]),
+                        (Setpoint::Velocity(v), _) => v,
+                        _ => 0.0,
+                    };
+                    rate[i] = nu_ref;
+                    let e = nu_ref - nu_m[i];
+                    (e, l.kp * e + l.ki * self.integral[i])
+                }
+            };
+            let wanted = raw + ff[i];
+            let lim = self.max_force[i];
+            let out = wanted.clamp(-lim, lim);
+            if out == wanted || e * (wanted - out) < 0.0 {
+                self.integral[i] += e * self.h;
+            }
+            tau[i] = Some(out);
+        }
+        (tau, rate)
     }
 }
