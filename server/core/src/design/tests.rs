@@ -69,6 +69,13 @@ fn rov_prediction_is_finite_and_names_the_weakest() {
         p.geometric_mean_relative_std
             .is_some_and(|g| g > 0.0 && g.is_finite())
     );
+    // The Surveyor profile declares no autopilot: the prediction says what
+    // it flew instead.
+    assert!(
+        p.notes.iter().any(|n| n.contains("declares no autopilot")),
+        "{:#?}",
+        p.notes
+    );
 }
 
 fn dp_prediction(repetitions: u32) -> PrecisionPrediction {
