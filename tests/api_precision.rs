@@ -14,7 +14,7 @@ use seatrial_core::design::{PredictSettings, Prior, PriorSource, predict_precisi
 use seatrial_core::estimation::NoProgress;
 use seatrial_core::planning::examples::{supply_vessel, supply_vessel_trial_campaign};
 use seatrial_core::planning::generate_plan;
-use serde_json::json;
+use serde_json::{Value, json};
 
 async fn app() -> TestApp {
     TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await
@@ -178,4 +178,107 @@ async fn unusable_precision_requests_are_422_naming_the_field() {
     assert_eq!(r.status, 422, "{}", r.text);
     assert_eq!(r.json["field"], "model_id");
     assert!(r.text.contains("another vessel"), "{}", r.text);
+}
+
+/// An ROV whose profile declares no autopilot: after a dive, the precision
+/// job infers the autopilot from the flown runs of the plan (logged as its
+/// computer read them) and flies the prediction through it; the inferred
+/// gains are the ones that flew the runs.
+#[tokio::test]
+async fn after_a_dive_the_autopilot_is_inferred_from_the_flown_runs() {
+    use seatrial_core::planning::examples::surveyor_rov;
+    use seatrial_core::planning::{Autopilot, AutopilotLoop, CampaignSpec, RestoringFeedForward};
+    use seatrial_core::simulation::rov::RovTruth;
+    use seatrial_core::simulation::trials::{Feedback, TrialSettings, fly_experiment};
+
+    let app = app().await;
+    let spec = json!({ "name": "first dive", "grid": { "unit": "kn", "speeds": [1.0, 2.0] }, "families": ["dynamic", "validation"], "seed": 5 });
+    let (cid, plan) = planned_campaign(&app, common::rov_profile(), spec.clone()).await;
+
+    // The team's autopilot, which the service is not told about.
+    let truth = RovTruth::surveyor_like();
+    let mut flying = surveyor_rov();
+    let loops = flying
+        .dofs
+        .iter()
+        .map(|&d| {
+            let m = truth.m[(d.index(), d.index())];
+            let l = if d.index() == 3 || d.index() == 4 {
+                let kp = m * 1.44 + 1500.0;
+                AutopilotLoop {
+                    kp,
+                    ki: 0.0,
+                    kd: Some(1.6 * (kp * m).sqrt()),
+                }
+            } else {
+                AutopilotLoop {
+                    kp: 0.8 * m,
+                    ki: 0.2 * m,
+                    kd: None,
+                }
+            };
+            (d, l)
+        })
+        .collect();
+    let declared = Autopilot {
+        loops,
+        restoring_feed_forward: Some(RestoringFeedForward {
+            w_minus_b: 40.0,
+            zg_w_minus_zb_b: 2500.0,
+        }),
+    };
+    flying.autopilot = Some(declared.clone());
+    let core_spec: CampaignSpec = serde_json::from_value(spec).unwrap();
+    let core_plan = generate_plan(&flying, &core_spec).unwrap();
+    let settings = TrialSettings {
+        seed: 9,
+        feedback: Feedback::Measured,
+        ..TrialSettings::default()
+    };
+    for p in &core_plan.experiments {
+        let flown = fly_experiment(&flying, &truth, p, &settings).unwrap();
+        common::flights::upload_planned(&app, &cid, &plan, &p.experiment.code, &flown.csv).await;
+    }
+
+    let job = common::run_job(
+        &app,
+        json!({ "kind": "precision", "campaign_id": cid, "settings": { "prior": "reference", "realisations": 2 } }),
+    )
+    .await;
+    let result = &job["result"];
+    let inferred = &result["inferred_autopilot"];
+    assert!(inferred.is_object(), "{result:#}");
+    for (d, want) in &declared.loops {
+        let got = &inferred["autopilot"]["loops"][d.name()];
+        // The integral is summed from the 10 Hz log, the autopilot's at
+        // 20 Hz: K_i is the least determined gain.
+        let close = |g: &Value, w: f64, what: &str| {
+            let g = g.as_f64().unwrap_or(f64::NAN);
+            let tol = if what == "ki" { 0.05 } else { 0.02 };
+            assert!(
+                (g - w).abs() <= tol * w.abs().max(1e-9),
+                "{} {what}: {g} vs {w}",
+                d.name()
+            );
+        };
+        close(&got["kp"], want.kp, "kp");
+        if want.ki > 0.0 {
+            close(&got["ki"], want.ki, "ki");
+        }
+        if let Some(kd) = want.kd {
+            close(&got["kd"], kd, "kd");
+        }
+    }
+    let ff = &inferred["autopilot"]["restoring_feed_forward"];
+    assert!(
+        (ff["zg_w_minus_zb_b"].as_f64().unwrap() - 2500.0).abs() < 50.0,
+        "{ff}"
+    );
+    let notes = result["prediction"]["notes"].to_string();
+    assert!(notes.contains("inferred from"), "{notes}");
+    let r = app
+        .call("GET", "/api/campaigns/{id}/precision", &[&cid], None)
+        .await;
+    assert_eq!(r.status, 200, "{}", r.text);
+    assert_finite_json(&r.json, "precision");
 }

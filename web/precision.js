@@ -7,6 +7,7 @@ import { api } from './api.js';
 import { fmt, fmtSig, fmtDate, unitLabel } from './format.js';
 import { h, fill, labelled } from './forms.js';
 import { newestResult, planJobRunner, priorSelect, withPrior } from './planjob.js';
+import { autopilotTable } from './vessels.js';
 
 const PRIOR_LABEL = {
   profile: 'the vessel profile\u2019s rough numbers',
@@ -108,6 +109,15 @@ export async function precisionSection(host, { campaign, plan: plan0 }) {
         return limited ? h('p', { class: 'hint', 'data-testid': 'precision-structure' },
           `${limited} parameter${limited === 1 ? ' is' : 's are'} limited by the model\u2019s structure rather than the noise: the identification will report a std over 3\u00d7 the spread; more runs of this plan will not sharpen ${limited === 1 ? 'it' : 'them'}.`) : null;
       })(),
+      stored.inferred_autopilot ? autopilotTable(
+        { autopilot: stored.inferred_autopilot.autopilot, dofs: stored.inferred_autopilot.loops.map((l) => l.dof) },
+        {
+          title: 'Autopilot inferred from the flown runs',
+          hint: 'The vessel profile declares no autopilot, so the prediction flew the plan through the loops fitted to the flown runs (their commands against their planned references). To keep them, copy them into the vessel profile (Copy as new vessel → Autopilot).',
+          testid: 'precision-autopilot',
+          heading: 'h3',
+        },
+      ) : null,
       h('h3', null, 'Weakest'),
       h('ol', { 'data-testid': 'precision-weakest' }, p.weakest.map((w) => h('li', null, w))),
       h('details', { class: 'sub', open: p.total <= 40 },

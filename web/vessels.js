@@ -72,14 +72,19 @@ export function limitsTable(v) {
 }
 
 /** The declared autopilot's gains, or null without one. */
-export function autopilotTable(v) {
+export function autopilotTable(v, {
+  title = 'Autopilot',
+  hint = 'The team’s own loops: simulated flights of the plan (predicted precision, experiment design) fly through them.',
+  testid = 'autopilot-table',
+  heading = 'h2',
+} = {}) {
   const a = v.autopilot;
   if (!a) return null;
   const gain = (x, unit) => (x == null ? '–' : `${fmt(x)} ${unit}`);
   const ff = a.restoring_feed_forward;
-  return h('div', { 'data-testid': 'autopilot-table' },
-    h('h2', null, 'Autopilot'),
-    h('p', { class: 'hint' }, 'The team’s own loops: simulated flights of the plan (predicted precision, experiment design) fly through them.'),
+  return h('div', { 'data-testid': testid },
+    h(heading, null, title),
+    h('p', { class: 'hint' }, hint),
     h('table', { class: 'grid-table' },
       h('thead', null, h('tr', null, h('th', null, 'DOF'), h('th', null, 'Loop'), h('th', null, 'K_p'), h('th', null, 'K_i'), h('th', null, 'K_d'))),
       h('tbody', null, v.dofs.filter((d) => a.loops[d]).map((d) => {

@@ -15,13 +15,15 @@
 //! feed-forward), so the prediction flies the plan through it;
 //! `--generic-autopilot` leaves it out (the project's loops designed from
 //! the profile's limits fly the prediction), `--tune-seed N` tunes the
-//! truth's autopilot from another seed, `--linear` identifies with linear
+//! truth's autopilot from another seed, `--inferred-autopilot` predicts
+//! with the autopilot inferred from a first dive's logs
+//! (`identification::autopilot_fit`) instead, `--linear` identifies with linear
 //! damping only (both sides).
 //! `--tsv PATH` writes each parameter's predicted and empirical std with
 //! the plan's ship hours, for `ship_hours.py` (the ship-hour ratio of a
 //! designed campaign against the rule-based plan repeated, on the truth).
 //!
-//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--designed] [--generic-autopilot] [--linear] [--tune-seed N] [--repeat N] [--tsv PATH] [--grid-kn 0.5,2,3.5]`
+//! `cargo run --release -p seatrial-core --example precision_table -- [seeds=20] [--threads 2] [--own] [--retune] [--no-recursive] [--designed] [--generic-autopilot] [--linear] [--tune-seed N] [--inferred-autopilot] [--repeat N] [--tsv PATH] [--grid-kn 0.5,2,3.5]`
 
 #[path = "../tests/support/precision_truth.rs"]
 mod precision_truth;
@@ -36,6 +38,7 @@ fn main() {
     let mut retune = false;
     let mut variant = precision_truth::PlanVariant::default();
     let mut tsv: Option<String> = None;
+    let mut inferred = false;
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
@@ -46,6 +49,7 @@ fn main() {
             "--designed" => variant.designed = true,
             "--generic-autopilot" => variant.generic_autopilot = true,
             "--linear" => variant.linear_damping = true,
+            "--inferred-autopilot" => inferred = true,
             "--tune-seed" => {
                 variant.tune_seed = Some(
                     it.next()
@@ -70,7 +74,37 @@ fn main() {
         }
     }
     let t0 = Instant::now();
-    let setup = precision_truth::setup(&variant);
+    let mut setup = precision_truth::setup(&variant);
+    if inferred {
+        // A first dive (noise seed 1000, not among the compared seeds)
+        // flown by the truth; the autopilot inferred from its logs replaces
+        // the declared one.
+        let fit = precision_truth::infer_truth_autopilot(&setup, 1000);
+        let c = &setup.controller;
+        println!("autopilot inferred from the first dive (truth in brackets):");
+        for l in &fit.loops {
+            let i = l.dof.index();
+            println!(
+                "  {:<6} kp {:.4e} [{:.4e}]  ki {:.4e} [{:.4e}]  kd {} [{:.4e}]  R² {:.4}  {} pairs",
+                l.dof.name(),
+                l.gains.kp,
+                c.kp[i],
+                l.gains.ki,
+                c.ki[i],
+                l.gains.kd.map_or("—".to_string(), |k| format!("{k:.4e}")),
+                c.kd[i],
+                l.r_squared,
+                l.pairs
+            );
+        }
+        if let Some(g) = &fit.autopilot.restoring_feed_forward {
+            println!(
+                "  W − B {:.4e} [{:.4e}] N, z_G W − z_B B {:.4e} [{:.4e}] N·m",
+                g.w_minus_b, c.nominal_w_minus_b, g.zg_w_minus_zb_b, c.nominal_zg_w_minus_zb_b
+            );
+        }
+        setup.profile.autopilot = Some(fit.autopilot);
+    }
     let hours = setup.plan.totals.total_time_s / 3600.0;
     println!(
         "plan: {} runs, {hours:.2} ship hours (runs and set-up)",

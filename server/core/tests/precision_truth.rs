@@ -135,3 +135,46 @@ fn on_the_designed_campaign_too() {
         "{within} of {live} parameters within {FACTOR}×"
     );
 }
+
+/// The autopilot the service infers from a first dive's logs
+/// (`identification::autopilot_fit`) is the truth's: every gain and the
+/// feed-forward within 2 % (the PI gains' integral is summed at the log's
+/// 10 Hz, the autopilot's at 20 Hz).
+#[test]
+fn the_truths_autopilot_is_inferred_from_a_first_dive() {
+    let s = setup(&PlanVariant::default());
+    let fit = precision_truth::infer_truth_autopilot(&s, 1000);
+    let c = &s.controller;
+    let close = |got: f64, want: f64, what: &str| {
+        assert!(
+            (got - want).abs() <= 0.02 * want.abs(),
+            "{what}: inferred {got:.5e}, the truth's {want:.5e}"
+        );
+    };
+    for l in &fit.loops {
+        let i = l.dof.index();
+        let name = l.dof.name();
+        close(l.gains.kp, c.kp[i], &format!("{name} kp"));
+        if c.ki[i] > 0.0 {
+            close(l.gains.ki, c.ki[i], &format!("{name} ki"));
+        } else {
+            // No integral: what is fitted is noise, far below K_p.
+            assert!(l.gains.ki < 1e-3 * c.kp[i], "{name} ki {}", l.gains.ki);
+        }
+        match l.gains.kd {
+            Some(kd) => close(kd, c.kd[i], &format!("{name} kd")),
+            None => assert!(!matches!(i, 3 | 4), "{name} is an attitude loop"),
+        }
+        assert!(l.r_squared > 0.99, "{name} R² {}", l.r_squared);
+    }
+    let g = fit
+        .autopilot
+        .restoring_feed_forward
+        .expect("ĝ is fed forward");
+    close(g.w_minus_b, c.nominal_w_minus_b, "W − B");
+    close(
+        g.zg_w_minus_zb_b,
+        c.nominal_zg_w_minus_zb_b,
+        "z_G W − z_B B",
+    );
+}

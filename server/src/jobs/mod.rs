@@ -106,6 +106,7 @@
 pub mod design;
 pub mod discover;
 pub mod events;
+mod flown_autopilot;
 pub mod handler;
 pub mod heartbeat;
 pub mod identify;

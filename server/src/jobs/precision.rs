@@ -9,10 +9,12 @@ use seatrial_core::design::{
     predict_precision,
 };
 use seatrial_core::estimation::Progress;
+use seatrial_core::identification::autopilot_fit::InferredAutopilot;
 use seatrial_core::identification::document::ModelDocument;
 use seatrial_core::planning::{ExperimentFamily, Plan, PlannedExperiment};
 use serde::{Deserialize, Serialize};
 
+use super::flown_autopilot;
 use super::handler::{BoxFuture, Compute, JobContext, JobFailure, JobHandler, compute};
 use super::identify::parse_settings;
 use crate::error::ApiError;
@@ -74,6 +76,11 @@ pub struct PrecisionResult {
     pub plan_version: i64,
     /// The table.
     pub prediction: PrecisionPrediction,
+    /// For an ROV whose profile declares no autopilot: the one inferred
+    /// from the campaign's flown runs, which the prediction flew (copy it
+    /// into the vessel profile's `autopilot` to keep it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inferred_autopilot: Option<InferredAutopilot>,
 }
 
 /// The `precision` handler.
@@ -289,22 +296,45 @@ impl JobHandler for Precision {
             let choice = c.settings.prior(req);
             let seed = c.settings.seed.unwrap_or(1);
             let realisations = c.settings.realisations;
+            let flown = flown_autopilot::flown_planned(cx, &cid, &c.profile, &stored).await?;
             let (plan_id, plan_version) = (stored.id.clone(), stored.version);
             Ok(compute(move |progress: &mut dyn Progress| {
-                let (prior, source) = build_prior(choice, c.model, &c.profile)?;
+                let mut profile = c.profile;
+                let (mut inferred, mut why_not) = (None, None);
+                if !flown.is_empty() {
+                    match flown_autopilot::infer(&profile, &plan, &flown, progress)? {
+                        Ok(fit) => {
+                            profile.autopilot = Some(fit.autopilot.clone());
+                            inferred = Some(fit);
+                        }
+                        Err(why) => why_not = Some(why),
+                    }
+                }
+                let (prior, source) = build_prior(choice, c.model, &profile)?;
                 let defaults = PredictSettings::default();
                 let settings = PredictSettings {
                     seed,
                     realisations: realisations.unwrap_or(defaults.realisations),
                     ..defaults
                 };
-                let prediction =
-                    predict_precision(&c.profile, &plan, &prior, source, &settings, progress)
+                let mut prediction =
+                    predict_precision(&profile, &plan, &prior, source, &settings, progress)
                         .map_err(failure)?;
+                if let Some(fit) = &inferred {
+                    prediction.notes.insert(
+                        1,
+                        format!(
+                            "the profile declares no autopilot: it was inferred from {} flown runs of the plan (`inferred_autopilot`), and the plan flown through it",
+                            fit.loops.iter().map(|l| l.runs).max().unwrap_or(0)
+                        ),
+                    );
+                }
+                prediction.notes.extend(why_not);
                 serde_json::to_value(PrecisionResult {
                     plan_id,
                     plan_version,
                     prediction,
+                    inferred_autopilot: inferred,
                 })
                 .map_err(|e| JobFailure::new(e.to_string()))
             }))

@@ -319,7 +319,7 @@ pub fn predict_precision(
     };
     let loops = match (prior, &profile.autopilot) {
         (Prior::Rov(_), Some(_)) => Some(
-            "the ROV flies the plan through the autopilot the vessel profile declares (its loops' gains and ĝ(η) feed-forward), as it will at sea".to_string(),
+            "the ROV flies the plan through its own autopilot (the loops' gains and ĝ(η) feed-forward of the vessel profile, or inferred from flown runs), as it will at sea".to_string(),
         ),
         (Prior::Rov(_), None) => Some(
             "the vessel profile declares no autopilot, so the ROV flies the plan through generic PI loops designed from its limits; how stiffly the real loops hold each DOF decides how much sensor noise becomes thrust and motion, so declare the autopilot (`autopilot` in the profile) for a sharper prediction (on the independent truth: within 1.5× of the spread for 92 % of the parameters with it, 57 % without)".to_string(),

@@ -27,6 +27,7 @@
 mod attitude_fusion;
 pub mod attitude_loop;
 pub mod augmented;
+pub mod autopilot_fit;
 pub mod bis;
 pub mod dataset;
 pub mod describe;

@@ -19,6 +19,7 @@ use std::collections::BTreeMap;
 use nalgebra::Matrix6;
 use seatrial_core::design::{PrecisionPrediction, PredictSettings, Prior, PriorSource};
 use seatrial_core::estimation::NoProgress;
+use seatrial_core::identification::autopilot_fit::{InferredAutopilot, infer_autopilot};
 use seatrial_core::identification::document::ParameterRow;
 use seatrial_core::identification::{LambdaCampaignSettings, RunInput, identify_lambda_campaign};
 use seatrial_core::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
@@ -275,9 +276,10 @@ pub fn fly_and_identify_retuned(s: &Setup, seed: u64) -> Estimates {
     identify_flown(s, &flown)
 }
 
-fn identify_flown(s: &Setup, flown: &[seatrial_truth::Run]) -> Estimates {
-    let inputs: Vec<RunInput> = s
-        .plan
+/// The truth's flown runs as the service reads them: each run's single
+/// CSV through the parser, paired with its planned experiment.
+pub fn run_inputs(s: &Setup, flown: &[seatrial_truth::Run]) -> Vec<RunInput> {
+    s.plan
         .experiments
         .iter()
         .zip(flown)
@@ -297,7 +299,20 @@ fn identify_flown(s: &Setup, flown: &[seatrial_truth::Run]) -> Estimates {
                 record,
             }
         })
-        .collect();
+        .collect()
+}
+
+/// Infers the truth's autopilot from its flown runs (noise seed `seed`),
+/// as the service would from a first dive.
+pub fn infer_truth_autopilot(s: &Setup, seed: u64) -> InferredAutopilot {
+    let flown = fly_external_runs(&s.vessel, &s.controller, &s.runs, &s.noise, seed);
+    let inputs = run_inputs(s, &flown);
+    let pairs: Vec<_> = s.plan.experiments.iter().zip(inputs.iter()).collect();
+    infer_autopilot(&s.profile, &pairs).expect("the truth's autopilot is inferred")
+}
+
+fn identify_flown(s: &Setup, flown: &[seatrial_truth::Run]) -> Estimates {
+    let inputs = run_inputs(s, flown);
     let id = identify_lambda_campaign(
         &s.profile,
         &grid(&s.plan),
