@@ -112,18 +112,13 @@ struct Rows {
 }
 
 /// ĝ's shape for DOF `d` at (φ, θ): the factor of W − B (u, v, w) or of
-/// z_G W − z_B B (φ, θ); yaw has none.
+/// z_G W − z_B B (φ, θ) in the lumped g(η); yaw has none.
 fn restoring_shape(d: Dof, phi: f64, theta: f64) -> Option<f64> {
-    let (sf, cf) = phi.sin_cos();
-    let (st, ct) = theta.sin_cos();
-    match d {
-        Dof::Surge => Some(st),
-        Dof::Sway => Some(-ct * sf),
-        Dof::Heave => Some(-ct * cf),
-        Dof::Roll => Some(ct * sf),
-        Dof::Pitch => Some(st),
-        Dof::Yaw => None,
-    }
+    let unit = RestoringFeedForward {
+        w_minus_b: 1.0,
+        zg_w_minus_zb_b: 1.0,
+    };
+    (d != Dof::Yaw).then(|| unit.force(phi, theta)[d.index()])
 }
 
 /// Infers the autopilot of an ROV `profile` from flown `runs`, each paired

@@ -371,43 +371,38 @@ pub fn fly_experiment(
             (nu, eta)
         };
         let mut rate_ref = [0.0; 6];
-        if let Some(ap) = declared.as_mut() {
-            let setpoints: [Setpoint; 6] = std::array::from_fn(|i| match drives[i] {
-                Drive::Velocity(c) => Setpoint::Velocity(reference(c, k)),
-                Drive::Attitude(c) => Setpoint::Attitude(reference(c, k)),
-                Drive::Force(_) | Drive::Passive => Setpoint::Idle,
-            });
-            let (nu_a, eta_a): ([f64; 6], [f64; 6]) = (nu_m.into(), eta_m.into());
-            let (tau, rate) = ap.step(&setpoints, &nu_a, &eta_a, k >= n_lead);
-            rate_ref = rate;
-            for (i, d) in drives.iter().enumerate() {
-                tau_cmd[(k, i)] = match *d {
-                    Drive::Force(c) => {
-                        let l = profile.limit(Dof::ALL[i]).max_force;
-                        reference(c, k).clamp(-l, l)
-                    }
-                    _ => tau[i].unwrap_or(0.0),
+        // The declared autopilot's τ and rate references, when it flies.
+        let declared_tau = match declared.as_mut() {
+            Some(ap) => {
+                let setpoints: [Setpoint; 6] = std::array::from_fn(|i| match drives[i] {
+                    Drive::Velocity(c) => Setpoint::Velocity(reference(c, k)),
+                    Drive::Attitude(c) => Setpoint::Attitude(reference(c, k)),
+                    Drive::Force(_) | Drive::Passive => Setpoint::Idle,
+                });
+                let (tau, rate) = ap.step(&setpoints, &nu_m.into(), &eta_m.into(), k >= n_lead);
+                rate_ref = rate;
+                Some(tau)
+            }
+            None => None,
+        };
+        for (i, d) in drives.iter().enumerate() {
+            if declared_tau.is_none() {
+                rate_ref[i] = match (*d, &attitude[i]) {
+                    (Drive::Velocity(c), _) => reference(c, k),
+                    (Drive::Attitude(c), Some(a)) => a.rate_reference(reference(c, k), eta_m[i]),
+                    _ => 0.0,
                 };
             }
-        }
-        for (i, d) in drives.iter().enumerate() {
-            if declared.is_some() {
-                break;
-            }
-            rate_ref[i] = match (*d, &attitude[i]) {
-                (Drive::Velocity(c), _) => reference(c, k),
-                (Drive::Attitude(c), Some(a)) => a.rate_reference(reference(c, k), eta_m[i]),
-                _ => 0.0,
-            };
-            tau_cmd[(k, i)] = match *d {
-                Drive::Velocity(_) | Drive::Attitude(_) => pis[i]
-                    .as_mut()
-                    .map_or(0.0, |pi| pi.step(rate_ref[i], nu_m[i])),
-                Drive::Force(c) => {
+            tau_cmd[(k, i)] = match (*d, &declared_tau) {
+                (Drive::Force(c), _) => {
                     let l = profile.limit(Dof::ALL[i]).max_force;
                     reference(c, k).clamp(-l, l)
                 }
-                Drive::Passive => 0.0,
+                (Drive::Passive, _) => 0.0,
+                (_, Some(tau)) => tau[i].unwrap_or(0.0),
+                (_, None) => pis[i]
+                    .as_mut()
+                    .map_or(0.0, |pi| pi.step(rate_ref[i], nu_m[i])),
             };
         }
         let shaped = acts.shaped(&tau_cmd, k);
