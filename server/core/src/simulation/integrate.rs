@@ -9,17 +9,27 @@ where
     F: FnMut(&[f64], &[f64], &mut [f64]),
 {
     let n = x.len();
-    // Stages on the stack for the small systems stepped millions of times
-    // (a vehicle's ν with a few extra states), on the heap beyond.
-    const SMALL: usize = 16;
-    let mut stack = [0.0f64; 5 * SMALL];
-    let mut heap = Vec::new();
-    let buf: &mut [f64] = if n <= SMALL {
-        &mut stack[..5 * n]
+    with_stages(5 * n, |buf| rk4_stages(f, x, u, h, buf));
+}
+
+/// Runs `f` on `len` zeroed scratch values: on the stack for the small
+/// systems stepped millions of times (a vehicle's ν with a few extra
+/// states: nine stages of 16), on the heap beyond.
+pub(crate) fn with_stages<R>(len: usize, f: impl FnOnce(&mut [f64]) -> R) -> R {
+    const SMALL: usize = 144;
+    if len <= SMALL {
+        let mut stack = [0.0f64; SMALL];
+        f(&mut stack[..len])
     } else {
-        heap.resize(5 * n, 0.0);
-        &mut heap
-    };
+        f(&mut vec![0.0; len])
+    }
+}
+
+fn rk4_stages<F>(f: &mut F, x: &mut [f64], u: &[f64], h: f64, buf: &mut [f64])
+where
+    F: FnMut(&[f64], &[f64], &mut [f64]),
+{
+    let n = x.len();
     let (k1, rest) = buf.split_at_mut(n);
     let (k2, rest) = rest.split_at_mut(n);
     let (k3, rest) = rest.split_at_mut(n);
