@@ -22,7 +22,7 @@ use super::lambda_coriolis::{fit_points, pooled_inertia};
 use super::lambda_data::{experiment, per_point, regression_columns, static_holds};
 use super::lambda_extension::{Sides, choose_extension, speed_coverage_notes};
 use super::lambda_information::default_t_lambda;
-use super::lambda_physical::enforce;
+use super::lambda_physical::{enforce, unresolved_mode};
 use super::lambda_quadratic;
 use super::lambda_structure::choose_structure;
 use super::lambda_validation::{HeldOut, choose_second_order};
@@ -420,6 +420,7 @@ pub fn identify_lambda_campaign(
         )?;
         findings.extend(physical.findings);
         let model = physical.model;
+        findings.extend(unresolved_mode(&dofs, model.a(), est.h, *speed));
         for i in 0..n {
             for j in 0..n {
                 for (group, value, std, per_s) in [
