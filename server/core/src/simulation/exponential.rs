@@ -74,11 +74,6 @@ impl EtdRk4 {
         }
     }
 
-    /// Step length h (s).
-    pub fn h(&self) -> f64 {
-        self.h
-    }
-
     /// One step of ẋ = L·x[..n] + N(x, u) over h with `u` held. `nl(x, u,
     /// dx)` writes N (the derivative without L·x) into `dx`.
     pub fn step<F>(&self, nl: &mut F, x: &mut [f64], u: &[f64])
