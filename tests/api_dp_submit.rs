@@ -3,9 +3,9 @@
 //! in degrees declared in the upload's meta), uploaded without a plan; what
 //! each run is is inferred from the data. A `parallel_ekf` job that cannot
 //! run is refused at `POST /api/jobs` with a 422 naming what is missing —
-//! no validation run, a manoeuvre, the pose of a velocity-only log, a
-//! thruster layout the θ″ parameterization does not cover — and nothing is
-//! queued; a profile without M″ is identified and says how.
+//! no validation run, a manoeuvre, the pose of a velocity-only log — and
+//! nothing is queued; a profile without M″ is identified and says how, and
+//! so is a vessel with another thruster layout (two tunnels, two azimuths).
 
 mod common;
 
@@ -13,7 +13,8 @@ use common::flights::planned_campaign;
 use common::{TestApp, dp_profile};
 use seatrial::jobs::{JobRegistry, JobsConfig};
 use seatrial_core::planning::examples::supply_vessel_trial_campaign;
-use seatrial_truth::dp_ship::{DpTrial, fly_dp_campaign};
+use seatrial_truth::dp_layouts::{AZ_K, AZ_T, DpLayout, fly_dp_layout_campaign};
+use seatrial_truth::dp_ship::{self, DpTrial, fly_dp_campaign};
 use serde_json::{Value, json};
 
 /// The log with ψ (the last column) in degrees.
@@ -191,7 +192,7 @@ async fn position_only_logs_are_accepted_and_bad_jobs_are_refused_at_submit() {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn a_profile_without_inertia_is_identified_and_a_foreign_layout_is_refused() {
+async fn a_profile_without_inertia_and_another_thruster_layout_are_identified() {
     let app = TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await;
     let mut profile = dp_profile();
     profile["name"] = json!("supply vessel without M″");
@@ -214,27 +215,54 @@ async fn a_profile_without_inertia_is_identified_and_a_foreign_layout_is_refused
     let findings = m.json["document"]["structure_findings"].to_string();
     assert!(findings.contains("θ″3 (A″_h23)"), "{findings}");
 
-    // Two azimuths and two tunnels: the profile is valid, its logs are
-    // accepted, but the θ″ of eq. 47 do not cover the layout.
-    let mut four = profile;
-    four["name"] = json!("two azimuths, two tunnels");
-    let thr = |name: &str, kind: &str| json!({ "name": name, "kind": kind, "max_command": 1.0, "max_rate": 0.1 });
+    // Two tunnels and two aft azimuths sharing one coefficient: the logs of
+    // the truth's other layout, uploaded without a plan, are staged by
+    // where their force goes and identified end to end.
+    let mut four = dp_profile();
+    four["name"] = json!("two tunnels, two azimuths");
+    let thr = |name: &str, kind: &str, group: &str| json!({ "name": name, "kind": kind, "max_command": 1.0, "max_rate": 0.1, "coefficient_group": group });
     four["inputs"] = json!({
         "kind": "thrusters",
-        "thrusters": [thr("aft azimuth port", "azimuth"), thr("aft azimuth stbd", "azimuth"),
-                      thr("bow tunnel I", "tunnel"), thr("bow tunnel II", "tunnel")],
-        "configuration": [[1.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.0], [0.1, -0.1, 0.45, 0.42]]
+        "thrusters": [thr("bow tunnel", "tunnel", "bow"), thr("stern tunnel", "tunnel", "stern"),
+                      thr("port azimuth", "azimuth", "azimuths"), thr("starboard azimuth", "azimuth", "azimuths")],
+        "configuration": AZ_T.iter().map(|r| r.to_vec()).collect::<Vec<_>>()
     });
     let mut spec = serde_json::to_value(supply_vessel_trial_campaign(3)).unwrap();
-    spec["families"] = json!(["dp_sway_yaw", "dp_azimuth", "validation"]);
+    spec["families"] = json!(["validation"]);
     let (cid4, _) = planned_campaign(&app, four, spec).await;
-    let body = json!({ "kind": "identify", "campaign_id": cid4, "method": "parallel_ekf" });
-    let r = app.call("POST", "/api/jobs", &[], Some(body)).await;
-    assert_eq!(r.status, 422, "{}", r.text);
-    assert_eq!(r.json["field"], "vessel.inputs.thrusters", "{}", r.text);
+    for log in fly_dp_layout_campaign(&DpTrial::default(), DpLayout::AzimuthsTunnels, 11) {
+        upload(&app, &cid4, &log.name, &log.csv, json!({})).await;
+    }
+    let runs = app
+        .call("GET", "/api/campaigns/{id}/runs", &[&cid4], None)
+        .await;
+    eprintln!("{}", runs.text);
+    let job = common::run_job(
+        &app,
+        json!({ "kind": "identify", "campaign_id": cid4, "method": "parallel_ekf" }),
+    )
+    .await;
+    let mid = job["result"]["model_id"].as_str().unwrap();
+    let m = app.call("GET", "/api/models/{id}", &[mid], None).await;
+    assert_eq!(m.status, 200, "{}", m.text);
+    let doc = &m.json["document"];
+    let k = doc["dp_ship"]["k"].as_array().unwrap();
+    assert_eq!(k.len(), 4, "{k:?}");
+    assert_eq!(k[2], k[3]);
+    for (j, want) in AZ_K.iter().enumerate() {
+        let got = k[j].as_f64().unwrap();
+        assert!(
+            (got / want - 1.0).abs() < 0.05,
+            "K″ of thr_{}: {got}",
+            j + 1
+        );
+    }
+    let a11 = doc["dp_ship"]["theta"][0].as_f64().unwrap();
+    assert!((a11 / dp_ship::A_H[0][0] - 1.0).abs() < 0.05, "θ″1 = {a11}");
+    assert_eq!(doc["parameters"].as_array().unwrap().len(), 8);
+    let notes = doc["notes"].to_string();
     assert!(
-        r.text.contains("azimuth, azimuth, tunnel, tunnel"),
-        "{}",
-        r.text
+        notes.contains("grouped as the profile says: bow, stern, azimuths"),
+        "{notes}"
     );
 }

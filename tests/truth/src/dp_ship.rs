@@ -80,7 +80,8 @@ pub struct DpLog {
     pub name: String,
     /// What it flew.
     pub manoeuvre: DpManoeuvre,
-    /// The CSV log (header `t,thr_1,…,thr_6,x,y,psi[,u,v,r]`).
+    /// The CSV log (header `t,thr_1,…,thr_6,x,y,psi[,u,v,r]`; the other
+    /// layouts' headers are in [`crate::dp_layouts`]).
     pub csv: String,
 }
 
@@ -289,62 +290,122 @@ fn run_samples(kind: DpManoeuvre, trial: &DpTrial) -> usize {
     }
 }
 
-/// Commands (n × 6) of a manoeuvre.
-fn commands(kind: DpManoeuvre, n: usize, inputs: &DpInputs, rng: &mut Rng) -> Vec<[f64; 6]> {
-    if let DpInputs::Prbs {
-        level,
-        slew,
-        surge,
-        sway_yaw,
-        azimuth,
-        validation,
-    } = *inputs
-    {
-        return prbs_commands(
-            kind,
-            n,
-            level,
-            slew,
-            [surge, sway_yaw, azimuth, validation],
-            rng,
-        );
-    }
-    let mut u = vec![[0.0; 6]; n];
-    let mut set = |cols: &[usize], p: Vec<f64>| {
-        for (row, pk) in u.iter_mut().zip(p) {
-            for &c in cols {
-                row[c] = pk;
-            }
-        }
-    };
-    match kind {
-        DpManoeuvre::Surge => set(&[0, 1], pitch(rng, n, (80.0, 160.0), (0.3, 0.6))),
-        DpManoeuvre::SwayYaw => {
-            set(&[2, 3], pitch(rng, n, (40.0, 120.0), (0.4, 1.0)));
-            set(&[4], pitch(rng, n, (40.0, 120.0), (0.4, 1.0)));
-        }
-        DpManoeuvre::Azimuth => set(&[5], pitch(rng, n, (60.0, 150.0), (0.4, 1.0))),
-        DpManoeuvre::Validation => {
-            set(&[0, 1], pitch(rng, n, (80.0, 160.0), (0.2, 0.4)));
-            set(&[2, 3], pitch(rng, n, (40.0, 120.0), (0.3, 0.8)));
-            set(&[4], pitch(rng, n, (40.0, 120.0), (0.3, 0.8)));
-            set(&[5], pitch(rng, n, (60.0, 150.0), (0.3, 0.8)));
-        }
-    }
-    u
+/// Thrusters flown by one command sequence in a manoeuvre, with the hold
+/// (samples) and |p| range of its [`DpInputs::Pitch`] levels.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Group {
+    /// Thruster columns (0-based) that share the sequence.
+    pub cols: &'static [usize],
+    /// Hold of each pitch level (samples).
+    pub hold: (f64, f64),
+    /// Range of |p|.
+    pub level: (f64, f64),
 }
 
-/// Binary commands (n × 6) of a manoeuvre ([`DpInputs::Prbs`]); `runs` is
-/// SI1, SI2, SI3, validation.
-fn prbs_commands(
+/// What a log carries between t and the pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Logged {
+    /// The thruster commands `thr_1 … thr_r`.
+    Commands,
+    /// The commanded generalized forces τ″ = T″K″u (bias excluded) in SI,
+    /// `tau_X,tau_Y,tau_N` (N, N, N·m), for a displacement mass (kg).
+    Forces(f64),
+}
+
+/// A thruster layout on the paper's hull: T″ by rows (3 × r), K″ (r), the
+/// manoeuvres of a campaign with their run codes, the groups each
+/// manoeuvre flies, and what the log carries.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Layout {
+    /// Rows of T″.
+    pub t: [&'static [f64]; 3],
+    /// K″ per thruster.
+    pub k: &'static [f64],
+    /// SI manoeuvres in campaign order, e.g. `(Surge, "SI1")`.
+    pub runs: &'static [(DpManoeuvre, &'static str)],
+    /// The groups a manoeuvre flies, in the order their commands are drawn.
+    pub plan: fn(DpManoeuvre) -> &'static [Group],
+    /// Commands or forces.
+    pub logged: Logged,
+}
+
+/// The paper's six thrusters, flown as in Fig. 5–7.
+pub(crate) const PAPER: Layout = Layout {
+    t: [&T[0], &T[1], &T[2]],
+    k: &K,
+    runs: &[
+        (DpManoeuvre::Surge, "SI1"),
+        (DpManoeuvre::SwayYaw, "SI2"),
+        (DpManoeuvre::Azimuth, "SI3"),
+    ],
+    plan: paper_plan,
+    logged: Logged::Commands,
+};
+
+/// Groups of the paper's manoeuvres: mains together (SI1), aft tunnels
+/// against the bow tunnel (SI2), the azimuth alone (SI3), all (validation).
+fn paper_plan(kind: DpManoeuvre) -> &'static [Group] {
+    match kind {
+        DpManoeuvre::Surge => &[Group {
+            cols: &[0, 1],
+            hold: (80.0, 160.0),
+            level: (0.3, 0.6),
+        }],
+        DpManoeuvre::SwayYaw => &[
+            Group {
+                cols: &[2, 3],
+                hold: (40.0, 120.0),
+                level: (0.4, 1.0),
+            },
+            Group {
+                cols: &[4],
+                hold: (40.0, 120.0),
+                level: (0.4, 1.0),
+            },
+        ],
+        DpManoeuvre::Azimuth => &[Group {
+            cols: &[5],
+            hold: (60.0, 150.0),
+            level: (0.4, 1.0),
+        }],
+        DpManoeuvre::Validation => &[
+            Group {
+                cols: &[0, 1],
+                hold: (80.0, 160.0),
+                level: (0.2, 0.4),
+            },
+            Group {
+                cols: &[2, 3],
+                hold: (40.0, 120.0),
+                level: (0.3, 0.8),
+            },
+            Group {
+                cols: &[4],
+                hold: (40.0, 120.0),
+                level: (0.3, 0.8),
+            },
+            Group {
+                cols: &[5],
+                hold: (60.0, 150.0),
+                level: (0.3, 0.8),
+            },
+        ],
+    }
+}
+
+/// Commands (n × r) of a manoeuvre flying `groups` on r thrusters. Pitch:
+/// one held-level sequence per group. Prbs: the first group flies the
+/// run's m-sequence, later groups the same sequence delayed by ⌊m/2⌋ chips;
+/// validation draws independent signs per group.
+pub(crate) fn commands(
     kind: DpManoeuvre,
     n: usize,
-    level: f64,
-    slew: f64,
-    runs: [PrbsRun; 4],
+    inputs: &DpInputs,
+    groups: &[Group],
+    r: usize,
     rng: &mut Rng,
-) -> Vec<[f64; 6]> {
-    let mut u = vec![[0.0; 6]; n];
+) -> Vec<Vec<f64>> {
+    let mut u = vec![vec![0.0; r]; n];
     let mut set = |cols: &[usize], p: Vec<f64>| {
         for (row, pk) in u.iter_mut().zip(p) {
             for &c in cols {
@@ -352,37 +413,64 @@ fn prbs_commands(
             }
         }
     };
-    let [surge, sway_yaw, azimuth, validation] = runs;
-    match kind {
-        DpManoeuvre::Surge => {
-            let s = m_sequence(rng, surge.order);
-            set(&[0, 1], binary(&s, surge.chip_s, n, level, slew));
+    match *inputs {
+        DpInputs::Pitch => {
+            for g in groups {
+                set(g.cols, pitch(rng, n, g.hold, g.level));
+            }
         }
-        DpManoeuvre::SwayYaw => {
-            let s = m_sequence(rng, sway_yaw.order);
-            let mut bow = s.clone();
-            bow.rotate_left(s.len() / 2);
-            set(&[2, 3], binary(&s, sway_yaw.chip_s, n, level, slew));
-            set(&[4], binary(&bow, sway_yaw.chip_s, n, level, slew));
-        }
-        DpManoeuvre::Azimuth => {
-            let s = m_sequence(rng, azimuth.order);
-            set(&[5], binary(&s, azimuth.chip_s, n, level, slew));
-        }
-        DpManoeuvre::Validation => {
-            let chips = (n as f64 / validation.chip_s).ceil() as usize + 1;
-            for cols in [&[0, 1][..], &[2, 3], &[4], &[5]] {
-                let s: Vec<f64> = (0..chips).map(|_| rng.sign()).collect();
-                set(cols, binary(&s, validation.chip_s, n, level, slew));
+        DpInputs::Prbs {
+            level,
+            slew,
+            surge,
+            sway_yaw,
+            azimuth,
+            validation,
+        } => {
+            if kind == DpManoeuvre::Validation {
+                let chips = (n as f64 / validation.chip_s).ceil() as usize + 1;
+                for g in groups {
+                    let s: Vec<f64> = (0..chips).map(|_| rng.sign()).collect();
+                    set(g.cols, binary(&s, validation.chip_s, n, level, slew));
+                }
+            } else {
+                let run = match kind {
+                    DpManoeuvre::Surge => surge,
+                    DpManoeuvre::SwayYaw => sway_yaw,
+                    _ => azimuth,
+                };
+                let s = m_sequence(rng, run.order);
+                let mut delayed = s.clone();
+                delayed.rotate_left(s.len() / 2);
+                for (i, g) in groups.iter().enumerate() {
+                    let chips = if i == 0 { &s } else { &delayed };
+                    set(g.cols, binary(chips, run.chip_s, n, level, slew));
+                }
             }
         }
     }
     u
 }
 
-/// Flies one run and writes its log.
-fn fly(kind: DpManoeuvre, name: String, trial: &DpTrial, seed: u64) -> DpLog {
+/// Flies one run of `layout` and writes its log.
+fn fly(kind: DpManoeuvre, name: String, trial: &DpTrial, layout: &Layout, seed: u64) -> DpLog {
     let mut rng = Rng::new(seed);
+    let n = run_samples(kind, trial);
+    let groups = (layout.plan)(kind);
+    let u = commands(kind, n, &trial.inputs, groups, layout.k.len(), &mut rng);
+    simulate(kind, name, trial, layout, &u, &mut rng)
+}
+
+/// Flies the commands `u` (n × r) on `layout`, drawing the initial bias and
+/// heading, the noise and the bias walk from `rng`, and writes the log.
+pub(crate) fn simulate(
+    kind: DpManoeuvre,
+    name: String,
+    trial: &DpTrial,
+    layout: &Layout,
+    u: &[Vec<f64>],
+    rng: &mut Rng,
+) -> DpLog {
     let m = mat(&M);
     let m_inv = m.try_inverse().expect("M″ is invertible");
     let d = -mat(&A_H) * m;
@@ -390,26 +478,43 @@ fn fly(kind: DpManoeuvre, name: String, trial: &DpTrial, seed: u64) -> DpLog {
     let h = 1.0 / time_unit; // 1 s in Bis time
     let steps = 10;
     let dt = h / steps as f64;
-    let n = run_samples(kind, trial);
-    let u = commands(kind, n, &trial.inputs, &mut rng);
+    let (t, k) = (layout.t, layout.k);
     let mut b: [f64; 3] = std::array::from_fn(|i| trial.bias_initial[i] * rng.normal());
     let heading0 = rng.range(-std::f64::consts::PI, std::f64::consts::PI);
     let mut s = [0.0, 0.0, 0.0, 0.0, 0.0, heading0];
-    let mut csv = String::from("t,thr_1,thr_2,thr_3,thr_4,thr_5,thr_6,x,y,psi");
+    let mut csv = String::from("t");
+    match layout.logged {
+        Logged::Commands => (1..=k.len()).for_each(|j| csv.push_str(&format!(",thr_{j}"))),
+        Logged::Forces(_) => csv.push_str(",tau_X,tau_Y,tau_N"),
+    }
+    csv.push_str(",x,y,psi");
     if trial.log_velocities {
         csv.push_str(",u,v,r");
     }
     csv.push('\n');
     let vel = LENGTH_M / time_unit;
-    for (k, uk) in u.iter().enumerate() {
+    for (kk, uk) in u.iter().enumerate() {
         let x = s[3] * LENGTH_M + trial.position_noise_m * rng.normal();
         let y = s[4] * LENGTH_M + trial.position_noise_m * rng.normal();
         let psi = s[5] + trial.heading_noise_rad * rng.normal();
         let psi =
             (psi + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-        csv.push_str(&format!("{}", k as f64));
-        for c in uk {
-            csv.push_str(&format!(",{c:.6}"));
+        csv.push_str(&format!("{}", kk as f64));
+        match layout.logged {
+            Logged::Commands => {
+                for c in uk {
+                    csv.push_str(&format!(",{c:.6}"));
+                }
+            }
+            Logged::Forces(mass) => {
+                let mg = mass * GRAVITY;
+                let scale = [mg, mg, mg * LENGTH_M];
+                for i in 0..3 {
+                    let tau: f64 = (0..uk.len()).map(|j| t[i][j] * k[j] * uk[j]).sum();
+                    // + 0.0 writes −0 as 0.
+                    csv.push_str(&format!(",{:.12e}", tau * scale[i] + 0.0));
+                }
+            }
         }
         csv.push_str(&format!(",{x:.4},{y:.4},{psi:.6}"));
         if trial.log_velocities {
@@ -424,7 +529,7 @@ fn fly(kind: DpManoeuvre, name: String, trial: &DpTrial, seed: u64) -> DpLog {
         let mut f = Vector3::new(b[0], b[1], b[2]);
         for (j, &c) in uk.iter().enumerate() {
             for i in 0..3 {
-                f[i] += T[i][j] * K[j] * c;
+                f[i] += t[i][j] * k[j] * c;
             }
         }
         for _ in 0..steps {
@@ -448,24 +553,16 @@ fn fly(kind: DpManoeuvre, name: String, trial: &DpTrial, seed: u64) -> DpLog {
     }
 }
 
-/// The campaign of seed `seed`: `repetitions` runs of SI1, SI2, SI3 each,
-/// then `validation_runs` validation runs with every thruster.
-pub fn fly_dp_campaign(trial: &DpTrial, seed: u64) -> Vec<DpLog> {
+/// The campaign of `layout` for seed `seed`: `repetitions` runs of each of
+/// its SI manoeuvres, then `validation_runs` validation runs.
+pub(crate) fn fly_layout(trial: &DpTrial, layout: &Layout, seed: u64) -> Vec<DpLog> {
     let mut out = Vec::new();
     let mut tag = 0;
-    for (kind, code) in [
-        (DpManoeuvre::Surge, "SI1"),
-        (DpManoeuvre::SwayYaw, "SI2"),
-        (DpManoeuvre::Azimuth, "SI3"),
-    ] {
+    for &(kind, code) in layout.runs {
         for r in 1..=trial.repetitions {
             tag += 1;
-            out.push(fly(
-                kind,
-                format!("{code}-{r}"),
-                trial,
-                derive_seed(seed, tag),
-            ));
+            let name = format!("{code}-{r}");
+            out.push(fly(kind, name, trial, layout, derive_seed(seed, tag)));
         }
     }
     for r in 1..=trial.validation_runs {
@@ -474,14 +571,16 @@ pub fn fly_dp_campaign(trial: &DpTrial, seed: u64) -> Vec<DpLog> {
         } else {
             format!("VAL-{r}")
         };
-        out.push(fly(
-            DpManoeuvre::Validation,
-            name,
-            trial,
-            derive_seed(seed, 999 + r as u64),
-        ));
+        let run_seed = derive_seed(seed, 999 + r as u64);
+        out.push(fly(DpManoeuvre::Validation, name, trial, layout, run_seed));
     }
     out
+}
+
+/// The campaign of seed `seed`: `repetitions` runs of SI1, SI2, SI3 each,
+/// then `validation_runs` validation runs with every thruster.
+pub fn fly_dp_campaign(trial: &DpTrial, seed: u64) -> Vec<DpLog> {
+    fly_layout(trial, &PAPER, seed)
 }
 
 #[cfg(test)]

@@ -12,7 +12,9 @@
 //! forces and RK4.
 //!
 //! [`dp_ship`] adds a DP surface vessel (Fossen, Sagatun & Sørensen 1995)
-//! flown through decoupled manoeuvres and logged position-only at 1 Hz.
+//! flown through decoupled manoeuvres and logged position-only at 1 Hz;
+//! [`dp_layouts`] flies the same hull with a four-thruster layout, or logs
+//! the commanded generalized forces instead of the thruster commands.
 //!
 //! Conventions: NED/body frames, SI and radians; z and w positive down;
 //! g(η) on the left-hand side (a heavy vessel, W − B > 0, has g_Z < 0);
@@ -20,6 +22,7 @@
 
 pub mod campaign;
 pub mod controller;
+pub mod dp_layouts;
 pub mod dp_ship;
 pub mod forces;
 pub mod json;

@@ -66,8 +66,11 @@ impl Prior {
                 let t = from_rows(&d.t_config)
                     .filter(|t| t.shape() == (3, 6))
                     .ok_or_else(|| DesignError::new("prior.model_id", "T″ is not 3 × 6"))?;
-                let t = crate::simulation::dp_ship::Matrix3x6::from_fn(|i, j| t[(i, j)]);
-                Ok(Prior::Dp(Box::new(DpShip::from_theta(m, t, &theta))))
+                let thrust = crate::simulation::dp_ship::ThrustLayout {
+                    t,
+                    groups: crate::simulation::dp_ship::ThrustLayout::paper().groups,
+                };
+                Ok(Prior::Dp(Box::new(DpShip::from_theta(m, thrust, &theta))))
             }
             (k, v) => Err(DesignError::new(
                 "prior.model_id",
@@ -118,11 +121,11 @@ impl Prior {
                 Ok(Prior::Rov(Box::new(truth)))
             }
             VesselKind::Dp3 => {
-                let (m, t, scale) = known(profile).map_err(ekf_field)?;
+                let (m, layout, scale) = known(profile).map_err(ekf_field)?;
                 let m = m.unwrap_or_else(|| Matrix3::from_diagonal(&[1.0, 1.0, 1.0 / 16.0].into()));
                 Ok(Prior::Dp(Box::new(DpShip::from_theta(
                     m,
-                    t,
+                    layout.thrust,
                     &default_theta(profile, &scale),
                 ))))
             }
@@ -136,11 +139,11 @@ impl Prior {
         match profile.kind {
             VesselKind::Rov6 => Ok(Prior::Rov(Box::new(RovTruth::surveyor_like()))),
             VesselKind::Dp3 => {
-                let (m, t, _) = known(profile).map_err(ekf_field)?;
+                let (m, layout, _) = known(profile).map_err(ekf_field)?;
                 let paper = DpShip::supply_vessel();
                 Ok(Prior::Dp(Box::new(DpShip::from_theta(
                     m.unwrap_or(paper.m),
-                    t,
+                    layout.thrust,
                     &paper.theta(),
                 ))))
             }

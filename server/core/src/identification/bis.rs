@@ -9,7 +9,6 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use crate::estimation::ekf::IdentifiedDpShip;
 use crate::planning::vessel::DpPrior;
-use crate::simulation::dp_ship::Matrix3x6;
 use crate::simulation::dp_ship::model::rotation;
 use crate::simulation::integrate::rk4_step;
 use crate::validation::{Predictor, ValidationRecord, restart_windows};
@@ -44,10 +43,10 @@ impl BisScale {
         Matrix3::from_fn(|i, j| a[(i, j)] * s[i] / s[j] / self.time_unit_s)
     }
 
-    /// B (SI per unit command) from the Bis B″.
-    pub fn b_si(&self, b: &Matrix3x6) -> Matrix3x6 {
+    /// B (SI per unit input, 3 × r) from the Bis B″.
+    pub fn b_si(&self, b: &DMatrix<f64>) -> DMatrix<f64> {
         let s = self.velocity_units();
-        Matrix3x6::from_fn(|i, j| b[(i, j)] * s[i] / self.time_unit_s)
+        DMatrix::from_fn(3, b.ncols(), |i, j| b[(i, j)] * s[i] / self.time_unit_s)
     }
 
     /// Measured pose (N × 3: x, y in m, ψ in rad) in Bis.
@@ -138,7 +137,8 @@ fn restarted_free_runs(
 ) -> DMatrix<f64> {
     let n = rec.y.nrows();
     let mut out = DMatrix::from_element(n, 3, f64::NAN);
-    if rec.u.ncols() != 6 || rec.u.nrows() != n {
+    let r = model.ship.k.len();
+    if rec.u.ncols() != r || rec.u.nrows() != n {
         return out;
     }
     let Some(states) = model.estimate_states(rec) else {
@@ -146,7 +146,7 @@ fn restarted_free_runs(
     };
     let ship = &model.ship;
     let m_inv = ship.m_inv();
-    let mut w = [0.0; 6];
+    let mut w = vec![0.0; r];
     for (s, e) in restart_windows(n, every) {
         let b = Vector3::new(states[(s, 6)], states[(s, 7)], states[(s, 8)]);
         let mut x: [f64; 6] = std::array::from_fn(|j| states[(s, j)]);

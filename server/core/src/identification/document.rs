@@ -293,17 +293,20 @@ pub struct DpShipDoc {
     pub time_unit_s: f64,
     /// Inertia M″ (known a priori, eq. 30).
     pub m: Matrix,
-    /// Thruster configuration T″ (3 × 6, eq. 29).
+    /// Thruster configuration T″ (3 × r, one column per input channel, eq.
+    /// 29; diag(1, 1, 1/L)/F_ref for a vessel that logs forces τ).
     pub t_config: Matrix,
     /// A″_h = −D″ M″⁻¹ (eq. 39, 48).
     pub a_h: Matrix,
     /// Std of A″_h's entries (0 where structurally zero).
     pub a_h_std: Matrix,
-    /// Thrust coefficients K″ (diagonal, eq. 49).
+    /// Thrust coefficients K″ (diagonal, eq. 49), one per column of T″;
+    /// columns of one coefficient group carry the same value.
     pub k: Vec<f64>,
     /// Std of K″.
     pub k_std: Vec<f64>,
-    /// θ″1 … θ″9 (eq. 46–47).
+    /// θ″1 … θ″9 (eq. 46–47): A″_h, then K″ of coefficient groups 1–4
+    /// (0 for a group the layout does not have).
     pub theta: Vec<f64>,
     /// Their standard deviations.
     pub theta_std: Vec<f64>,

@@ -20,6 +20,7 @@ use super::document::{
 };
 use super::ekf_checks::{every_stage, stage_of};
 use super::ekf_init::{InitBlock, WITHOUT_PRIOR_FINDING, ls_start, without_prior_note};
+use super::ekf_layout::{EkfLayout, ekf_layout, is_paper_layout, stage_frees};
 use super::ekf_refine::{RefineOutcome, not_run, refine_campaign};
 pub use super::ekf_settings::EkfCampaignSettings;
 use super::ekf_settings::{check_settings, nine};
@@ -27,33 +28,17 @@ use super::error::IdentifyError;
 use super::outcome::{Identified, RunValidation};
 use super::roles::assign_roles;
 use crate::estimation::ekf::{
-    DpIdentConfig, DpStage, EkfError, IdentifiedDpShip, RunData, SI1_FREE, SI2_FREE, SI3_FREE,
-    identify_dp_ship,
+    DpIdentConfig, DpStage, EkfError, IdentifiedDpShip, RunData, identify_dp_ship,
 };
 use crate::estimation::{Progress, SubProgress};
 use crate::numbers::sig3;
 use crate::planning::dof::Dof;
-use crate::planning::vessel::{InputChannels, ThrusterKind, VesselKind, VesselProfile};
-use crate::simulation::dp_ship::{Matrix3x6, N_THETA, THETA_NAMES};
+use crate::planning::vessel::{VesselKind, VesselProfile};
+use crate::simulation::dp_ship::N_THETA;
 use crate::validation::{ValidationRecord, ValidationSettings, validate};
 
 /// Shortest block of a run the EKF uses (samples).
 const MIN_SAMPLES: usize = 50;
-
-/// The thruster kinds the θ″ parameterization of eq. 47 assumes, in column
-/// order: two main propellers (K1 = K2), three tunnels (the two stern ones
-/// K3 = K4, the bow one K5), one azimuth (K6).
-const LAYOUT: [ThrusterKind; 6] = [
-    ThrusterKind::Main,
-    ThrusterKind::Main,
-    ThrusterKind::Tunnel,
-    ThrusterKind::Tunnel,
-    ThrusterKind::Tunnel,
-    ThrusterKind::Azimuth,
-];
-
-/// The thruster group (K″ index 0–3: θ″6 … θ″9) of each column of T″.
-const GROUPS: [usize; 6] = [0, 0, 1, 1, 2, 3];
 
 /// The pose columns the EKF measures (Fossen et al. eq. 39: z = [x, y, ψ]).
 pub const EKF_POSE: [&str; 3] = ["x", "y", "psi"];
@@ -62,17 +47,18 @@ pub const EKF_POSE: [&str; 3] = ["x", "y", "psi"];
 const NO_REFINEMENT_WITHOUT_PRIOR: &str = "Not refined after the staging: without M″ the θ″ rest on the rough least-squares inertia, and a likelihood refinement would only fit them tighter to it; θ″ and std are the staged EKF's.";
 
 /// Checks that `profile` can be identified by the parallel EKF: a DP vessel
-/// with surge, sway, yaw, a ship length L, and thrusters in the layout of
-/// the θ″ parameterization; the field that is wrong is named.
+/// with surge, sway, yaw, a ship length L, and a thrust layout of at most
+/// four coefficient groups (or generalized forces); the field that is wrong
+/// is named.
 pub fn check_ekf_profile(profile: &VesselProfile) -> Result<(), IdentifyError> {
     known(profile).map(|_| ())
 }
 
-/// M″ (when the profile gives it), T″ and the Bis scale of a profile, or
-/// the field that lacks them.
+/// M″ (when the profile gives it), the thrust layout and the Bis scale of
+/// a profile, or the field that lacks them.
 pub(crate) fn known(
     profile: &VesselProfile,
-) -> Result<(Option<Matrix3<f64>>, Matrix3x6, BisScale), IdentifyError> {
+) -> Result<(Option<Matrix3<f64>>, EkfLayout, BisScale), IdentifyError> {
     if profile.kind != VesselKind::Dp3 || profile.dofs != Dof::HORIZONTAL {
         return Err(IdentifyError::invalid(
             "method",
@@ -85,37 +71,12 @@ pub(crate) fn known(
             "the parallel EKF needs the ship length L (the Bis scale) in the vessel profile's dp_prior; the inertia M″ is optional",
         )
     })?;
-    let InputChannels::Thrusters {
-        thrusters,
-        configuration,
-    } = &profile.inputs
-    else {
-        return Err(IdentifyError::invalid(
-            "vessel.inputs",
-            "the parallel EKF's θ″ (eq. 47) are thrust coefficients of six thrusters; a vessel logging generalized forces τ is identified by n4sid",
-        ));
-    };
-    let kinds: Vec<ThrusterKind> = thrusters.iter().map(|t| t.kind).collect();
-    if kinds != LAYOUT {
-        return Err(IdentifyError::invalid(
-            "vessel.inputs.thrusters",
-            format!(
-                "the θ″ parameterization (eq. 47) needs six thrusters in the order main, main, tunnel (stern), tunnel (stern), tunnel (bow), azimuth; the profile has {} ({})",
-                kinds.len(),
-                kinds
-                    .iter()
-                    .map(|k| format!("{k:?}").to_lowercase())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        ));
-    }
+    let layout = ekf_layout(profile, prior.length_m)?;
     let m = prior
         .inertia_bis
         .as_ref()
         .map(|m| Matrix3::from_fn(|i, j| m[i][j]));
-    let t = Matrix3x6::from_fn(|i, j| configuration[i][j]);
-    Ok((m, t, BisScale::of(prior)))
+    Ok((m, layout, BisScale::of(prior)))
 }
 
 /// Default initial guess from the profile's time constants.
@@ -132,6 +93,16 @@ pub(crate) fn default_theta(profile: &VesselProfile, scale: &BisScale) -> [f64; 
         5e-3,
         5e-3,
     ]
+}
+
+/// θ″ with the slots of groups the layout does not use at 0.
+fn unused_zero(mut theta: [f64; N_THETA], layout: &EkfLayout) -> [f64; N_THETA] {
+    for g in 0..4 {
+        if !layout.thrust.uses(g) {
+            theta[5 + g] = 0.0;
+        }
+    }
+    theta
 }
 
 fn default_theta_std(theta: &[f64; N_THETA]) -> [f64; N_THETA] {
@@ -250,13 +221,15 @@ pub fn identify_ekf_campaign(
     settings: &EkfCampaignSettings,
     progress: &mut dyn Progress,
 ) -> Result<Identified, IdentifyError> {
-    let (prior_m, t, scale) = known(profile)?;
+    let (prior_m, layout, scale) = known(profile)?;
     check_settings(settings)?;
-    if inputs.len() != 6 {
+    if inputs.len() != layout.thrust.columns() {
         return Err(IdentifyError::invalid(
             "vessel.inputs.thrusters",
             format!(
-                "six thruster command columns are needed, got {}",
+                "{} input columns are needed ({}), got {}",
+                layout.thrust.columns(),
+                layout.columns.join(", "),
                 inputs.len()
             ),
         ));
@@ -269,7 +242,11 @@ pub fn identify_ekf_campaign(
     for r in &roles.estimation {
         staged[stage_of(&r.run_id, r.family)?].extend(blocks(r, inputs, &scale)?);
     }
-    every_stage(&staged.each_ref().map(Vec::len))?;
+    every_stage(&staged.each_ref().map(Vec::len), is_paper_layout(profile))?;
+    let frees = stage_frees(
+        &layout,
+        &staged.each_ref().map(|b| b.iter().map(|b| &b.u).collect()),
+    )?;
     let h_s = staged[0][0].h_s;
     if let Some(b) = staged
         .iter()
@@ -284,31 +261,44 @@ pub fn identify_ekf_campaign(
             ),
         ));
     }
+    let ls = || {
+        let b: Vec<InitBlock<'_>> = staged
+            .iter()
+            .flatten()
+            .map(|b| InitBlock { u: &b.u, z: &b.z })
+            .collect();
+        ls_start(&b, h_s / scale.time_unit_s, &layout.thrust)
+    };
     let start = match prior_m {
         Some(_) => None,
-        None => {
-            let b: Vec<InitBlock<'_>> = staged
-                .iter()
-                .flatten()
-                .map(|b| InitBlock { u: &b.u, z: &b.z })
-                .collect();
-            Some(ls_start(&b, h_s / scale.time_unit_s, &t, &GROUPS).map_err(|e| {
-                IdentifyError::invalid(
-                    "vessel.dp_prior.inertia_bis",
-                    format!(
-                        "the profile gives no M″ and the runs do not determine it: {e}; give M″ in the profile"
-                    ),
-                )
-            })?)
-        }
+        None => Some(ls().map_err(|e| {
+            IdentifyError::invalid(
+                "vessel.dp_prior.inertia_bis",
+                format!(
+                    "the profile gives no M″ and the runs do not determine it: {e}; give M″ in the profile"
+                ),
+            )
+        })?),
     };
     let m = prior_m.unwrap_or_else(|| start.as_ref().map_or(Matrix3::identity(), |s| s.m));
     let theta_init = match nine("settings.theta_init", &settings.theta_init)? {
         Some(t) => t,
-        None => start
-            .as_ref()
-            .map_or_else(|| default_theta(profile, &scale), |s| s.theta),
+        None => match (&start, prior_m) {
+            (Some(s), _) => s.theta,
+            // Logged forces: K″ = F_ref/(m·g) is unknown, unlike a thrust
+            // coefficient's usual few 10⁻³; the least-squares fit gives
+            // K″/M″11, scaled by the prior's M″11.
+            (None, Some(pm)) if layout.force_ref_n.is_some() => {
+                let mut t = default_theta(profile, &scale);
+                if let Ok(s) = ls() {
+                    t[5] = s.theta[5] * pm[(0, 0)];
+                }
+                t
+            }
+            _ => default_theta(profile, &scale),
+        },
     };
+    let theta_init = unused_zero(theta_init, &layout);
     let theta_init_std = match nine("settings.theta_init_std", &settings.theta_init_std)? {
         Some(s) => s,
         None => default_theta_std(&theta_init),
@@ -317,7 +307,7 @@ pub fn identify_ekf_campaign(
     let pos = settings.position_noise_std_m / scale.length_m;
     let cfg = DpIdentConfig {
         m,
-        t,
+        thrust: layout.thrust.clone(),
         h: h_s / scale.time_unit_s,
         theta_init,
         theta_init_std,
@@ -329,11 +319,15 @@ pub fn identify_ekf_campaign(
         q_theta: settings.q_theta,
         sweeps: settings.sweeps,
     };
-    let frees = [SI1_FREE.to_vec(), SI2_FREE.to_vec(), SI3_FREE.to_vec()];
+    let idle: Vec<String> = (0..3)
+        .filter(|&s| !staged[s].is_empty() && frees[s].is_empty())
+        .map(|s| format!("SI{}", s + 1))
+        .collect();
     let stages: Vec<DpStage<'_>> = staged
         .iter()
         .zip(frees)
         .enumerate()
+        .filter(|(_, (b, free))| !b.is_empty() && !free.is_empty())
         .map(|(s, (b, free))| DpStage {
             name: format!("SI{}", s + 1),
             free,
@@ -361,7 +355,7 @@ pub fn identify_ekf_campaign(
             .flat_map(|(_, bs)| bs.iter().map(|b| RunData { u: &b.u, z: &b.z }))
             .collect();
         let mut sub = SubProgress::new(progress, 0.5, 0.35);
-        refine_campaign(&mut id, &cfg, &estimation, &check, &mut sub)?
+        refine_campaign(&mut id, &cfg, &layout.names, &estimation, &check, &mut sub)?
     } else if settings.refine {
         RefineOutcome {
             notes: vec![NO_REFINEMENT_WITHOUT_PRIOR.into()],
@@ -412,7 +406,13 @@ pub fn identify_ekf_campaign(
         });
     }
     progress.update(1.0, "done")?;
-    let mut document = document(&id, &cfg, &scale, inputs, &staged);
+    let mut document = document(&id, &cfg, &scale, &layout, inputs, &staged);
+    if !idle.is_empty() {
+        document.notes.push(format!(
+            "The {} run(s) drive no thruster group left to estimate after the earlier stages: not used.",
+            idle.join(", ")
+        ));
+    }
     document.notes.extend(refined.notes);
     document.structure_findings.extend(refined.findings);
     if let Some(dp) = document.dp_ship.as_mut() {
@@ -444,14 +444,16 @@ fn document(
     id: &crate::estimation::ekf::DpIdentification,
     cfg: &DpIdentConfig,
     scale: &BisScale,
+    layout: &EkfLayout,
     inputs: &[String],
     staged: &[Vec<Block>; 3],
 ) -> ModelDocument {
+    let names = &layout.names;
+    let used = |p: usize| p < 5 || layout.thrust.uses(p - 5);
     let ship = &id.ship;
     let std = &id.theta_std;
     // θ″ index of each A_h entry and K column (eq. 46–47).
     let a_idx = [(0, 0, 0), (1, 1, 1), (1, 2, 2), (2, 1, 3), (2, 2, 4)];
-    let k_idx = [5, 5, 6, 6, 7, 8];
     let mut a_h_std = Matrix3::zeros();
     for &(i, j, p) in &a_idx {
         a_h_std[(i, j)] = std[p];
@@ -459,9 +461,10 @@ fn document(
     let a = ship.state_space_a();
     let b = ship.state_space_b();
     let parameters = (0..N_THETA)
+        .filter(|&p| used(p))
         .map(|p| ParameterRow {
             group: "θ″".into(),
-            symbol: format!("θ″{} ({})", p + 1, THETA_NAMES[p]),
+            symbol: format!("θ″{} ({})", p + 1, names[p]),
             grid_speed_mps: None,
             value: id.theta[p],
             std: Some(std[p]),
@@ -470,14 +473,13 @@ fn document(
         .collect();
     let dm = |m: &DMatrix<f64>| to_rows(m);
     let fixed = |m: &Matrix3<f64>| dm(&DMatrix::from_column_slice(3, 3, m.as_slice()));
-    let wide = |m: &Matrix3x6| dm(&DMatrix::from_column_slice(3, 6, m.as_slice()));
     let mut findings = structure_findings(&ship.m, &ship.a_h, ship.k.as_slice());
-    for p in 0..N_THETA {
+    for p in (0..N_THETA).filter(|&p| used(p)) {
         if std[p] > 0.5 * id.theta[p].abs() {
             findings.push(format!(
                 "θ″{} ({}) = {} ± {} is poorly determined (σ > 50 %): excite its manoeuvre more or fly more runs",
                 p + 1,
-                THETA_NAMES[p],
+                names[p],
                 sig3(id.theta[p]),
                 sig3(std[p])
             ));
@@ -486,8 +488,19 @@ fn document(
     let counts: Vec<String> = staged
         .iter()
         .enumerate()
+        .filter(|(_, b)| !b.is_empty())
         .map(|(s, b)| format!("SI{}: {} block(s)", s + 1, b.len()))
         .collect();
+    let mut layout_note = layout.note.clone();
+    if let Some(f) = layout.force_ref_n {
+        let k = id.theta[5];
+        if k > 0.0 {
+            layout_note.push_str(&format!(
+                " Implied m = F_ref/(g·K″) = {} t: the displacement when the profile gives M″; without M″, the surge inertia m·M″11 including added mass.",
+                sig3(f / (9.81 * k) / 1000.0)
+            ));
+        }
+    }
     ModelDocument {
         kind: ModelKind::DpShip,
         method: Method::ParallelEkf,
@@ -501,18 +514,18 @@ fn document(
             length_m: scale.length_m,
             time_unit_s: scale.time_unit_s,
             m: fixed(&ship.m),
-            t_config: wide(&ship.t),
+            t_config: dm(&ship.thrust.t),
             a_h: fixed(&ship.a_h),
             a_h_std: fixed(&a_h_std),
             k: ship.k.iter().copied().collect(),
-            k_std: k_idx.iter().map(|&p| std[p]).collect(),
+            k_std: ship.thrust.groups.iter().map(|&g| std[5 + g]).collect(),
             theta: id.theta.to_vec(),
             theta_std: std.to_vec(),
             d: fixed(&ship.damping()),
             a: fixed(&a),
-            b: wide(&b),
+            b: dm(&b),
             a_si: fixed(&scale.a_si(&a)),
-            b_si: wide(&scale.b_si(&b)),
+            b_si: dm(&scale.b_si(&b)),
             noise: DpNoiseDoc {
                 r: cfg.r.to_vec(),
                 p0_h: cfg.p0_h.to_vec(),
@@ -536,6 +549,7 @@ fn document(
                 scale.length_m, scale.time_unit_s
             ),
             "M″ and T″ are the profile's a-priori values; A″ = M″⁻¹A″_h M″ and B″ = M″⁻¹T″K″ drop C_h (eq. 50–52).".into(),
+            layout_note,
         ],
     }
 }

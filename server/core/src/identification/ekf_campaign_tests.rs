@@ -10,7 +10,8 @@ use crate::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
 use crate::planning::campaign::ExperimentFamily;
 use crate::planning::examples::{supply_vessel, supply_vessel_trial_campaign};
 use crate::planning::generate_plan;
-use crate::simulation::dp_ship::{DpFlightSettings, DpShip, fly_dp_campaign, paper};
+use crate::planning::vessel::InputChannels;
+use crate::simulation::dp_ship::{DpFlightSettings, DpShip, THETA_NAMES, fly_dp_campaign, paper};
 
 /// The campaign flown with truth noise seed `seed`, as uploaded runs.
 pub(crate) fn flown_runs(plan_seed: u64, seed: u64) -> Vec<RunInput> {

@@ -6,6 +6,7 @@
 //! and a run of every manoeuvre SI1–SI3 (Fossen et al. 1995, sec. 4.2).
 
 use super::ekf_campaign::{EKF_POSE, EkfCampaignSettings, check_ekf_profile};
+use super::ekf_layout::is_paper_layout;
 use super::ekf_settings::check_settings;
 use super::error::IdentifyError;
 use super::roles::{held_out, no_validation_run};
@@ -44,10 +45,12 @@ pub fn stage_of(run_id: &str, family: Option<ExperimentFamily>) -> Result<usize,
     }
 }
 
-/// Every stage needs a run: `counts` per stage SI1–SI3.
-pub fn every_stage(counts: &[usize; 3]) -> Result<(), IdentifyError> {
+/// SI1 and SI2 need a run (they estimate A″_h), SI3 when `need_si3` (the
+/// paper's layout, whose azimuth only SI3 drives): `counts` per stage.
+pub fn every_stage(counts: &[usize; 3], need_si3: bool) -> Result<(), IdentifyError> {
     let families = ["dp_surge", "dp_sway_yaw", "dp_azimuth"];
-    match counts.iter().position(|&c| c == 0) {
+    let needed = if need_si3 { 3 } else { 2 };
+    match counts[..needed].iter().position(|&c| c == 0) {
         None => Ok(()),
         Some(s) => Err(IdentifyError::invalid(
             "run_ids",
@@ -141,7 +144,7 @@ pub fn check_ekf_job(
     if validation == 0 {
         return Err(no_validation_run());
     }
-    every_stage(&counts)
+    every_stage(&counts, is_paper_layout(profile))
 }
 
 #[cfg(test)]

@@ -27,14 +27,21 @@
 use nalgebra::{DMatrix, DVector, Matrix3};
 
 use crate::logs::measurements::local_slope;
-use crate::simulation::dp_ship::{Matrix3x6, N_THETA};
+use crate::simulation::dp_ship::{N_GROUPS, N_THETA, ThrustLayout};
 
 /// Samples each side of the local linear fit that differentiates the pose.
 const SLOPE_HALF_WINDOW: usize = 2;
 /// State-variable filter time constant, in samples.
 const FILTER_SAMPLES: f64 = 4.0;
 
-/// One gap-free block: commands u (N × 6) and the measured pose z (N × 3:
+/// Share of a group's force energy in surge above which its K″ is fitted
+/// from the surge equation.
+const SURGE_SHARE: f64 = 0.05;
+/// Share of the sway–yaw force energy from surge-fitted groups above which
+/// M″22 is fitted against them instead of fixed at 1.
+const SWAY_FROM_SURGE_SHARE: f64 = 0.01;
+
+/// One gap-free block: commands u (N × r) and the measured pose z (N × 3:
 /// x″, y″, ψ unwrapped), Bis units.
 pub struct InitBlock<'a> {
     /// Thruster commands.
@@ -46,7 +53,9 @@ pub struct InitBlock<'a> {
 /// The least-squares start of the EKF.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LsStart {
-    /// M″ with M″11 = M″22 = 1 and the estimated sway–yaw shape.
+    /// M″ with M″11 = 1 and the estimated sway–yaw inertia: M″22 = 1 too
+    /// unless groups fitted in surge also drive sway–yaw (then M″22 is
+    /// fitted against their K″).
     pub m: Matrix3<f64>,
     /// θ″1 … θ″9 under that M″.
     pub theta: [f64; N_THETA],
@@ -123,85 +132,133 @@ fn solve(rows: &[Vec<f64>], y: &[f64]) -> Result<DVector<f64>, String> {
     }
 }
 
-/// The least-squares start from `blocks` (sample time `h`, Bis), thruster
-/// configuration `t` and the K″ index of each thruster column (`groups[j]`
-/// in 0..4: θ″6 … θ″9). Errors say why the data cannot give it (too short,
-/// singular, an inertia shape that is not positive definite).
+/// The least-squares start from `blocks` (sample time `h`, Bis) and the
+/// thrust layout (T and the K″ group of each column, θ″6 … θ″9). A group
+/// whose force is mostly not surge-free (≥ 5 % of its energy in surge) has
+/// its K″ fitted from the surge equation, the others from sway–yaw. Errors
+/// say why the data cannot give it (too short, singular, an inertia shape
+/// that is not positive definite).
 pub fn ls_start(
     blocks: &[InitBlock<'_>],
     h: f64,
-    t: &Matrix3x6,
-    groups: &[usize; 6],
+    thrust: &ThrustLayout,
 ) -> Result<LsStart, String> {
     let skip = (3.0 * FILTER_SAMPLES).ceil() as usize;
     let nb = blocks.len();
-    // Surge: s·F·u = −d11·F·u + K1·Σ t1j F·u_j + b0 (main-propeller group 0).
-    let (mut surge, mut y0) = (Vec::new(), Vec::new());
-    // Sway–yaw, unknowns [m23, m33, d22, d23, d32, d33, K_g (g = 1..3),
-    // b1 per block, b2 per block], M″22 = 1.
-    let (mut sy, mut y12) = (Vec::new(), Vec::new());
+    let t = &thrust.t;
     let w = |f: &Filtered, i: usize, g: usize, k: usize| -> f64 {
-        (0..6)
-            .filter(|&j| groups[j] == g)
+        (0..thrust.columns())
+            .filter(|&j| thrust.groups[j] == g)
             .map(|j| t[(i, j)] * f.u[j][k])
             .sum()
     };
     let filt: Vec<Filtered> = blocks.iter().map(|b| filtered(b, h)).collect();
+    // Force energy per group and DOF.
+    let mut energy = [[0.0f64; 3]; N_GROUPS];
+    for f in &filt {
+        for k in skip..f.nu[0].len() {
+            for (g, e) in energy.iter_mut().enumerate() {
+                for (i, ei) in e.iter_mut().enumerate() {
+                    *ei += w(f, i, g, k).powi(2);
+                }
+            }
+        }
+    }
+    let total = |g: usize| energy[g].iter().sum::<f64>();
+    let used: Vec<usize> = (0..N_GROUPS)
+        .filter(|&g| thrust.uses(g) && total(g) > 0.0)
+        .collect();
+    let (surge_g, sway_g): (Vec<usize>, Vec<usize>) = used
+        .iter()
+        .partition(|&&g| energy[g][0] >= SURGE_SHARE * total(g));
+    if surge_g.is_empty() {
+        return Err("no thruster group pushes in surge in the estimation runs".into());
+    }
+    let sway_energy: f64 = used.iter().map(|&g| energy[g][1] + energy[g][2]).sum();
+    let from_surge: f64 = surge_g.iter().map(|&g| energy[g][1] + energy[g][2]).sum();
+    let fit_m22 = sway_g.is_empty() || from_surge > SWAY_FROM_SURGE_SHARE * sway_energy;
+    // Surge: s·F·ν1 = −d11·F·ν1 + Σ_g K_g·F·w_g1 + b0 per block (M″11 = 1).
+    let (mut surge, mut y0) = (Vec::new(), Vec::new());
     for (bi, f) in filt.iter().enumerate() {
         for k in skip..f.nu[0].len() {
-            let mut row = vec![-f.nu[0][k], w(f, 0, 0, k)];
+            let mut row = vec![-f.nu[0][k]];
+            row.extend(surge_g.iter().map(|&g| w(f, 0, g, k)));
             row.extend((0..nb).map(|j| f64::from(u8::from(j == bi))));
             surge.push(row);
             y0.push(f.nu_dot[0][k]);
         }
     }
     let s0 = solve(&surge, &y0)?;
-    let (d11, k1) = (s0[0], s0[1]);
+    let d11 = s0[0];
+    let mut theta = [0.0; N_THETA];
+    for (c, &g) in surge_g.iter().enumerate() {
+        theta[5 + g] = s0[1 + c];
+    }
+    // Sway–yaw, unknowns [m22 (when fitted), m23, m33, d22, d23, d32, d33,
+    // K_g of the sway–yaw groups, b1 per block, b2 per block].
+    let lead = usize::from(fit_m22);
+    let (mut sy, mut y12) = (Vec::new(), Vec::new());
     for (bi, f) in filt.iter().enumerate() {
         for k in skip..f.nu[0].len() {
             let (v, r, vd, rd) = (f.nu[1][k], f.nu[2][k], f.nu_dot[1][k], f.nu_dot[2][k]);
             let mut row1 = vec![-rd, 0.0, -v, -r, 0.0, 0.0];
             let mut row2 = vec![-vd, -rd, 0.0, 0.0, -v, -r];
-            for g in 1..4 {
+            if fit_m22 {
+                row1.insert(0, -vd);
+                row2.insert(0, 0.0);
+            }
+            for &g in &sway_g {
                 row1.push(w(f, 1, g, k));
                 row2.push(w(f, 2, g, k));
             }
             row1.extend((0..2 * nb).map(|j| f64::from(u8::from(j == bi))));
             row2.extend((0..2 * nb).map(|j| f64::from(u8::from(j == nb + bi))));
+            let known =
+                |i: usize| -> f64 { surge_g.iter().map(|&g| theta[5 + g] * w(f, i, g, k)).sum() };
             sy.push(row1);
-            y12.push(vd - k1 * w(f, 1, 0, k));
+            y12.push(if fit_m22 { -known(1) } else { vd - known(1) });
             sy.push(row2);
-            y12.push(-k1 * w(f, 2, 0, k));
+            y12.push(-known(2));
         }
     }
     let p = solve(&sy, &y12)?;
-    let m = Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, p[0], 0.0, p[0], p[1]);
+    let m22 = if fit_m22 { p[0] } else { 1.0 };
+    let (m23, m33) = (p[lead], p[lead + 1]);
+    let m = Matrix3::new(1.0, 0.0, 0.0, 0.0, m22, m23, 0.0, m23, m33);
     if m.cholesky().is_none() {
         return Err(format!(
-            "the fitted sway–yaw inertia (M″23 = {:.3e}, M″33 = {:.3e} per M″22) is not positive definite",
-            p[0], p[1]
+            "the fitted sway–yaw inertia (M″22 = {:.3e}, M″23 = {:.3e}, M″33 = {:.3e}) is not positive definite",
+            m22, m23, m33
         ));
     }
-    let d = Matrix3::new(d11, 0.0, 0.0, 0.0, p[2], p[3], 0.0, p[4], p[5]);
+    let q = &p.as_slice()[lead + 2..];
+    let d = Matrix3::new(d11, 0.0, 0.0, 0.0, q[0], q[1], 0.0, q[2], q[3]);
+    for (c, &g) in sway_g.iter().enumerate() {
+        theta[5 + g] = q[4 + c];
+    }
     let m_inv = m.try_inverse().ok_or("M″ is singular")?;
     let a_h = -d * m_inv;
-    let theta = [
+    theta[..5].copy_from_slice(&[
         a_h[(0, 0)],
         a_h[(1, 1)],
         a_h[(1, 2)],
         a_h[(2, 1)],
         a_h[(2, 2)],
-        k1,
-        p[6],
-        p[7],
-        p[8],
-    ];
+    ]);
     Ok(LsStart { m, theta })
 }
 
 /// The model note of an identification without M″ in the profile.
 pub fn without_prior_note(m: &Matrix3<f64>) -> String {
     let sig = crate::numbers::sig3;
+    if m[(1, 1)] != 1.0 {
+        return format!(
+            "No M″ in the profile: the EKF started from a least-squares fit on body velocities differentiated from the measured pose (M″ν̇ + D″ν = T″K″u + b, state-variable filter), which gave M″22 = {}, M″23 = {}, M″33 = {} per M″11 = 1, the rigid-body mass without added mass (M″22 from thrusters that push in surge and sway alike); M″ is then held fixed and C(ν)ν uses it. The common scale of M″ and K″ is not identifiable from commands and motion: each K″ is K″/M″11 of the ship, while A″_h11 and A″ do not depend on that choice. Give M″ in the profile for K″ in the Bis system.",
+            sig(m[(1, 1)]),
+            sig(m[(1, 2)]),
+            sig(m[(2, 2)])
+        );
+    }
     format!(
         "No M″ in the profile: the EKF started from a least-squares fit on body velocities differentiated from the measured pose (M″ν̇ + D″ν = T″K″u + b, state-variable filter), which gave the sway–yaw inertia shape M″23 = {}, M″33 = {} per M″22, with M″11 = M″22 = 1, the rigid-body mass without added mass; M″ is then held fixed and C(ν)ν uses it. The common scale of M″ and K″ is not identifiable from commands and motion: each K″ is K″/M″ii of the ship (surge: M″11, sway–yaw: M″22), while A″_h11 and A″ do not depend on that choice. Give M″ in the profile for K″ in the Bis system.",
         sig(m[(1, 2)]),

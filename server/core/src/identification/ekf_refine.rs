@@ -1,5 +1,5 @@
 //! The refinement step of a DP campaign: after the staged parallel EKF,
-//! all nine θ″ are refined jointly on every estimation block by prediction
+//! every θ″ of the layout is refined jointly on every estimation block by prediction
 //! error ([`refine_dp_ship`]), and the refined θ″ replace the EKF's only
 //! if the refinement converged and the held-out runs are predicted no worse
 //! (the negative log-likelihood V of the Kalman predictor's innovations on
@@ -14,7 +14,7 @@ use crate::estimation::ekf::{
     refine_dp_ship,
 };
 use crate::numbers::sig3;
-use crate::simulation::dp_ship::{DpShip, N_THETA, THETA_NAMES};
+use crate::simulation::dp_ship::{DpShip, N_THETA};
 
 /// Largest rise of the held-out V accepted (log-likelihood units): a
 /// likelihood ratio of e², beyond what parameters moving within their
@@ -47,15 +47,18 @@ pub(crate) fn not_run(id: &DpIdentification, why: &str) -> DpRefinementDoc {
 }
 
 /// Refines `id` in place on `estimation` (all stages' blocks), checked on
-/// `held_out`.
+/// `held_out`; `names` are the layout's θ″ names.
 pub(crate) fn refine_campaign(
     id: &mut DpIdentification,
     cfg: &DpIdentConfig,
+    names: &[String; N_THETA],
     estimation: &[RunData<'_>],
     held_out: &[RunData<'_>],
     progress: &mut dyn Progress,
 ) -> Result<RefineOutcome, IdentifyError> {
-    let all: Vec<usize> = (0..N_THETA).collect();
+    let all: Vec<usize> = (0..N_THETA)
+        .filter(|&p| p < 5 || cfg.thrust.uses(p - 5))
+        .collect();
     let mut out = RefineOutcome::default();
     let kept = |why: String| format!("{why}; the staged EKF's θ″ and std are kept");
     let r = match refine_dp_ship(
@@ -84,7 +87,11 @@ pub(crate) fn refine_campaign(
         variance_ratio: Some(fit.variance_ratio).filter(|v| v.is_finite()),
         // Only when every factor is a number (a failed pass may leave NaN).
         std_inflation: if fit.inflation.iter().all(|f| f.is_finite()) {
-            fit.inflation.iter().copied().collect()
+            let mut per_theta = vec![1.0; N_THETA];
+            for (c, &p) in all.iter().enumerate() {
+                per_theta[p] = fit.inflation[c];
+            }
+            per_theta
         } else {
             Vec::new()
         },
@@ -121,22 +128,18 @@ pub(crate) fn refine_campaign(
     }
     out.record = Some(ran(None, held.map(|(b, a)| a - b)));
     let ekf = id.theta;
-    let inflated: Vec<String> = (0..N_THETA)
-        .filter(|&p| fit.inflation[p] > 1.05)
-        .map(|p| {
-            format!(
-                "θ″{} ({}) ×{}",
-                p + 1,
-                THETA_NAMES[p],
-                sig3(fit.inflation[p])
-            )
-        })
+    let inflated: Vec<String> = all
+        .iter()
+        .enumerate()
+        .filter(|&(c, _)| fit.inflation[c] > 1.05)
+        .map(|(c, &p)| format!("θ″{} ({}) ×{}", p + 1, names[p], sig3(fit.inflation[c])))
         .collect();
     out.notes.push(format!(
-        "Refined after the staging: all nine θ″ jointly on the {} estimation block(s) by prediction error (Levenberg–Marquardt on the negative log-likelihood of the Kalman predictor's innovations, forward sensitivities), {} step(s), from the EKF's θ″ = [{}].{}",
+        "Refined after the staging: all {} θ″ jointly on the {} estimation block(s) by prediction error (Levenberg–Marquardt on the negative log-likelihood of the Kalman predictor's innovations, forward sensitivities), {} step(s), from the EKF's θ″ = [{}].{}",
+        all.len(),
         estimation.len(),
         fit.iterations,
-        ekf.map(sig3).join(", "),
+        all.iter().map(|&p| sig3(ekf[p])).collect::<Vec<_>>().join(", "),
         match held {
             Some((b, a)) => format!(
                 " Held-out negative log-likelihood changed by {}.",
@@ -154,7 +157,7 @@ pub(crate) fn refine_campaign(
             format!(": {}", inflated.join(", "))
         }
     ));
-    let ship = DpShip::from_theta(cfg.m, cfg.t, &r.theta);
+    let ship = DpShip::from_theta(cfg.m, cfg.thrust.clone(), &r.theta);
     id.theta = r.theta;
     id.theta_std = r.theta_std;
     id.a = ship.state_space_a();

@@ -39,6 +39,7 @@ pub mod document;
 pub mod ekf_campaign;
 pub mod ekf_checks;
 pub mod ekf_init;
+pub mod ekf_layout;
 mod ekf_refine;
 mod ekf_settings;
 pub mod error;

@@ -2,7 +2,7 @@
 //! record — so any model can be validated on any run later (side-by-side
 //! comparison of two models on the same run).
 
-use nalgebra::{DMatrix, Matrix3, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix3};
 
 use super::attitude_loop::AttitudeLoop;
 use super::augmented::{AugmentedLpv, is_augmented};
@@ -18,7 +18,7 @@ use crate::estimation::restoring::RestoringParams;
 use crate::logs::schema::pose_column;
 use crate::models::{LinearVesselModel, LpvModel};
 use crate::planning::dof::Dof;
-use crate::simulation::dp_ship::{DpShip, Matrix3x6};
+use crate::simulation::dp_ship::{DpShip, N_GROUPS, ThrustLayout};
 use crate::validation::{
     Predictor, ValidationRecord, ValidationReport, ValidationSettings, validate,
 };
@@ -167,19 +167,25 @@ pub fn dp_ship(doc: &ModelDocument) -> Result<SiDpShip, IdentifyError> {
         matrix(&s.t_config, "T")?,
         matrix(&s.a_h, "A_h")?,
     );
-    if m.shape() != (3, 3) || a_h.shape() != (3, 3) || t.shape() != (3, 6) || s.k.len() != 6 {
+    if m.shape() != (3, 3) || a_h.shape() != (3, 3) || t.nrows() != 3 || s.k.len() != t.ncols() {
         return Err(IdentifyError::invalid(
             "document.dp_ship",
-            "M and A_h must be 3 × 3, T 3 × 6 and K of length 6",
+            "M and A_h must be 3 × 3, T 3 × r and K of length r",
         ));
     }
+    let groups = groups_of(&s.k).ok_or_else(|| {
+        IdentifyError::invalid(
+            "document.dp_ship.k",
+            format!("K takes more than {N_GROUPS} distinct values"),
+        )
+    })?;
     Ok(SiDpShip {
         model: IdentifiedDpShip {
             ship: DpShip {
                 m: Matrix3::from_fn(|i, j| m[(i, j)]),
-                t: Matrix3x6::from_fn(|i, j| t[(i, j)]),
+                thrust: ThrustLayout { t, groups },
                 a_h: Matrix3::from_fn(|i, j| a_h[(i, j)]),
-                k: Vector6::from_column_slice(&s.k),
+                k: DVector::from_column_slice(&s.k),
             },
             r: three(&s.noise.r, "r")?,
             p0_h: three(&s.noise.p0_h, "p0_h")?,
@@ -192,6 +198,22 @@ pub fn dp_ship(doc: &ModelDocument) -> Result<SiDpShip, IdentifyError> {
             time_unit_s: s.time_unit_s,
         },
     })
+}
+
+/// The coefficient groups of a stored K (one per column): columns with the
+/// same K″ share a group, which is how the identification wrote them.
+fn groups_of(k: &[f64]) -> Option<Vec<usize>> {
+    let mut values: Vec<f64> = Vec::new();
+    k.iter()
+        .map(|v| match values.iter().position(|w| w == v) {
+            Some(g) => Some(g),
+            None if values.len() < N_GROUPS => {
+                values.push(*v);
+                Some(values.len() - 1)
+            }
+            None => None,
+        })
+        .collect()
 }
 
 /// The longest valid block of `run` as the model's validation data:

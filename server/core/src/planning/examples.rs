@@ -81,6 +81,7 @@ pub fn supply_vessel() -> VesselProfile {
         kind,
         max_command: 1.0,
         max_rate: 0.1,
+        coefficient_group: None,
     };
     VesselProfile {
         name: "Supply vessel (Fossen et al. 1995)".into(),

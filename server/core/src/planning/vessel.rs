@@ -77,6 +77,13 @@ pub struct Thruster {
     pub max_command: f64,
     /// Largest rate of change of u_i per second.
     pub max_rate: f64,
+    /// Thrusters with the same group share one thrust coefficient K″ in
+    /// the parallel EKF (as the paper's two mains share K1 = K2), at most
+    /// four groups. Without any group, the paper's six-thruster layout
+    /// takes eq. 47's groups, four or fewer thrusters one coefficient
+    /// each, more thrusters one per kind.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coefficient_group: Option<String>,
 }
 
 /// How the vessel is actuated.
@@ -356,6 +363,9 @@ impl VesselProfile {
                 super::check_name(&format!("inputs.thrusters[{i}].name"), &t.name)?;
                 positive(&format!("inputs.thrusters[{i}].max_command"), t.max_command)?;
                 positive(&format!("inputs.thrusters[{i}].max_rate"), t.max_rate)?;
+                if let Some(g) = &t.coefficient_group {
+                    super::check_name(&format!("inputs.thrusters[{i}].coefficient_group"), g)?;
+                }
             }
             if configuration.len() != self.dofs.len() {
                 return Err(PlanError::invalid(

@@ -28,8 +28,12 @@ fn family(m: DpManoeuvre) -> ExperimentFamily {
 /// The campaign of `trial` and `seed`, flown by the truth and parsed as
 /// uploads for `profile`.
 pub fn runs(profile: &VesselProfile, trial: &DpTrial, seed: u64) -> Vec<RunInput> {
-    fly_dp_campaign(trial, seed)
-        .into_iter()
+    parsed(profile, fly_dp_campaign(trial, seed))
+}
+
+/// The truth's logs parsed as uploads for `profile`.
+pub fn parsed(profile: &VesselProfile, logs: Vec<dp_ship::DpLog>) -> Vec<RunInput> {
+    logs.into_iter()
         .map(|log| {
             let parsed = parse_log(
                 log.csv.as_bytes(),

@@ -11,8 +11,7 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::model::ContinuousRunModel;
 use crate::simulation::dp_ship::model::{
-    Matrix3x6, N_THETA, a_h_from_theta, coriolis_force, coriolis_force_jacobian, k_from_theta,
-    rotation,
+    N_THETA, ThrustLayout, a_h_from_theta, coriolis_force, coriolis_force_jacobian, rotation,
 };
 
 /// States per run: h (3), η (3), b_h (3).
@@ -23,17 +22,22 @@ pub const DP_STATES: usize = 9;
 pub struct DpMomentumModel {
     m: Matrix3<f64>,
     m_inv: Matrix3<f64>,
-    t: Matrix3x6,
+    thrust: ThrustLayout,
     frozen: [f64; N_THETA],
     free: Vec<usize>,
     h_meas: DMatrix<f64>,
 }
 
 impl DpMomentumModel {
-    /// Known M and T; θ″ values `frozen` for the parameters not in `free`
+    /// Known M and thrust layout; θ″ values `frozen` for the parameters not in `free`
     /// (indices 0–8 into θ″1 … θ″9). Panics on an invalid M or index; the
     /// staged identification validates both first.
-    pub fn new(m: Matrix3<f64>, t: Matrix3x6, frozen: [f64; N_THETA], free: Vec<usize>) -> Self {
+    pub fn new(
+        m: Matrix3<f64>,
+        thrust: ThrustLayout,
+        frozen: [f64; N_THETA],
+        free: Vec<usize>,
+    ) -> Self {
         assert!(free.iter().all(|&f| f < N_THETA), "θ″ index out of range");
         let m_inv = m.try_inverse().expect("M must be invertible");
         let mut h_meas = DMatrix::zeros(3, DP_STATES);
@@ -43,7 +47,7 @@ impl DpMomentumModel {
         DpMomentumModel {
             m,
             m_inv,
-            t,
+            thrust,
             frozen,
             free,
             h_meas,
@@ -68,7 +72,7 @@ impl ContinuousRunModel for DpMomentumModel {
         self.free.len()
     }
     fn n_inputs(&self) -> usize {
-        6
+        self.thrust.columns()
     }
     fn measurement_matrix(&self) -> &DMatrix<f64> {
         &self.h_meas
@@ -88,14 +92,13 @@ impl ContinuousRunModel for DpMomentumModel {
     ) {
         let full = self.full_theta(theta);
         let a_h = a_h_from_theta(&full);
-        let k = k_from_theta(&full);
         let h = Vector3::new(x[0], x[1], x[2]);
         let psi = x[5];
         let b = Vector3::new(x[6], x[7], x[8]);
         let nu = self.m_inv * h;
         let mut tau = Vector3::zeros();
-        for j in 0..6 {
-            tau += self.t.column(j) * (k[j] * u[j]);
+        for (j, &g) in self.thrust.groups.iter().enumerate() {
+            tau += self.thrust.t.fixed_view::<3, 1>(0, j) * (full[5 + g] * u[j]);
         }
         let h_dot = -coriolis_force(&self.m, &nu) + a_h * h + tau + b;
         let rot = rotation(psi);
@@ -120,13 +123,6 @@ impl ContinuousRunModel for DpMomentumModel {
 
         // ∂ḣ/∂θ″ (eq. 46–47); η̇ and ḃ_h do not depend on θ″.
         g_theta.fill(0.0);
-        let thrust = |cols: &[usize]| {
-            let mut v = Vector3::zeros();
-            for &j in cols {
-                v += self.t.column(j) * u[j];
-            }
-            v
-        };
         for (col, &f) in self.free.iter().enumerate() {
             let d = match f {
                 0 => Vector3::new(h[0], 0.0, 0.0),
@@ -134,10 +130,7 @@ impl ContinuousRunModel for DpMomentumModel {
                 2 => Vector3::new(0.0, h[2], 0.0),
                 3 => Vector3::new(0.0, 0.0, h[1]),
                 4 => Vector3::new(0.0, 0.0, h[2]),
-                5 => thrust(&[0, 1]),
-                6 => thrust(&[2, 3]),
-                7 => thrust(&[4]),
-                _ => thrust(&[5]),
+                g => self.thrust.group_force(g - 5, u),
             };
             for i in 0..3 {
                 g_theta[(i, col)] = d[i];

@@ -43,7 +43,12 @@ impl IdentifiedDpShip {
     /// `None` if the record is unusable (shapes, NaN).
     pub fn estimate_states(&self, rec: &ValidationRecord<'_>) -> Option<DMatrix<f64>> {
         let model = Rk4 {
-            model: DpMomentumModel::new(self.ship.m, self.ship.t, self.ship.theta(), Vec::new()),
+            model: DpMomentumModel::new(
+                self.ship.m,
+                self.ship.thrust.clone(),
+                self.ship.theta(),
+                Vec::new(),
+            ),
             h: rec.h,
         };
         if rec.y.ncols() != 3 || rec.y.nrows() == 0 {
@@ -95,7 +100,7 @@ impl IdentifiedDpShip {
             dx[..3].copy_from_slice(hd.as_slice());
             dx[3..].copy_from_slice(eta_dot.as_slice());
         };
-        let mut w = [0.0; 6];
+        let mut w = vec![0.0; self.ship.k.len()];
         for k in from..to {
             for (j, v) in w.iter_mut().enumerate() {
                 *v = u[(k, j)];
@@ -133,7 +138,8 @@ impl Predictor for IdentifiedDpShip {
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
         let n = rec.y.nrows();
         let mut out = DMatrix::from_element(n, 3, f64::NAN);
-        if n == 0 || rec.y.ncols() != 3 || rec.u.ncols() != 6 || rec.u.nrows() != n {
+        let r = self.ship.k.len();
+        if n == 0 || rec.y.ncols() != 3 || rec.u.ncols() != r || rec.u.nrows() != n {
             return out;
         }
         let m_inv = self.ship.m_inv();
@@ -146,7 +152,7 @@ impl Predictor for IdentifiedDpShip {
             dx[..3].copy_from_slice(hd.as_slice());
             dx[3..].copy_from_slice(eta_dot.as_slice());
         };
-        let mut w = [0.0; 6];
+        let mut w = vec![0.0; r];
         for t in 0..n {
             for j in 0..3 {
                 out[(t, j)] = x[3 + j];

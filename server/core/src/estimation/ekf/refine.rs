@@ -244,7 +244,7 @@ fn dp_predictor(
         r: cfg.r.to_vec(),
     };
     let model = Rk4 {
-        model: DpMomentumModel::new(cfg.m, cfg.t, *theta, free.to_vec()),
+        model: DpMomentumModel::new(cfg.m, cfg.thrust.clone(), *theta, free.to_vec()),
         h: cfg.h,
     };
     Ok((model, noise))

@@ -16,7 +16,7 @@ use super::error::{EkfError, check_finite, check_variances};
 use super::filter::{EkfSettings, RunData, parallel_ekf};
 use super::model::Rk4;
 use crate::estimation::{Progress, SubProgress};
-use crate::simulation::dp_ship::model::{DpShip, Matrix3x6, N_THETA};
+use crate::simulation::dp_ship::model::{DpShip, N_GROUPS, N_THETA, ThrustLayout};
 
 /// Free θ″ indices (0-based) of SI1: A_h11 and K1 = K2.
 pub const SI1_FREE: [usize; 2] = [0, 5];
@@ -43,8 +43,8 @@ pub struct DpStage<'a> {
 pub struct DpIdentConfig {
     /// Inertia M including added mass (known, eq. 30).
     pub m: Matrix3<f64>,
-    /// Thruster configuration T (known, eq. 29).
-    pub t: Matrix3x6,
+    /// Thruster configuration T and its coefficient groups (known, eq. 29, 47).
+    pub thrust: ThrustLayout,
     /// Sample time h.
     pub h: f64,
     /// Initial guess of θ″1 … θ″9.
@@ -81,7 +81,7 @@ impl DpIdentConfig {
         let sq = |a: [f64; 3]| a.map(|v| v * v);
         DpIdentConfig {
             m: ship.m,
-            t: ship.t,
+            thrust: ship.thrust,
             h: trial.h,
             // Damping time constants of ~ 10 Bis units, no coupling, and a
             // thrust coefficient of a few 10⁻³ for every thruster.
@@ -168,15 +168,32 @@ pub struct DpIdentification {
     pub ship: DpShip,
     /// A = M⁻¹·A_h·M (eq. 51).
     pub a: Matrix3<f64>,
-    /// B = M⁻¹·T·K (eq. 52).
-    pub b: Matrix3x6,
+    /// B = M⁻¹·T·K (eq. 52), 3 × r.
+    pub b: DMatrix<f64>,
     /// Per-stage details.
     pub stages: Vec<DpStageResult>,
 }
 
 fn validate(cfg: &DpIdentConfig, stages: &[DpStage<'_>]) -> Result<(), EkfError> {
     check_finite("m", cfg.m.iter())?;
-    check_finite("t", cfg.t.iter())?;
+    check_finite("t", cfg.thrust.t.iter())?;
+    let thrust = &cfg.thrust;
+    if thrust.t.nrows() != 3
+        || thrust.t.ncols() == 0
+        || thrust.groups.len() != thrust.t.ncols()
+        || thrust.groups.iter().any(|&g| g >= N_GROUPS)
+    {
+        return Err(EkfError::Invalid {
+            field: "t".into(),
+            reason: format!(
+                "T must be 3 × r (r ≥ 1) with a group 0–{} per column; got {} × {} with {} group(s)",
+                N_GROUPS - 1,
+                thrust.t.nrows(),
+                thrust.t.ncols(),
+                thrust.groups.len()
+            ),
+        });
+    }
     check_finite("theta_init", &cfg.theta_init)?;
     if !(cfg.h.is_finite() && cfg.h > 0.0) {
         return Err(EkfError::Invalid {
@@ -226,6 +243,15 @@ fn validate(cfg: &DpIdentConfig, stages: &[DpStage<'_>]) -> Result<(), EkfError>
                     reason: format!("θ″ index {f} is out of 0–8 or repeated"),
                 });
             }
+            if f >= 5 && !thrust.uses(f - 5) {
+                return Err(EkfError::Invalid {
+                    field,
+                    reason: format!(
+                        "θ″{} is the coefficient of a thruster group with no column",
+                        f + 1
+                    ),
+                });
+            }
         }
         if stage.runs.is_empty() {
             return Err(EkfError::NoRuns);
@@ -264,7 +290,7 @@ pub fn identify_dp_ship(
             results.push(stage_result);
         }
     }
-    let ship = DpShip::from_theta(cfg.m, cfg.t, &theta);
+    let ship = DpShip::from_theta(cfg.m, cfg.thrust.clone(), &theta);
     Ok(DpIdentification {
         theta,
         theta_std,
@@ -290,7 +316,7 @@ fn run_stage(
 ) -> Result<DpStageResult, EkfError> {
     {
         let model = Rk4 {
-            model: DpMomentumModel::new(cfg.m, cfg.t, *theta, stage.free.clone()),
+            model: DpMomentumModel::new(cfg.m, cfg.thrust.clone(), *theta, stage.free.clone()),
             h: cfg.h,
         };
         let x0 = initial_states(&stage.runs).map_err(|e| prefix_runs(e, s))?;

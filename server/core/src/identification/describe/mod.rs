@@ -57,6 +57,7 @@ use crate::planning::vessel::{InputChannels, ThrusterKind, VesselKind, VesselPro
 use crate::planning::{Dof, KNOT};
 use crate::timeseries::UniformRecord;
 
+mod dp_force;
 mod signal;
 mod speed;
 
@@ -568,6 +569,9 @@ fn role(
         return (RunRole::Static, ExperimentFamily::Static, why);
     }
     let names: Vec<Dof> = excited.iter().map(|a| a.dof).collect();
+    if profile.kind == VesselKind::Dp3 && !super::ekf_layout::is_paper_layout(profile) {
+        return dp_force::dp_role_by_force(rec, profile, &names);
+    }
     if profile.kind == VesselKind::Dp3 {
         let kinds = driven_kinds(rec, profile);
         let list = kinds

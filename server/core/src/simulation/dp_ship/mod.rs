@@ -21,5 +21,5 @@ mod tests;
 
 pub use fly::{DpFlightSettings, FlownDpRun, fly_dp_campaign, fly_dp_experiment};
 pub use manoeuvres::{Manoeuvre, manoeuvre_inputs};
-pub use model::{DpShip, Matrix3x6, N_THETA, THETA_NAMES};
+pub use model::{DpShip, N_GROUPS, N_THETA, THETA_NAMES, ThrustLayout};
 pub use trial::{DpRun, TrialConfig, simulate_campaign, simulate_trial};

@@ -66,7 +66,7 @@ fn a_from_eq_30_48_reproduces_eq_51_except_the_sensitive_a32() {
 fn theta_round_trips_through_a_h_and_k() {
     let ship = DpShip::supply_vessel();
     assert_eq!(ship.theta(), paper::THETA);
-    let back = DpShip::from_theta(ship.m, ship.t, &paper::THETA);
+    let back = DpShip::from_theta(ship.m, ship.thrust.clone(), &paper::THETA);
     assert_eq!(back, ship);
     // A_h = −D·M⁻¹ (eq. 39).
     let d = ship.damping();
