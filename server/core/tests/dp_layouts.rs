@@ -258,3 +258,33 @@ fn unplanned_runs_are_staged_by_their_force() {
         }
     }
 }
+
+/// Without M″ in the profile the EKF starts from the least-squares fit on
+/// both layouts; A″_h11 does not depend on M″'s scale (within 10 %), the
+/// notes say how the EKF was started, and with a group that drives sway–yaw
+/// alongside surge (τ) M″22 is fitted against it.
+#[test]
+fn without_the_inertia_both_layouts_start_from_least_squares() {
+    for (layout, mut profile) in [
+        (DpLayout::AzimuthsTunnels, azimuth_profile()),
+        (DpLayout::Forces, forces_profile()),
+    ] {
+        profile.dp_prior.as_mut().unwrap().inertia_bis = None;
+        let g = grade(layout, &profile, &DpTrial::default(), &[1, 2]);
+        let (t, _) = truth(layout);
+        for x in &g {
+            let e = x.theta[0] / t[0] - 1.0;
+            assert!(
+                e.abs() < 0.1,
+                "{layout:?} seed {}: θ″1 {:+.1} %",
+                x.seed,
+                100.0 * e
+            );
+            let notes = x.doc.notes.join(" ");
+            assert!(notes.contains("No M″ in the profile"), "{notes}");
+            if layout == DpLayout::Forces {
+                assert!(notes.contains("per M″11 = 1"), "{notes}");
+            }
+        }
+    }
+}

@@ -30,4 +30,6 @@ pub use vessel::VesselProfile;
 #[cfg(test)]
 mod attitude_tests;
 #[cfg(test)]
+mod dp_layout_tests;
+#[cfg(test)]
 mod tests;

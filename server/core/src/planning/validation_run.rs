@@ -5,7 +5,7 @@
 use super::campaign::ExperimentFamily;
 use super::design::{MAX_SEED, SQUARE_HOLD_TIME_CONSTANTS};
 use super::dof::Dof;
-use super::dp_manoeuvres::{dp_groups, thruster_channels};
+use super::dp_manoeuvres::dp_channels;
 use super::dynamic_runs::attitude_note;
 use super::error::PlanError;
 use super::plan::{ChannelSpec, Ctx, ExperimentHead, PlannedExperiment, assemble, run_seed};
@@ -26,10 +26,7 @@ pub(super) fn validation(
     for rep in 1..=reps {
         let seed = run_seed(ctx.spec.seed, ExperimentFamily::Validation, 0, 0, rep);
         let channels = match ctx.vessel.kind {
-            VesselKind::Dp3 => {
-                let groups = dp_groups(ctx.vessel, ExperimentFamily::Validation);
-                thruster_channels(ctx, &groups, ExperimentFamily::Validation, total, seed)?
-            }
+            VesselKind::Dp3 => dp_channels(ctx, ExperimentFamily::Validation, total, seed)?,
             VesselKind::Rov6 => {
                 let t_max = dofs
                     .iter()
