@@ -163,50 +163,61 @@ pub(super) fn thruster_channels(
         })?;
         for &i in group {
             specs[i] = Some(ChannelSpec {
-                plan: ChannelPlan {
-                    column: format!("thr_{}", i + 1),
-                    unit: "1".into(),
-                    dof: None,
-                    thruster: Some(i),
-                    excited: true,
-                    waveform: design.waveform.clone(),
-                    offset: 0.0,
-                    amplitude,
-                    limit: thr[i].max_command,
-                    rate_limit: Some(thr[i].max_rate),
-                    analysis: None,
-                },
+                plan: thruster_plan(ctx, i, true, design.waveform.clone(), amplitude),
                 duration_s: design.duration_s,
             });
         }
     }
+    Ok(with_idle(specs, |i| {
+        thruster_plan(ctx, i, false, Waveform::Constant, 0.0)
+    }))
+}
+
+/// The command channel `thr_{i+1}` of thruster `i`.
+fn thruster_plan(
+    ctx: &Ctx<'_>,
+    i: usize,
+    excited: bool,
+    waveform: Waveform,
+    amplitude: f64,
+) -> ChannelPlan {
+    let t = &ctx.vessel.thrusters()[i];
+    ChannelPlan {
+        column: format!("thr_{}", i + 1),
+        unit: "1".into(),
+        dof: None,
+        thruster: Some(i),
+        excited,
+        waveform,
+        offset: 0.0,
+        amplitude,
+        limit: t.max_command,
+        rate_limit: Some(t.max_rate),
+        analysis: None,
+    }
+}
+
+/// The channels with the undriven ones (`None`) filled by `idle(i)`, held
+/// for the longest driven channel's duration.
+fn with_idle(
+    specs: Vec<Option<ChannelSpec>>,
+    idle: impl Fn(usize) -> ChannelPlan,
+) -> Vec<ChannelSpec> {
     let duration = specs
         .iter()
         .flatten()
         .map(|s| s.duration_s)
         .fold(0.0, f64::max);
-    Ok(specs
+    specs
         .into_iter()
         .enumerate()
         .map(|(i, s)| {
             s.unwrap_or_else(|| ChannelSpec {
-                plan: ChannelPlan {
-                    column: format!("thr_{}", i + 1),
-                    unit: "1".into(),
-                    dof: None,
-                    thruster: Some(i),
-                    excited: false,
-                    waveform: Waveform::Constant,
-                    offset: 0.0,
-                    amplitude: 0.0,
-                    limit: thr[i].max_command,
-                    rate_limit: Some(thr[i].max_rate),
-                    analysis: None,
-                },
+                plan: idle(i),
                 duration_s: duration,
             })
         })
-        .collect())
+        .collect()
 }
 
 /// Force channels τ of a DP vessel that logs forces: each DOF group one
@@ -251,21 +262,9 @@ fn force_channels(
             });
         }
     }
-    let duration = specs
-        .iter()
-        .flatten()
-        .map(|s| s.duration_s)
-        .fold(0.0, f64::max);
-    Ok(specs
-        .into_iter()
-        .enumerate()
-        .map(|(i, s)| {
-            s.unwrap_or_else(|| ChannelSpec {
-                plan: force_plan(ctx, dofs[i], false, Waveform::Constant, 0.0),
-                duration_s: duration,
-            })
-        })
-        .collect())
+    Ok(with_idle(specs, |i| {
+        force_plan(ctx, dofs[i], false, Waveform::Constant, 0.0)
+    }))
 }
 
 /// The τ channel of `d`.
