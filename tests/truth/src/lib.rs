@@ -32,6 +32,7 @@ pub mod plant;
 pub mod predict;
 pub mod rng;
 pub mod signals;
+pub mod usv;
 pub mod vessel;
 mod vessel_draw;
 
