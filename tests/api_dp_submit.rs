@@ -5,7 +5,8 @@
 //! run is refused at `POST /api/jobs` with a 422 naming what is missing —
 //! no validation run, a manoeuvre, the pose of a velocity-only log — and
 //! nothing is queued; a profile without M″ is identified and says how, and
-//! so is a vessel with another thruster layout (two tunnels, two azimuths).
+//! so are a vessel with another thruster layout (two tunnels, two azimuths)
+//! and one that logs forces τ (planned with force schedules).
 
 mod common;
 
@@ -13,7 +14,7 @@ use common::flights::planned_campaign;
 use common::{TestApp, dp_profile};
 use seatrial::jobs::{JobRegistry, JobsConfig};
 use seatrial_core::planning::examples::supply_vessel_trial_campaign;
-use seatrial_truth::dp_layouts::{AZ_K, AZ_T, DpLayout, fly_dp_layout_campaign};
+use seatrial_truth::dp_layouts::{AZ_K, AZ_T, DISPLACEMENT_KG, DpLayout, fly_dp_layout_campaign};
 use seatrial_truth::dp_ship::{self, DpTrial, fly_dp_campaign};
 use serde_json::{Value, json};
 
@@ -67,6 +68,19 @@ async fn campaign(app: &TestApp, profile: Value) -> (String, Vec<(String, String
         ids.push((log.name, run["id"].as_str().unwrap().to_string()));
     }
     (cid, ids)
+}
+
+/// The model document of a default `parallel_ekf` job on campaign `cid`.
+async fn identified(app: &TestApp, cid: &str) -> Value {
+    let job = common::run_job(
+        app,
+        json!({ "kind": "identify", "campaign_id": cid, "method": "parallel_ekf" }),
+    )
+    .await;
+    let mid = job["result"]["model_id"].as_str().unwrap();
+    let m = app.call("GET", "/api/models/{id}", &[mid], None).await;
+    assert_eq!(m.status, 200, "{}", m.text);
+    m.json["document"].clone()
 }
 
 fn id<'a>(ids: &'a [(String, String)], name: &str) -> &'a str {
@@ -233,19 +247,7 @@ async fn a_profile_without_inertia_and_another_thruster_layout_are_identified() 
     for log in fly_dp_layout_campaign(&DpTrial::default(), DpLayout::AzimuthsTunnels, 11) {
         upload(&app, &cid4, &log.name, &log.csv, json!({})).await;
     }
-    let runs = app
-        .call("GET", "/api/campaigns/{id}/runs", &[&cid4], None)
-        .await;
-    eprintln!("{}", runs.text);
-    let job = common::run_job(
-        &app,
-        json!({ "kind": "identify", "campaign_id": cid4, "method": "parallel_ekf" }),
-    )
-    .await;
-    let mid = job["result"]["model_id"].as_str().unwrap();
-    let m = app.call("GET", "/api/models/{id}", &[mid], None).await;
-    assert_eq!(m.status, 200, "{}", m.text);
-    let doc = &m.json["document"];
+    let doc = &identified(&app, &cid4).await;
     let k = doc["dp_ship"]["k"].as_array().unwrap();
     assert_eq!(k.len(), 4, "{k:?}");
     assert_eq!(k[2], k[3]);
@@ -265,4 +267,33 @@ async fn a_profile_without_inertia_and_another_thruster_layout_are_identified() 
         notes.contains("grouped as the profile says: bow, stern, azimuths"),
         "{notes}"
     );
+}
+
+/// A DP vessel that logs generalized forces τ (N, N·m): planned with force
+/// schedules, the truth's τ logs uploaded without a plan and staged by
+/// which forces move, identified with one coefficient K″ = F_ref/(m·g)
+/// whose implied displacement the notes give.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_vessel_logging_forces_is_planned_and_identified() {
+    let app = TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await;
+    let mut profile = dp_profile();
+    profile["name"] = json!("supply vessel logging τ");
+    profile["inputs"] = json!({ "kind": "generalized_forces" });
+    let mut spec = serde_json::to_value(supply_vessel_trial_campaign(5)).unwrap();
+    spec["families"] = json!(["dp_surge", "dp_sway_yaw", "validation"]);
+    let (cid, plan) = planned_campaign(&app, profile, spec).await;
+    let columns = plan["experiments"][0]["channels"].to_string();
+    assert!(columns.contains("tau_X"), "{columns}");
+    for log in fly_dp_layout_campaign(&DpTrial::default(), DpLayout::Forces, 11) {
+        upload(&app, &cid, &log.name, &log.csv, json!({})).await;
+    }
+    let doc = &identified(&app, &cid).await;
+    assert_eq!(doc["inputs"], json!(["tau_X", "tau_Y", "tau_N"]));
+    let k = doc["dp_ship"]["theta"][5].as_f64().unwrap();
+    let f = 1.3e6; // the supply vessel profile's surge force limit (N)
+    let mass = f / (9.81 * k);
+    assert!((mass / DISPLACEMENT_KG - 1.0).abs() < 0.02, "m = {mass} kg");
+    let notes = doc["notes"].to_string();
+    assert!(notes.contains("Implied m = F_ref/(g·K″)"), "{notes}");
+    assert_eq!(doc["parameters"].as_array().unwrap().len(), 6);
 }
