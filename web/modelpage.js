@@ -123,7 +123,8 @@ function refinementPart(dp) {
     h('p', { class: 'hint' }, head),
     r.applied ? h('table', { class: 'grid-table compact', 'data-testid': 'dp-refinement-table' },
       h('thead', null, h('tr', null, h('th', null, 'θ″'), h('th', { class: 'num' }, 'staged EKF'), h('th', { class: 'num' }, 'refined (stored)'), h('th', { class: 'num' }, 'std inflation'))),
-      h('tbody', null, r.ekf_theta.map((v, i) => h('tr', null,
+      // A thrust-coefficient slot the vessel's layout does not use stays 0 ± 0: not shown.
+      h('tbody', null, r.ekf_theta.map((v, i) => (v === 0 && dp.theta[i] === 0 && !r.ekf_theta_std[i]) ? null : h('tr', null,
         h('th', { scope: 'row' }, `θ″${i + 1}`),
         h('td', { class: 'num mono' }, pm(v, r.ekf_theta_std[i])),
         h('td', { class: 'num mono' }, pm(dp.theta[i], dp.theta_std[i])),
