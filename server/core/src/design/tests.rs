@@ -286,3 +286,39 @@ fn a_deciding_run_comes_after_validation_until_it_is_flown() {
         propose_next_dive(&profile, &plan, &[], &done, &truth, 3.0, &mut NoProgress).unwrap();
     assert!(later.proposed.iter().all(|p| p.code != "DEC1-sway-000"));
 }
+
+/// A DP vessel outside the paper's layout is flown through the project's
+/// DP simulator with its own T″ and predicted like any other: a vessel
+/// that logs τ (one coefficient, no SI3) and one with four thrusters, each
+/// with a finite std for every θ″ its layout has.
+#[test]
+fn dp_vessels_of_other_layouts_are_predicted() {
+    use crate::planning::campaign::ExperimentFamily as F;
+    use crate::planning::vessel::InputChannels;
+    let mut forces = supply_vessel();
+    forces.inputs = InputChannels::GeneralizedForces;
+    let four = crate::planning::examples::supply_vessel_azimuths_tunnels();
+    for (profile, total) in [(forces, 6), (four, 9)] {
+        let mut spec = supply_vessel_trial_campaign(3);
+        spec.families = vec![F::DpSurge, F::DpSwayYaw, F::Validation];
+        let plan = generate_plan(&profile, &spec).unwrap();
+        let prior = Prior::from_profile(&profile).unwrap();
+        let p = predict_precision(
+            &profile,
+            &plan,
+            &prior,
+            PriorSource::Profile,
+            &PredictSettings {
+                realisations: 1,
+                ..PredictSettings::default()
+            },
+            &mut NoProgress,
+        )
+        .unwrap();
+        assert_eq!(p.total, total, "{:#?}", p.parameters);
+        for row in &p.parameters {
+            let s = row.predicted_std.unwrap();
+            assert!(s.is_finite() && s > 0.0, "{}: {s}", row.symbol);
+        }
+    }
+}

@@ -3,35 +3,9 @@
 //! vessel that logs forces.
 
 use super::campaign::ExperimentFamily;
-use super::examples::{supply_vessel, supply_vessel_campaign};
-use super::vessel::{InputChannels, Thruster, ThrusterKind, VesselProfile};
+use super::examples::{supply_vessel, supply_vessel_azimuths_tunnels, supply_vessel_campaign};
+use super::vessel::InputChannels;
 use super::*;
-
-/// Two tunnels (bow, stern) and two aft azimuths fixed at ±30°.
-fn azimuths_tunnels() -> VesselProfile {
-    let mut p = supply_vessel();
-    let thr = |name: &str, kind| Thruster {
-        name: name.into(),
-        kind,
-        max_command: 1.0,
-        max_rate: 0.1,
-        coefficient_group: None,
-    };
-    p.inputs = InputChannels::Thrusters {
-        thrusters: vec![
-            thr("bow tunnel", ThrusterKind::Tunnel),
-            thr("stern tunnel", ThrusterKind::Tunnel),
-            thr("port azimuth", ThrusterKind::Azimuth),
-            thr("starboard azimuth", ThrusterKind::Azimuth),
-        ],
-        configuration: vec![
-            vec![0.0, 0.0, 0.866, 0.866],
-            vec![1.0, 1.0, 0.5, -0.5],
-            vec![0.45, -0.4, -0.173, 0.173],
-        ],
-    };
-    p
-}
 
 fn excited(plan: &Plan, i: usize) -> Vec<&str> {
     plan.experiments[i]
@@ -51,7 +25,7 @@ fn other_layouts_fly_surge_thrusters_together_and_lateral_ones_apart() {
         ExperimentFamily::DpSwayYaw,
         ExperimentFamily::Validation,
     ];
-    let plan = generate_plan(&azimuths_tunnels(), &c).unwrap();
+    let plan = generate_plan(&supply_vessel_azimuths_tunnels(), &c).unwrap();
     // SI1: the azimuth pair on one signal (its sway and yaw cancel).
     assert_eq!(excited(&plan, 0), ["thr_3", "thr_4"]);
     let s1 = &plan.experiments[0].schedule.values;

@@ -76,13 +76,7 @@ pub fn supply_vessel() -> VesselProfile {
         (Dof::Sway, dof(1.0, 5.5e5, 0.0628)),
         (Dof::Yaw, dof(0.035, 1.6e7, 0.2428)),
     ]);
-    let thr = |name: &str, kind| Thruster {
-        name: name.into(),
-        kind,
-        max_command: 1.0,
-        max_rate: 0.1,
-        coefficient_group: None,
-    };
+    let thr = example_thruster;
     VesselProfile {
         name: "Supply vessel (Fossen et al. 1995)".into(),
         kind: VesselKind::Dp3,
@@ -117,6 +111,40 @@ pub fn supply_vessel() -> VesselProfile {
         heading_unit: None,
         autopilot: None,
     }
+}
+
+/// A thruster with full command 1 slewed at 10 %/s, no coefficient group.
+fn example_thruster(name: &str, kind: ThrusterKind) -> Thruster {
+    Thruster {
+        name: name.into(),
+        kind,
+        max_command: 1.0,
+        max_rate: 0.1,
+        coefficient_group: None,
+    }
+}
+
+/// The supply vessel's hull with two tunnels (bow at x = 0.45 L, stern at
+/// x = −0.40 L) and two aft azimuths at (−0.45 L, ∓0.06 L) fixed at ±30°,
+/// T″ in Bis: a layout outside the paper's, for tests and the docs.
+pub fn supply_vessel_azimuths_tunnels() -> VesselProfile {
+    let mut p = supply_vessel();
+    p.name = "Supply vessel, two tunnels and two azimuths".into();
+    let thr = example_thruster;
+    p.inputs = InputChannels::Thrusters {
+        thrusters: vec![
+            thr("bow tunnel", ThrusterKind::Tunnel),
+            thr("stern tunnel", ThrusterKind::Tunnel),
+            thr("port azimuth", ThrusterKind::Azimuth),
+            thr("starboard azimuth", ThrusterKind::Azimuth),
+        ],
+        configuration: vec![
+            vec![0.0, 0.0, 0.866, 0.866],
+            vec![1.0, 1.0, 0.5, -0.5],
+            vec![0.45, -0.4, -0.173, 0.173],
+        ],
+    };
+    p
 }
 
 /// The thesis's campaign for the Surveyor: grid {0.5, …, 3.5} kn (4.0 kn

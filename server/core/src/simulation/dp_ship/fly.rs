@@ -1,13 +1,14 @@
 //! A planned DP campaign flown by a DP ship truth and logged as the vessel's
 //! logger would: the counterpart of [`crate::simulation::trials`] for
-//! thruster-actuated (Dp3) profiles.
+//! DP (Dp3) profiles.
 //!
-//! Each planned experiment's `thr_1 … thr_6` schedule (normalized commands
-//! u = |p|·p, eq. 5) drives the momentum-form ship of [`super::model`] open
+//! Each planned experiment's input schedule — thruster commands `thr_1 …
+//! thr_r` (normalized, u = |p|·p, eq. 5) or forces `tau_X, tau_Y, tau_N`
+//! for a vessel that logs τ, through the ship's T — drives the momentum-form ship of [`super::model`] open
 //! loop from rest, with a slowly varying bias b_h and position/heading noise
 //! ([`super::trial::simulate_trial`], eq. 35–37, 44–45). The ship works in
 //! the Bis system of the profile's [`DpPrior`]; the log is SI: `t` (s),
-//! `thr_i`, `u v r` (m/s, rad/s, with a little white noise), `x y` (m) and
+//! the inputs, `u v r` (m/s, rad/s, with a little white noise), `x y` (m) and
 //! `psi` (rad, wrapped to (−π, π] like a gyro compass).
 
 use nalgebra::DMatrix;
@@ -15,7 +16,7 @@ use nalgebra::DMatrix;
 use super::manoeuvres::Manoeuvre;
 use super::model::DpShip;
 use super::trial::{DpRun, TrialConfig, simulate_trial};
-use crate::logs::schema::{LogRole, required_columns};
+use crate::logs::schema::{LogRole, input_columns, required_columns};
 use crate::planning::vessel::{DpPrior, VesselKind};
 use crate::planning::{Experiment, ExperimentFamily, Plan, PlannedExperiment, VesselProfile};
 use crate::simulation::trials::{TrialError, run_seed, wrap_pi};
@@ -82,12 +83,6 @@ fn prior(profile: &VesselProfile) -> Result<&DpPrior, TrialError> {
             "only DP vessels are flown by the DP ship truth",
         ));
     }
-    if profile.thrusters().len() != 6 {
-        return Err(TrialError::invalid(
-            "profile.inputs.thrusters",
-            "the DP ship truth has six thrusters (Fossen et al. eq. 29)",
-        ));
-    }
     if profile.logger_rate_hz != profile.controller_rate_hz {
         return Err(TrialError::invalid(
             "profile.logger_rate_hz",
@@ -115,10 +110,20 @@ pub fn fly_dp_experiment(
     let ex = &planned.experiment;
     let s = &planned.schedule;
     let n = s.len();
-    let mut u = DMatrix::zeros(n, 6);
-    for j in 0..6 {
-        let name = format!("thr_{}", j + 1);
-        let col = s.columns.iter().position(|c| *c == name).ok_or_else(|| {
+    let inputs = input_columns(profile);
+    if inputs.len() != ship.k.len() {
+        return Err(TrialError::invalid(
+            "profile.inputs",
+            format!(
+                "the profile has {} input columns and the ship's T has {}",
+                inputs.len(),
+                ship.k.len()
+            ),
+        ));
+    }
+    let mut u = DMatrix::zeros(n, inputs.len());
+    for (j, name) in inputs.iter().enumerate() {
+        let col = s.columns.iter().position(|c| c == name).ok_or_else(|| {
             TrialError::invalid(
                 format!("plan.{}.schedule", ex.code),
                 format!("no column '{name}'"),
@@ -185,6 +190,7 @@ fn dp_csv(
     );
     let mut rng = crate::rng::SplitMix64::new(crate::rng::mix(seed ^ 0x5eed));
     let cols = required_columns(profile, LogRole::Single, None);
+    let inputs = input_columns(profile);
     let mut out = cols.join(",");
     out.push('\n');
     for k in 0..run.t.len() {
@@ -198,10 +204,10 @@ fn dp_csv(
                 "x" => run.eta[(k, 0)] * l,
                 "y" => run.eta[(k, 1)] * l,
                 "psi" => wrap_pi(run.eta[(k, 2)]),
-                thr => thr
-                    .strip_prefix("thr_")
-                    .and_then(|i| i.parse::<usize>().ok())
-                    .map_or(0.0, |i| run.u[(k, i - 1)]),
+                input => inputs
+                    .iter()
+                    .position(|c| c == input)
+                    .map_or(0.0, |j| run.u[(k, j)]),
             };
             row.push(val.to_string());
         }

@@ -54,7 +54,8 @@ pub struct DpRun {
     pub manoeuvre: Manoeuvre,
     /// Sample times.
     pub t: Vec<f64>,
-    /// Thruster commands u (N × 6), held from sample k to k + 1.
+    /// Inputs u (N × r: thruster commands, or τ for a vessel that logs
+    /// forces), held from sample k to k + 1.
     pub u: DMatrix<f64>,
     /// Measured η = [x, y, ψ] with noise (N × 3).
     pub eta: DMatrix<f64>,
@@ -66,7 +67,8 @@ pub struct DpRun {
     pub bias: DMatrix<f64>,
 }
 
-/// Simulates `ship` from rest at pose `eta0` under the commands `u` (N × 6).
+/// Simulates `ship` from rest at pose `eta0` under the inputs `u` (N × r,
+/// one column per column of the ship's T).
 pub fn simulate_trial(
     ship: &DpShip,
     manoeuvre: Manoeuvre,
@@ -75,7 +77,8 @@ pub fn simulate_trial(
     cfg: &TrialConfig,
     seed: u64,
 ) -> DpRun {
-    assert_eq!(u.ncols(), 6, "u must have six thruster columns");
+    let r = ship.k.len();
+    assert_eq!(u.ncols(), r, "u must have one column per column of T");
     let n = u.nrows();
     let m_inv = ship.m_inv();
     let mut rng = SplitMix64::new(seed);
@@ -84,8 +87,8 @@ pub fn simulate_trial(
     let mut x = [0.0, 0.0, 0.0, eta0[0], eta0[1], eta0[2]];
     let mut f = |s: &[f64], w: &[f64], dx: &mut [f64]| {
         let h = Vector3::new(s[0], s[1], s[2]);
-        let bias = Vector3::new(w[6], w[7], w[8]);
-        let hd = ship.h_dot(&m_inv, &h, &w[..6], &bias);
+        let bias = Vector3::new(w[r], w[r + 1], w[r + 2]);
+        let hd = ship.h_dot(&m_inv, &h, &w[..r], &bias);
         let eta_dot = rotation(s[5]) * (m_inv * h);
         dx[..3].copy_from_slice(hd.as_slice());
         dx[3..].copy_from_slice(eta_dot.as_slice());
@@ -105,7 +108,7 @@ pub fn simulate_trial(
         cfg.heading_noise_std,
     ];
     let dt = cfg.h / cfg.substeps.max(1) as f64;
-    let mut w = [0.0; 9];
+    let mut w = vec![0.0; r + 3];
     for k in 0..n {
         let nu = m_inv * Vector3::new(x[0], x[1], x[2]);
         for j in 0..3 {
@@ -114,10 +117,10 @@ pub fn simulate_trial(
             run.nu[(k, j)] = nu[j];
             run.bias[(k, j)] = b[j];
         }
-        for j in 0..6 {
+        for j in 0..r {
             w[j] = u[(k, j)];
         }
-        w[6..].copy_from_slice(b.as_slice());
+        w[r..].copy_from_slice(b.as_slice());
         for _ in 0..cfg.substeps.max(1) {
             rk4_step(&mut f, &mut x, &w, dt);
         }
