@@ -13,7 +13,7 @@ use seatrial_core::identification::{
 };
 use seatrial_core::logs::input_columns;
 use seatrial_core::planning::VesselProfile;
-use seatrial_core::planning::vessel::VesselKind;
+use seatrial_core::planning::vessel::{InputChannels, VesselKind};
 use serde::de::DeserializeOwned;
 use sqlx::SqliteConnection;
 
@@ -25,8 +25,9 @@ use crate::storage::jobs::{Job, JobRequest};
 use crate::storage::models::{self, Lineage, NewModel};
 use crate::storage::{campaigns, runs, vessels};
 
-/// Methods of `identify`: `lambda_kf` (ROV LPV), `n4sid` (black box, any
-/// vessel), `parallel_ekf` (DP vessels).
+/// Methods of `identify`: `lambda_kf` (LPV on forward speed: ROVs, and
+/// surface vessels logging forces τ, with a current), `n4sid` (black box,
+/// any vessel), `parallel_ekf` (DP vessels).
 pub const METHODS: [&str; 3] = ["lambda_kf", "n4sid", "parallel_ekf"];
 
 /// The method used when the request names none: the vessel's physical one.
@@ -60,10 +61,13 @@ fn check_method(vessel: &VesselProfile, method: &str) -> Result<(), String> {
         ("lambda_kf", VesselKind::Rov6) | ("n4sid", _) | ("parallel_ekf", VesselKind::Dp3) => {
             Ok(())
         }
-        ("lambda_kf", VesselKind::Dp3) => Err(
-            "lambda_kf fits the ROV LPV model on forward speed; a DP vessel (dp3) is identified by parallel_ekf (Fossen et al. 1995), or n4sid for a black-box comparison"
-                .into(),
-        ),
+        ("lambda_kf", VesselKind::Dp3) => match vessel.inputs {
+            InputChannels::GeneralizedForces => Ok(()),
+            _ => Err(format!(
+                "lambda_kf fits M, D̄ and a current in SI units from forces in N and N·m; '{}' logs thruster commands whose T″ is in Bis units with unknown thrust coefficients: identify it by parallel_ekf (Fossen et al. 1995), or describe its inputs as generalized_forces (tau_X, tau_Y, tau_N) if the logs carry them",
+                vessel.name
+            )),
+        },
         ("parallel_ekf", _) => Err(format!(
             "parallel_ekf identifies DP vessels (kind dp3) from the SI1–SI3 manoeuvres; '{}' is a {:?} vessel: use lambda_kf or n4sid",
             vessel.name, vessel.kind

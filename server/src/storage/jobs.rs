@@ -75,8 +75,9 @@ pub struct JobRequest {
     #[serde(default)]
     pub run_ids: Vec<String>,
     /// The method, as the kind defines it. `identify`: `lambda_kf` (default
-    /// for ROVs), `parallel_ekf` (default for DP vessels; DP only) or
-    /// `n4sid`; the other kinds take none.
+    /// for ROVs; for DP vessels only those logging forces τ), `parallel_ekf`
+    /// (default for DP vessels; DP only) or `n4sid`; the other kinds take
+    /// none.
     #[serde(default)]
     #[schema(value_type = Option<IdentifyMethod>)]
     pub method: Option<String>,

@@ -134,6 +134,11 @@ pub struct LpvPoint {
     pub n_samples: usize,
     /// Runs used.
     pub run_ids: Vec<String>,
+    /// F (n × 2, N or N·m per unit) of a current fixed in NED on the
+    /// heading shapes [cos ψ, sin ψ]: M ν̇ + D̄ ν + F·[cos ψ, sin ψ]ᵀ = γ,
+    /// F = −D̄_{:,uv}·Q(V) (see `LpvDoc::current`). Absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub current_force: Option<Matrix>,
     /// Physics added at this speed by missing-physics discovery; the point's
     /// `m`, `d_bar` are then the refitted ones and the model is driven by
     /// (τ, η) instead of γ.
@@ -199,6 +204,31 @@ pub struct LpvDoc {
     /// Std of `quadratic_damping`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quadratic_damping_std: Option<Vec<f64>>,
+    /// A current fixed in NED (horizontal models of surface vessels), one
+    /// for the campaign: the damping acts on ν − ν_c(ψ), and predictions
+    /// integrate ψ from the model's yaw rate (inputs: the forces, then
+    /// `psi` in rad). Absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub current: Option<NedCurrentDoc>,
+}
+
+/// A current of constant speed and direction in NED.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct NedCurrentDoc {
+    /// Speed V_c (m/s).
+    pub speed_mps: f64,
+    /// Std of `speed_mps` (m/s).
+    pub speed_std_mps: f64,
+    /// Direction β_c the current flows towards (degrees from north towards
+    /// east, in [0, 360)).
+    pub direction_deg: f64,
+    /// Std of `direction_deg` (degrees).
+    pub direction_std_deg: f64,
+    /// North and east components [V_N, V_E] (m/s).
+    pub ned_mps: [f64; 2],
+    /// How it was estimated.
+    pub evidence: String,
 }
 
 /// Speeds (m/s) an LPV model extends to beyond its grid.

@@ -26,6 +26,7 @@ use super::lambda_physical::{enforce, unresolved_mode};
 use super::lambda_quadratic;
 use super::lambda_structure::choose_structure;
 use super::lambda_validation::{HeldOut, choose_second_order};
+use super::ned_current;
 use super::outcome::Identified;
 use super::roles::assign_roles;
 use crate::estimation::lambda::{
@@ -33,6 +34,7 @@ use crate::estimation::lambda::{
 };
 use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
 use crate::estimation::{Progress, SubProgress};
+use crate::logs::schema::pose_column;
 use crate::models::{LinearVesselModel, LpvModel, Scheduling};
 use crate::numbers::sig3;
 use crate::planning::dof::Dof;
@@ -134,8 +136,14 @@ pub fn identify_lambda_campaign(
 
     // Columns: τ, then η when g(η) is part of the model.
     let with_restoring = settings.estimate_restoring && six_dof;
-    let cols = regression_columns(inputs, with_restoring);
-    if !six_dof && settings.estimate_restoring {
+    let mut cols = regression_columns(inputs, with_restoring);
+    let with_current = settings.ned_current
+        && ned_current::applies(&dofs)
+        && ned_current::heading_logged(&roles, &mut notes);
+    if with_current {
+        cols.push(pose_column(Dof::Yaw).to_string());
+    }
+    if !six_dof && settings.estimate_restoring && !ned_current::applies(&dofs) {
         notes.push("g(η) needs all six DOFs and the attitude; γ = τ".into());
     }
     let data = per_point(&roles, grid, &dofs, &cols, &outputs, &mut notes)?;
@@ -185,6 +193,20 @@ pub fn identify_lambda_campaign(
             .map(|(s, e)| (*s, e))
             .collect()
     };
+    // The heading shapes e(ψ) of each point's segments appended (first
+    // pass) or the known current's force taken out of γ (second pass).
+    let heading = |exps: Vec<Vec<Experiment>>| -> Vec<Vec<Experiment>> {
+        exps.into_iter()
+            .zip(&data.segments)
+            .map(|(point, segs)| {
+                point
+                    .into_iter()
+                    .zip(segs)
+                    .map(|(e, s)| ned_current::append(e, s, n))
+                    .collect()
+            })
+            .collect()
+    };
     let plain = build(None, None)?;
     let all: Vec<Experiment> = plain.iter().flatten().cloned().collect();
     let chosen = choose_structure(settings, &dofs, &all, progress, &mut notes)?;
@@ -195,6 +217,11 @@ pub fn identify_lambda_campaign(
         Prior::from_profile(profile, &dofs),
     );
     lambda_settings.symmetric_inertia = settings.symmetric_inertia;
+    // A surface vessel's surge speed strays far from its grid speed (a DP
+    // vessel drifting, turning at speed): C(δ)δ is then taken out of γ in
+    // the fit too.
+    lambda_settings.second_order_coriolis =
+        settings.coriolis_second_order && ned_current::applies(&dofs);
     // A controller faster than the log: the fit returns M − c K_ν, and
     // M itself is what must be symmetric.
     let logged: Vec<&Segment> = data.segments.iter().flatten().collect();
@@ -256,13 +283,15 @@ pub fn identify_lambda_campaign(
     } else {
         None
     };
-    let joint = if with_restoring || !quad_cols.is_empty() {
-        lambda_settings.exogenous = lambda_quadratic::specification(
-            joint_functions.map(|f| specification(profile, &dofs, f)),
-            profile,
-            &dofs,
-            &quad_cols,
-        );
+    let joint = if with_restoring || !quad_cols.is_empty() || with_current {
+        let base = joint_functions.map(|f| specification(profile, &dofs, f));
+        let base = if with_current {
+            Some(ned_current::specification(base, profile, &dofs))
+        } else {
+            base
+        };
+        lambda_settings.exogenous =
+            lambda_quadratic::specification(base, profile, &dofs, &quad_cols);
         // Not with D_q's columns: a barely moved roll's D_q takes up the
         // restoring shapes' shift (vessel 2 of the independent truth: roll
         // D_q 32.7 ± 6.1 against 8.8 N·m·s²/rad²).
@@ -276,14 +305,22 @@ pub fn identify_lambda_campaign(
                         .map(|x| attitude_shape_noise(n, &x.names, sd))
                 });
         let mut sub = SubProgress::new(progress, 0.05, 0.4);
-        fit_points(
-            &points_of(with_quadratic(build(None, joint_functions)?)),
+        let first = build(None, joint_functions)?;
+        let first = if with_current { heading(first) } else { first };
+        // Before the current is known C(δ)δ of ν would act on the drift
+        // over ground; the first pass fits without it.
+        let second = lambda_settings.second_order_coriolis;
+        lambda_settings.second_order_coriolis &= !with_current;
+        let joint = fit_points(
+            &points_of(with_quadratic(first)),
             &lambda_settings,
             settings.coriolis_from_m,
             &mut sub,
             &mut notes,
         )
-        .map_err(lambda_error)?
+        .map_err(lambda_error)?;
+        lambda_settings.second_order_coriolis = second;
+        joint
     } else {
         Vec::new()
     };
@@ -319,7 +356,40 @@ pub fn identify_lambda_campaign(
         )),
         _ => None,
     };
+    let current = if with_current {
+        ned_current::campaign_current(&joint, &dofs, &mut notes)
+    } else {
+        None
+    };
+    let relative = current.as_ref().map(|c| ned_current::Relative {
+        dofs: dofs.clone(),
+        v: c.estimate.v,
+        m: c.m.clone(),
+        coriolis: lambda_settings.second_order_coriolis,
+    });
+    let current_forces = |speed: f64| -> Option<DMatrix<f64>> {
+        current
+            .as_ref()
+            .and_then(|c| c.forces.iter().find(|(s, _)| *s == speed))
+            .map(|(_, f)| f.clone())
+    };
     let plain_exps = build(g, loads)?;
+    let plain_exps: Vec<Vec<Experiment>> = plain_exps
+        .into_iter()
+        .zip(&data.segments)
+        .zip(grid)
+        .map(|((point, segs), &u0)| match current_forces(u0) {
+            Some(f) => point
+                .into_iter()
+                .zip(segs)
+                .map(|(e, s)| match &relative {
+                    Some(r) => r.apply(e, s, u0, &f),
+                    None => e,
+                })
+                .collect(),
+            None => point,
+        })
+        .collect();
     let known = |d_q: Option<&DVector<f64>>| -> Vec<Vec<Experiment>> {
         plain_exps
             .iter()
@@ -468,6 +538,7 @@ pub fn identify_lambda_campaign(
                 .then(|| load_std.iter().copied().collect()),
             n_samples: est.n_samples,
             run_ids: data.run_ids[idx].clone(),
+            current_force: current_forces(*speed).map(|f| to_rows(&f)),
             augmentation: None,
         });
         vehicle.push(model.clone());
@@ -487,6 +558,9 @@ pub fn identify_lambda_campaign(
     }
     if let Some((_, doc)) = &restoring {
         parameters.extend(doc.parameters.iter().cloned());
+    }
+    if let Some(c) = &current {
+        parameters.extend(c.parameters());
     }
     let scheduling = match settings.scheduling {
         SchedulingChoice::Nearest => Scheduling::Nearest,
@@ -564,6 +638,13 @@ pub fn identify_lambda_campaign(
         outputs: &outputs,
         n,
         restoring: g,
+        current: current.as_ref().map(|c| {
+            let forces = estimates
+                .iter()
+                .map(|&(s, _)| current_forces(s).unwrap_or_else(|| DMatrix::zeros(n, 2)))
+                .collect();
+            (forces, c.estimate.v)
+        }),
         settings: &vsettings,
     };
     let validate_with = |lpv: &LpvModel| held_out.validate(lpv);
@@ -603,6 +684,7 @@ pub fn identify_lambda_campaign(
             coriolis_second_order: second_order,
             quadratic_damping: quadratic.as_ref().map(|(d, _)| d.iter().copied().collect()),
             quadratic_damping_std: quadratic.as_ref().map(|(_, s)| s.iter().copied().collect()),
+            current: current.as_ref().map(|c| c.doc()),
         }),
         dp_ship: None,
         state_space: None,

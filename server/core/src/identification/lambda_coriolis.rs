@@ -18,7 +18,7 @@ use nalgebra::{DMatrix, DVector};
 use super::document::{LpvDoc, from_rows};
 use crate::estimation::lambda::{Experiment, Inversion, LambdaEstimate, LambdaSettings, identify};
 use crate::estimation::{Cancelled, Progress};
-use crate::models::coriolis::coriolis;
+use crate::models::coriolis::{coriolis, second_order_force_about};
 use crate::planning::dof::Dof;
 
 /// Fixed-point passes of M̂ → J_C → fit.
@@ -51,9 +51,17 @@ pub(crate) fn coriolis_jacobian(m: &DMatrix<f64>, dofs: &[Dof], u0: f64) -> Opti
     j.iter().all(|v| v.is_finite()).then_some(j)
 }
 
-/// γ' = γ − J ν̄ per run, with ν̄ the step mean ½(ν_k + ν_{k+1}) (held
-/// over the step like γ).
-fn moved(exps: &[Experiment], j: &DMatrix<f64>) -> Vec<Experiment> {
+/// The vehicle's M, DOFs and grid speed for C(δ)δ on the known side.
+struct SecondOrder<'a> {
+    m: &'a DMatrix<f64>,
+    dofs: &'a [Dof],
+    surge: usize,
+    u0: f64,
+}
+
+/// γ' = γ − J ν̄ (and − C(δ̄)δ̄, δ̄ = ν̄ − (u₀, 0, …), with `second`) per
+/// run, with ν̄ the step mean ½(ν_k + ν_{k+1}) (held over the step like γ).
+fn moved(exps: &[Experiment], j: &DMatrix<f64>, second: Option<&SecondOrder>) -> Vec<Experiment> {
     exps.iter()
         .map(|e| {
             let rows = e.nu.nrows();
@@ -61,7 +69,11 @@ fn moved(exps: &[Experiment], j: &DMatrix<f64>) -> Vec<Experiment> {
             for k in 0..rows {
                 let next = if k + 1 < rows { k + 1 } else { k };
                 let nu = (e.nu.row(k) + e.nu.row(next)).transpose() * 0.5;
-                let f = j * nu;
+                let mut f = j * &nu;
+                if let Some(s) = second {
+                    let c = second_order_force_about(s.dofs, s.m, nu.as_slice(), s.surge, s.u0);
+                    f += DVector::from_vec(c);
+                }
                 for i in 0..g.ncols() {
                     g[(k, i)] -= f[i];
                 }
@@ -100,7 +112,17 @@ pub(crate) fn identify_with_coriolis(
         let Some(j) = coriolis_jacobian(&vehicle, &settings.dofs, u0) else {
             return Ok((est, None));
         };
-        est = identify(&moved(exps, &j), settings)?;
+        let surge = settings.dofs.iter().position(|d| *d == Dof::Surge);
+        let second = match surge {
+            Some(surge) if settings.second_order_coriolis => Some(SecondOrder {
+                m: &vehicle,
+                dofs: &settings.dofs,
+                surge,
+                u0,
+            }),
+            _ => None,
+        };
+        est = identify(&moved(exps, &j, second.as_ref()), settings)?;
         jc = Some(j);
     }
     if let Some(j) = &jc {

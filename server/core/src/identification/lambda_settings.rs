@@ -128,6 +128,14 @@ pub struct LambdaCampaignSettings {
     /// damping only (the thesis's model).
     #[serde(default = "default_true")]
     pub quadratic_damping: bool,
+    /// Horizontal models (surge, sway, yaw; a surface vessel) whose logs
+    /// carry the heading `psi`: estimate one current fixed in NED for the
+    /// campaign, acting through the damping of the velocity through the
+    /// water, and keep it when the data hold it beyond their noise (χ² of
+    /// no current above its 99 % point). Predictions then integrate ψ from
+    /// the model's yaw rate. False: constant loads only.
+    #[serde(default = "default_true")]
+    pub ned_current: bool,
 }
 
 fn default_threshold() -> f64 {
@@ -159,6 +167,7 @@ impl Default for LambdaCampaignSettings {
             symmetric_inertia: true,
             coriolis_second_order: true,
             quadratic_damping: true,
+            ned_current: true,
         }
     }
 }

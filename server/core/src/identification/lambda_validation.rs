@@ -3,11 +3,13 @@
 use super::attitude_loop::AttitudeLoop;
 use super::dataset::{RunInput, segments};
 use super::error::IdentifyError;
+use super::heading_loop::HeadingLoop;
 use super::lambda_data::experiment;
 use super::outcome::RunValidation;
 use crate::estimation::restoring::RestoringParams;
 use crate::models::LpvModel;
 use crate::validation::{ValidationRecord, ValidationSettings, validate};
+use nalgebra::DMatrix;
 
 /// How much better (summed free-run fit) the linear model must be on the
 /// held-out runs for C(δ)δ to be left out: round-off and the noise of a
@@ -25,6 +27,10 @@ pub(crate) struct HeldOut<'a> {
     pub n: usize,
     /// g(η), when estimated: validated with the attitude in the loop.
     pub restoring: Option<&'a RestoringParams>,
+    /// A current fixed in NED: F (n × 2) per grid point of the model,
+    /// validated with the heading in the loop (the regression columns end
+    /// with ψ).
+    pub current: Option<(Vec<DMatrix<f64>>, nalgebra::Vector2<f64>)>,
     pub settings: &'a ValidationSettings,
 }
 
@@ -39,6 +45,14 @@ impl HeldOut<'_> {
             input_names: AttitudeLoop::input_names(&self.cols[..n]),
             ..self.settings.clone()
         };
+        let heading_loop = self
+            .current
+            .as_ref()
+            .and_then(|(f, v)| HeadingLoop::new(lpv.clone(), f.clone(), *v));
+        let heading_settings = ValidationSettings {
+            input_names: HeadingLoop::input_names(&self.cols[..n]),
+            ..self.settings.clone()
+        };
         let mut validation = Vec::new();
         for r in self.runs {
             let segs = segments(r, self.cols, self.outputs, 50).map_err(|e| {
@@ -48,9 +62,19 @@ impl HeldOut<'_> {
                 .iter()
                 .max_by_key(|s| s.y.nrows())
                 .expect("segments is non-empty");
-            let report = match &attitude_loop {
+            let report = match (&attitude_loop, &heading_loop) {
+                // The current's force of the simulated heading: [τ | ψ].
+                (None, Some(model)) => validate(
+                    model,
+                    &ValidationRecord {
+                        h: longest.h,
+                        u: &longest.u.columns(0, n + 1).into_owned(),
+                        y: &longest.y,
+                    },
+                    &heading_settings,
+                ),
                 // g(η) of the simulated attitude in the loop: record [τ | η].
-                Some(model) => validate(
+                (Some(model), _) => validate(
                     model,
                     &ValidationRecord {
                         h: longest.h,
@@ -59,7 +83,7 @@ impl HeldOut<'_> {
                     },
                     &loop_settings,
                 ),
-                None => {
+                (None, None) => {
                     let e = experiment(longest, n, g, None)?;
                     let rec = ValidationRecord {
                         h: longest.h,

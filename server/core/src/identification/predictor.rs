@@ -10,6 +10,7 @@ use super::bis::{BisScale, SiDpShip, unwrap_heading};
 use super::dataset::{RunInput, segments};
 use super::document::{ModelDocument, ModelKind, from_rows};
 use super::error::IdentifyError;
+use super::heading_loop::HeadingLoop;
 use super::intersample::logged_equivalent;
 use super::state_space::StateSpacePredictor;
 use crate::estimation::ekf::IdentifiedDpShip;
@@ -37,12 +38,42 @@ fn attitude_in_loop(doc: &ModelDocument) -> Option<RestoringParams> {
         .map(|r| r.params)
 }
 
+/// F (n × 2) per grid point when a stored LPV model carries a current
+/// fixed in NED (and no discovered terms): validated with ψ in the loop.
+fn current_in_loop(doc: &ModelDocument) -> Option<(Vec<DMatrix<f64>>, nalgebra::Vector2<f64>)> {
+    let lpv = doc.lpv.as_ref()?;
+    if doc.kind != ModelKind::Lpv || is_augmented(doc) {
+        return None;
+    }
+    let v = lpv.current.as_ref()?.ned_mps;
+    let n = doc.dofs.len();
+    let forces = lpv
+        .points
+        .iter()
+        .map(|p| match &p.current_force {
+            Some(f) => from_rows(f).filter(|f| f.shape() == (n, 2)),
+            None => Some(DMatrix::zeros(n, 2)),
+        })
+        .collect::<Option<Vec<_>>>()?;
+    Some((forces, nalgebra::Vector2::new(v[0], v[1])))
+}
+
 /// The predictor of a stored model.
 pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyError> {
     match doc.kind {
         ModelKind::Lpv if is_augmented(doc) => Ok(Box::new(AugmentedLpv::from_doc(doc)?)),
         ModelKind::Lpv => {
             let model = baseline_lpv(doc)?;
+            if let Some((forces, v)) = current_in_loop(doc) {
+                return HeadingLoop::new(model, forces, v)
+                    .map(|m| Box::new(m) as Box<dyn Predictor>)
+                    .ok_or_else(|| {
+                        IdentifyError::invalid(
+                            "document.lpv.current",
+                            "a current needs surge and yaw and one F per grid point",
+                        )
+                    });
+            }
             match attitude_in_loop(doc) {
                 Some(g) => Ok(Box::new(
                     AttitudeLoop::new(model, g).expect("attitude_in_loop checked the DOFs"),
@@ -251,8 +282,11 @@ pub fn validation_data(
     let restoring = doc.restoring.as_ref().map(|r| r.params);
     let augmented = is_augmented(doc);
     let mut cols = inputs.to_vec();
+    let current = current_in_loop(doc).is_some();
     if restoring.is_some() || augmented {
         cols.extend(Dof::ALL.iter().map(|d| pose_column(*d).to_string()));
+    } else if current {
+        cols.push(pose_column(Dof::Yaw).to_string());
     }
     let segs = segments(run, &cols, &outputs, 50)
         .map_err(|e| IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string()))?;
@@ -263,6 +297,9 @@ pub fn validation_data(
     let tau = seg.u.columns(0, n).into_owned();
     if augmented || attitude_in_loop(doc).is_some() {
         return Ok((seg.h, seg.u.columns(0, n + 6).into_owned(), seg.y.clone()));
+    }
+    if current {
+        return Ok((seg.h, seg.u.columns(0, n + 1).into_owned(), seg.y.clone()));
     }
     match doc.kind {
         ModelKind::StateSpace => {
@@ -313,9 +350,10 @@ pub fn validate_on_run_with(
 ) -> Result<ValidationReport, IdentifyError> {
     let model = predictor(doc)?;
     let (h, u, y) = validation_data(doc, run, inputs)?;
-    let input_names = match attitude_in_loop(doc) {
-        Some(_) => AttitudeLoop::input_names(inputs),
-        None => doc.inputs.clone(),
+    let input_names = match (attitude_in_loop(doc), current_in_loop(doc)) {
+        (Some(_), _) => AttitudeLoop::input_names(inputs),
+        (None, Some(_)) => HeadingLoop::input_names(&doc.inputs),
+        (None, None) => doc.inputs.clone(),
     };
     let settings = ValidationSettings {
         input_names,

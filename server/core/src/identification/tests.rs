@@ -349,6 +349,7 @@ pub(crate) fn lpv_doc(
                 load_std: None,
                 n_samples: 1,
                 run_ids: vec![],
+                current_force: None,
                 augmentation: None,
             }
         })
@@ -370,6 +371,7 @@ pub(crate) fn lpv_doc(
             coriolis_second_order: false,
             quadratic_damping: None,
             quadratic_damping_std: None,
+            current: None,
         }),
         dp_ship: None,
         state_space: None,

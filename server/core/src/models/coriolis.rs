@@ -150,6 +150,26 @@ pub fn second_order_force(dofs: &[Dof], m: &DMatrix<f64>, nu: &[f64], surge: usi
     coriolis_force(dofs, m, &delta)
 }
 
+/// C(δ)δ about the sub-model's own speed: δ = ν − (u₀, 0, …, 0). Blended
+/// linearly in u between sub-models the (u − u₀)-products cancel, so
+/// within the grid (and an extension) it equals [`second_order_force`];
+/// where a sub-model is held — a single grid point, beyond the grid without
+/// an extension, nearest scheduling — it adds the u-products (the Munk
+/// moment (m_v − m_u)(u − u₀)v, the sway m_u(u − u₀)r) that no scheduling
+/// then follows: with one grid point at u₀ = 0 (a DP vessel) it is the whole
+/// C(ν)ν.
+pub fn second_order_force_about(
+    dofs: &[Dof],
+    m: &DMatrix<f64>,
+    nu: &[f64],
+    surge: usize,
+    u0: f64,
+) -> Vec<f64> {
+    let mut delta = nu.to_vec();
+    delta[surge] -= u0;
+    coriolis_force(dofs, m, &delta)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -175,6 +195,33 @@ mod tests {
         let full = coriolis_force(&Dof::ALL, &m, &[1.7, v, 0.0, 0.0, 0.0, r]);
         assert!((full[1] - 300.0 * 1.7 * r).abs() < 1e-9);
         assert!((full[5] - (450.0 - 300.0) * 1.7 * v).abs() < 1e-9);
+    }
+
+    /// About u₀ = 0 the second-order force is the whole C(ν)ν; about the
+    /// measured u it is C(δ)δ with δ = ν except u.
+    #[test]
+    fn second_order_force_about_a_speed() {
+        let m3 =
+            DMatrix::from_row_slice(3, 3, &[300.0, 0.0, 0.0, 0.0, 450.0, 20.0, 0.0, 20.0, 70.0]);
+        let nu = [1.2, -0.4, 0.15];
+        let full = coriolis_force(&Dof::HORIZONTAL, &m3, &nu);
+        let about0 = second_order_force_about(&Dof::HORIZONTAL, &m3, &nu, 0, 0.0);
+        let at_u = second_order_force_about(&Dof::HORIZONTAL, &m3, &nu, 0, 1.2);
+        let scheduled = second_order_force(&Dof::HORIZONTAL, &m3, &nu, 0);
+        for i in 0..3 {
+            assert!((about0[i] - full[i]).abs() < 1e-12);
+            assert!((at_u[i] - scheduled[i]).abs() < 1e-12);
+        }
+        // Linear blending in u of two sub-models cancels the u-products.
+        let (u0, u1, w) = (1.0, 1.5, 0.6);
+        let u = w * u0 + (1.0 - w) * u1;
+        let nu = [u, -0.4, 0.15];
+        let lo = second_order_force_about(&Dof::HORIZONTAL, &m3, &nu, 0, u0);
+        let hi = second_order_force_about(&Dof::HORIZONTAL, &m3, &nu, 0, u1);
+        let scheduled = second_order_force(&Dof::HORIZONTAL, &m3, &nu, 0);
+        for i in 0..3 {
+            assert!((w * lo[i] + (1.0 - w) * hi[i] - scheduled[i]).abs() < 1e-9);
+        }
     }
 
     /// On a horizontal model (surge, sway, yaw) the embedding gives the

@@ -23,7 +23,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::coriolis::second_order_force;
+use super::coriolis::second_order_force_about;
 use super::error::{ModelError, check_finite};
 pub use super::lpv_schedule::{Blend, Extension, ScheduleWeights, Scheduling};
 use super::lpv_schedule::{blend as schedule_blend, schedule};
@@ -43,7 +43,7 @@ pub struct LpvModel {
     scheduling: Scheduling,
     extension: Option<Extension>,
     /// The vehicle's M per grid point for the second-order Coriolis–
-    /// centripetal force C(δ)δ ([`second_order_force`]); `None`: the thesis's
+    /// centripetal force C(δ)δ ([`second_order_force_about`]); `None`: the thesis's
     /// linear sub-models alone.
     coriolis: Option<Vec<DMatrix<f64>>>,
     /// Diagonal quadratic damping D_q per grid point (one entry per DOF,
@@ -174,7 +174,7 @@ impl LpvModel {
     /// The same model with the second-order Coriolis–centripetal force
     /// C(δ)δ of the vehicle's inertia `m` (one per grid point, the M of the
     /// vehicle rather than the M a log behind a faster controller shows):
-    /// each sub-model is driven by γ − C(δ)δ ([`second_order_force`]).
+    /// each sub-model is driven by γ − C(δ)δ ([`second_order_force_about`]).
     /// Beyond the grid the end point's M serves, as M does.
     ///
     /// # Errors
@@ -479,7 +479,13 @@ impl DiscreteLpv {
     fn driving(&self, x: &DVector<f64>, u: &DVector<f64>, k: usize, u0: f64) -> DVector<f64> {
         let mut out = u.clone();
         if let (Some(m), Some(i)) = (&self.coriolis, self.surge) {
-            out -= DVector::from_vec(second_order_force(&self.dofs, &m[k], x.as_slice(), i));
+            out -= DVector::from_vec(second_order_force_about(
+                &self.dofs,
+                &m[k],
+                x.as_slice(),
+                i,
+                u0,
+            ));
         }
         if let (Some(d), Some(i)) = (&self.quadratic, self.surge) {
             let x_uu = d[k].get(i).copied().unwrap_or(0.0);

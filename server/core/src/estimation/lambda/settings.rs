@@ -120,6 +120,12 @@ pub struct LambdaSettings {
     /// `errors_in_variables`; the constant-parameter path only). `None`:
     /// the regressors are taken as exact.
     pub regressor_noise: Option<RegressorNoise>,
+    /// With the Coriolis linearization at the grid speed (see
+    /// `identification::lambda_coriolis`), also take the second-order
+    /// C(δ)δ (δ = ν − (u₀, 0, …)) of the fitted M to the known side, for a
+    /// model that carries it: off-grid surge speeds in the data (a DP
+    /// vessel drifting in a current) then do not bias D̄. Off by default.
+    pub second_order_coriolis: bool,
 }
 
 impl LambdaSettings {
@@ -142,6 +148,7 @@ impl LambdaSettings {
             symmetric_inertia: false,
             inertia_offset: None,
             regressor_noise: None,
+            second_order_coriolis: false,
         }
     }
 }

@@ -1,0 +1,597 @@
+//! A current fixed in NED for horizontal (surge–sway–yaw) models of surface
+//! vessels, estimated once for the campaign.
+//!
+//! Hull damping acts on the velocity through the water ν_r = ν − ν_c
+//! (Fossen 2021, eq. 6.111), and a current of constant speed and direction
+//! in NED, V = [V_N, V_E]ᵀ, is seen in the body frame as
+//! ν_c(ψ) = [V_N cos ψ + V_E sin ψ, −V_N sin ψ + V_E cos ψ, 0]ᵀ
+//! = Q(V)·e(ψ), Q(V) = [[V_N, V_E], [V_E, −V_N]], e(ψ) = [cos ψ, sin ψ]ᵀ.
+//! In the λ regression M ν̇ + D̄ ν + F e = γ the current is the term
+//! F = −D̄_{:,uv}·Q(V) on the heading shapes e(ψ): D̄'s surge and sway
+//! columns hold the hydrodynamic damping and the Munk moment's linear part,
+//! which act on ν_r (C_RB's terms sit in the yaw column).
+//!
+//! 1. With the constant loads, F is estimated freely per grid point
+//!    ([`append`], [`specification`]); each point's F and D̄ give its V by
+//!    weighted least squares ([`current_of`]).
+//! 2. The points' V are pooled by inverse covariance ([`pool`]) — one
+//!    current for the campaign — and kept only when it differs from zero
+//!    beyond the data's noise.
+//! 3. The sub-models are refitted on γ − F e(ψ) with F = −D̄₁·Q(V) of the
+//!    first pass's D̄ ([`subtract`]); that F is stored per point and
+//!    predictions integrate ψ from the model's own yaw rate
+//!    ([`super::heading_loop`]).
+
+use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
+
+use super::dataset::Segment;
+use super::document::{NedCurrentDoc, ParameterRow};
+use super::roles::Roles;
+use crate::estimation::lambda::{Exogenous, Experiment, LambdaEstimate};
+use crate::logs::schema::pose_column;
+use crate::models::coriolis::second_order_force_about;
+use crate::numbers::sig3;
+use crate::planning::dof::Dof;
+use crate::planning::vessel::VesselProfile;
+
+/// Names of the heading shapes among the exogenous columns.
+pub(crate) const COS_PSI: &str = "cos ψ";
+pub(crate) const SIN_PSI: &str = "sin ψ";
+
+/// χ² of V = 0 (2 degrees of freedom) above which the current is kept:
+/// the 99 % point.
+const KEEP_CHI2: f64 = 9.21;
+
+/// Whether `dofs` is a horizontal model a NED current acts on: surge, sway
+/// and yaw modelled, no heave, roll or pitch.
+pub(crate) fn applies(dofs: &[Dof]) -> bool {
+    [Dof::Surge, Dof::Sway, Dof::Yaw]
+        .iter()
+        .all(|d| dofs.contains(d))
+        && !dofs
+            .iter()
+            .any(|d| matches!(d, Dof::Heave | Dof::Roll | Dof::Pitch))
+}
+
+/// e(ψ) = [cos ψ, sin ψ] held over each step like γ: row k is the mean of
+/// its values at ψ_k and ψ_{k+1} (the last row e(ψ_{N−1})).
+pub(crate) fn functions_of(psi: &[f64]) -> DMatrix<f64> {
+    let n = psi.len();
+    let e = |k: usize| {
+        let (s, c) = psi[k].sin_cos();
+        [c, s]
+    };
+    DMatrix::from_fn(n, 2, |k, j| {
+        if k + 1 < n {
+            0.5 * (e(k)[j] + e(k + 1)[j])
+        } else {
+            e(k)[j]
+        }
+    })
+}
+
+/// The heading ψ (rad) of a segment whose inputs are the n forces then ψ.
+pub(crate) fn heading(seg: &Segment, n: usize) -> Vec<f64> {
+    seg.u.column(n).iter().copied().collect()
+}
+
+/// `exp` with e(ψ) of `seg` appended to its exogenous columns.
+pub(crate) fn append(exp: Experiment, seg: &Segment, n: usize) -> Experiment {
+    let e = functions_of(&heading(seg, n));
+    let rows = exp.exogenous.nrows();
+    let q = exp.exogenous.ncols();
+    let mut x = DMatrix::zeros(rows, q + 2);
+    x.columns_mut(0, q).copy_from(&exp.exogenous);
+    x.columns_mut(q, 2).copy_from(&e.rows(0, rows));
+    Experiment {
+        exogenous: x,
+        ..exp
+    }
+}
+
+/// `base` (or nothing) with the heading shapes on every DOF; their prior
+/// std is ten times each DOF's force limit (weak), like the loads'.
+pub(crate) fn specification(
+    base: Option<Exogenous>,
+    profile: &VesselProfile,
+    dofs: &[Dof],
+) -> Exogenous {
+    let n = dofs.len();
+    let base = base.unwrap_or_else(|| Exogenous {
+        names: Vec::new(),
+        pattern: DMatrix::from_element(n, 0, false),
+        force_std: dofs
+            .iter()
+            .map(|&d| 10.0 * profile.limit(d).max_force.abs().max(1.0))
+            .collect(),
+    });
+    let q = base.names.len();
+    let mut names = base.names.clone();
+    names.extend([COS_PSI.to_string(), SIN_PSI.to_string()]);
+    let pattern = DMatrix::from_fn(n, q + 2, |i, j| j >= q || base.pattern[(i, j)]);
+    Exogenous {
+        names,
+        pattern,
+        force_std: base.force_std,
+    }
+}
+
+/// A current V = [V_N, V_E] (m/s) with its covariance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CurrentEstimate {
+    pub v: Vector2<f64>,
+    pub cov: Matrix2<f64>,
+    /// χ²/dof of the estimates pooled about the mean (1 for one).
+    pub birge_ratio_sq: f64,
+    /// Estimates pooled.
+    pub count: usize,
+}
+
+impl CurrentEstimate {
+    /// Speed |V| (m/s) and its std (first order).
+    pub fn speed(&self) -> (f64, f64) {
+        let s = self.v.norm();
+        if s == 0.0 {
+            return (0.0, self.cov.trace().max(0.0).sqrt());
+        }
+        let d = self.v / s;
+        (s, (d.transpose() * self.cov * d)[0].max(0.0).sqrt())
+    }
+
+    /// Direction the current flows towards (rad, from north towards east)
+    /// and its std (first order).
+    pub fn direction(&self) -> (f64, f64) {
+        let s2 = self.v.norm_squared();
+        let beta = self.v[1].atan2(self.v[0]);
+        if s2 == 0.0 {
+            return (beta, std::f64::consts::PI);
+        }
+        let g = Vector2::new(-self.v[1], self.v[0]) / s2;
+        (beta, (g.transpose() * self.cov * g)[0].max(0.0).sqrt())
+    }
+
+    /// χ² of V = 0 under the covariance.
+    pub fn chi2_of_zero(&self) -> f64 {
+        match self.cov.try_inverse() {
+            Some(inv) => (self.v.transpose() * inv * self.v)[0],
+            None => 0.0,
+        }
+    }
+
+    /// Whether the data hold a current beyond their noise.
+    pub fn significant(&self) -> bool {
+        self.chi2_of_zero() > KEEP_CHI2
+    }
+}
+
+/// Indices of surge and sway in `dofs`.
+fn uv(dofs: &[Dof]) -> Option<(usize, usize)> {
+    let u = dofs.iter().position(|d| *d == Dof::Surge)?;
+    let v = dofs.iter().position(|d| *d == Dof::Sway)?;
+    Some((u, v))
+}
+
+/// The current one sub-model's F on e(ψ) and its D̄ imply: F = −D̄_{:,uv}
+/// Q(V), two unknowns from 2n entries weighted by F's std (D̄'s own error
+/// is second order against F's). `None` without the heading columns or
+/// when D̄'s surge and sway columns cannot carry a current.
+pub(crate) fn current_of(est: &LambdaEstimate) -> Option<CurrentEstimate> {
+    let (iu, iv) = uv(&est.dofs)?;
+    let jc = est.exogenous.iter().position(|e| e == COS_PSI)?;
+    let js = est.exogenous.iter().position(|e| e == SIN_PSI)?;
+    let n = est.dofs.len();
+    let d = &est.d_bar;
+    let mut normal = Matrix2::zeros();
+    let mut rhs = Vector2::zeros();
+    let mut rows = Vec::new();
+    for i in 0..n {
+        // cos ψ column: F_ic = −D_iu V_N − D_iv V_E; sin ψ: F_is = D_iv V_N − D_iu V_E.
+        for (j, g) in [
+            (jc, Vector2::new(-d[(i, iu)], -d[(i, iv)])),
+            (js, Vector2::new(d[(i, iv)], -d[(i, iu)])),
+        ] {
+            let sd = est.std_force[(i, j)];
+            let f = est.force[(i, j)];
+            if !(sd.is_finite() && sd > 0.0 && f.is_finite()) {
+                continue;
+            }
+            let w = 1.0 / (sd * sd);
+            normal += g * g.transpose() * w;
+            rhs += g * (f * w);
+            rows.push((g, f, w));
+        }
+    }
+    let cov = normal.try_inverse()?;
+    let v = cov * rhs;
+    if !v.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let dof = rows.len().saturating_sub(2).max(1);
+    let chi2: f64 = rows
+        .iter()
+        .map(|(g, f, w)| (f - g.dot(&v)).powi(2) * w)
+        .sum();
+    let birge = chi2 / dof as f64;
+    Some(CurrentEstimate {
+        v,
+        cov: cov * birge.max(1.0),
+        birge_ratio_sq: birge,
+        count: 1,
+    })
+}
+
+/// The grid points' currents pooled by inverse covariance, the covariance
+/// inflated by the Birge ratio when they disagree beyond their own.
+pub(crate) fn pool(estimates: &[CurrentEstimate]) -> Option<CurrentEstimate> {
+    let mut info = Matrix2::zeros();
+    let mut rhs = Vector2::zeros();
+    let mut used = Vec::new();
+    for e in estimates {
+        if let Some(w) = e.cov.try_inverse() {
+            info += w;
+            rhs += w * e.v;
+            used.push((e.v, w));
+        }
+    }
+    let cov = info.try_inverse()?;
+    let v = cov * rhs;
+    let dof = 2 * used.len().saturating_sub(1);
+    let chi2: f64 = used
+        .iter()
+        .map(|(x, w)| ((x - v).transpose() * w * (x - v))[0])
+        .sum();
+    let birge = if dof > 0 { chi2 / dof as f64 } else { 1.0 };
+    Some(CurrentEstimate {
+        v,
+        cov: cov * birge.max(1.0),
+        birge_ratio_sq: birge,
+        count: used.len(),
+    })
+}
+
+/// F (n × 2) of a sub-model's D̄ for the current `v`: −D̄_{:,uv}·Q(V).
+pub(crate) fn force(d_bar: &DMatrix<f64>, dofs: &[Dof], v: &Vector2<f64>) -> DMatrix<f64> {
+    let Some((iu, iv)) = uv(dofs) else {
+        return DMatrix::zeros(dofs.len(), 2);
+    };
+    DMatrix::from_fn(dofs.len(), 2, |i, j| {
+        let (du, dv) = (d_bar[(i, iu)], d_bar[(i, iv)]);
+        match j {
+            0 => -du * v[0] - dv * v[1],
+            _ => dv * v[0] - du * v[1],
+        }
+    })
+}
+
+/// What a known current adds to the forces that drive a horizontal
+/// sub-model M ν̇ + D̄ ν + b = γ_eff at grid speed u₀ (see [`Relative::drive`]).
+#[derive(Debug, Clone)]
+pub(crate) struct Relative {
+    pub dofs: Vec<Dof>,
+    /// V = [V_N, V_E] (m/s).
+    pub v: Vector2<f64>,
+    /// The vehicle's M: for M ν̇_c, and for C(·) when `coriolis`.
+    pub m: DMatrix<f64>,
+    /// The model carries the second-order C(δ)δ.
+    pub coriolis: bool,
+}
+
+impl Relative {
+    /// ν_c(ψ) in the model's DOF order.
+    pub fn nu_c(&self, psi: f64) -> DVector<f64> {
+        let (s, c) = psi.sin_cos();
+        let (u_c, v_c) = (
+            self.v[0] * c + self.v[1] * s,
+            -self.v[0] * s + self.v[1] * c,
+        );
+        DVector::from_iterator(
+            self.dofs.len(),
+            self.dofs.iter().map(|d| match d {
+                Dof::Surge => u_c,
+                Dof::Sway => v_c,
+                _ => 0.0,
+            }),
+        )
+    }
+
+    /// γ_eff − τ at ν, ψ for the sub-model at u₀ with current force F:
+    /// −F e(ψ) (the damping of −ν_c), + M ν̇_c (ν̇_c = r·[v_c, −u_c, 0]
+    /// for a current constant in NED), and, when the model carries C(δ)δ
+    /// of ν, + C(δ)δ − C(δ_r)δ_r so that it acts on the relative velocity
+    /// δ_r = ν − ν_c − u₀ instead: for a current constant in NED,
+    /// M_RB ν̇ + C_RB(ν)ν = M_RB ν̇_r + C_RB(ν_r)ν_r (Fossen 2011,
+    /// Property 8.1), and the added mass's C_A acts on ν_r, so the whole
+    /// model reads M ν̇_r + C(ν_r)ν_r + D̄ ν_r + b = τ.
+    pub fn drive(&self, nu: &DVector<f64>, psi: f64, u0: f64, f: &DMatrix<f64>) -> DVector<f64> {
+        let (sn, cs) = psi.sin_cos();
+        let mut out = -(f * Vector2::new(cs, sn));
+        let nu_c = self.nu_c(psi);
+        let (Some(surge), Some(sway), Some(yaw)) = (
+            self.dofs.iter().position(|d| *d == Dof::Surge),
+            self.dofs.iter().position(|d| *d == Dof::Sway),
+            self.dofs.iter().position(|d| *d == Dof::Yaw),
+        ) else {
+            return out;
+        };
+        let mut nu_c_dot = DVector::zeros(self.dofs.len());
+        nu_c_dot[surge] = nu[yaw] * nu_c[sway];
+        nu_c_dot[sway] = -nu[yaw] * nu_c[surge];
+        out += &self.m * nu_c_dot;
+        if self.coriolis {
+            let nu_r = nu - &nu_c;
+            let c = second_order_force_about(&self.dofs, &self.m, nu.as_slice(), surge, u0);
+            let c_r = second_order_force_about(&self.dofs, &self.m, nu_r.as_slice(), surge, u0);
+            for i in 0..out.len() {
+                out[i] += c[i] - c_r[i];
+            }
+        }
+        out
+    }
+
+    /// `exp` of `seg` (at grid speed `u0`) driven by γ + [`Relative::drive`]
+    /// over each step (at the step means of ν and ψ): the current known.
+    pub fn apply(&self, exp: Experiment, seg: &Segment, u0: f64, f: &DMatrix<f64>) -> Experiment {
+        let n = self.dofs.len();
+        let psi = heading(seg, n);
+        let rows = exp.gamma.nrows().min(psi.len());
+        let mut gamma = exp.gamma.clone();
+        for k in 0..rows {
+            let next = if k + 1 < rows { k + 1 } else { k };
+            let nu = (exp.nu.row(k) + exp.nu.row(next)).transpose() * 0.5;
+            let step = psi[next] - psi[k];
+            let step = step - std::f64::consts::TAU * (step / std::f64::consts::TAU).round();
+            let extra = self.drive(&nu, psi[k] + 0.5 * step, u0, f);
+            for i in 0..n {
+                gamma[(k, i)] += extra[i];
+            }
+        }
+        Experiment { gamma, ..exp }
+    }
+}
+
+/// Whether every run the identification reads logs the heading `psi`; a
+/// note names the first that does not (the model then carries no current).
+pub(crate) fn heading_logged(roles: &Roles<'_>, notes: &mut Vec<String>) -> bool {
+    let psi = pose_column(Dof::Yaw);
+    let missing = roles
+        .estimation
+        .iter()
+        .chain(&roles.validation)
+        .find(|r| r.record.column(psi).is_none());
+    match missing {
+        Some(r) => {
+            notes.push(format!(
+                "run '{}' logs no heading `{psi}`: a current fixed in NED is seen through the heading, so the model carries none (constant loads only)",
+                r.name
+            ));
+            false
+        }
+        None => true,
+    }
+}
+
+/// The campaign's current and the force F = −D̄₁·Q(V) it puts on each grid
+/// point's heading shapes.
+#[derive(Debug, Clone)]
+pub(crate) struct CampaignCurrent {
+    pub estimate: CurrentEstimate,
+    /// The first pass's M (pooled over the grid by inverse variance, else
+    /// the first point's): what M ν̇_c and C(ν_r) are built from.
+    pub m: DMatrix<f64>,
+    /// (grid speed, F n × 2).
+    pub forces: Vec<(f64, DMatrix<f64>)>,
+}
+
+impl CampaignCurrent {
+    /// Parameter rows: V_c (m/s) and β_c (°), one for the campaign.
+    pub fn parameters(&self) -> Vec<ParameterRow> {
+        let (s, s_sd) = self.estimate.speed();
+        let (b, b_sd) = self.estimate.direction();
+        let row = |symbol: &str, value: f64, std: f64, unit: &str| ParameterRow {
+            group: "current".into(),
+            symbol: symbol.into(),
+            grid_speed_mps: None,
+            value,
+            std: Some(std),
+            unit: unit.into(),
+        };
+        vec![
+            row("V_c", s, s_sd, "m/s"),
+            row(
+                "β_c",
+                b.to_degrees().rem_euclid(360.0),
+                b_sd.to_degrees(),
+                "°",
+            ),
+        ]
+    }
+
+    /// The document's summary.
+    pub fn doc(&self) -> NedCurrentDoc {
+        let (s, s_sd) = self.estimate.speed();
+        let (b, b_sd) = self.estimate.direction();
+        NedCurrentDoc {
+            speed_mps: s,
+            speed_std_mps: s_sd,
+            direction_deg: b.to_degrees().rem_euclid(360.0),
+            direction_std_deg: b_sd.to_degrees(),
+            ned_mps: [self.estimate.v[0], self.estimate.v[1]],
+            evidence: note(&self.estimate, true),
+        }
+    }
+}
+
+/// The current of the first pass's sub-models (`joint`: each fitted with
+/// the heading shapes free), pooled over the grid; `None` (with a note)
+/// when no point carries one or it is within the noise.
+pub(crate) fn campaign_current(
+    joint: &[(f64, LambdaEstimate)],
+    dofs: &[Dof],
+    notes: &mut Vec<String>,
+) -> Option<CampaignCurrent> {
+    let per_point: Vec<CurrentEstimate> = joint.iter().filter_map(|(_, e)| current_of(e)).collect();
+    let Some(pooled) = pool(&per_point) else {
+        notes.push(
+            "no grid point's damping could carry a current (its surge and sway columns give no solution): the model carries none".into(),
+        );
+        return None;
+    };
+    let kept = pooled.significant();
+    notes.push(note(&pooled, kept));
+    let ms: Vec<DMatrix<f64>> = joint.iter().map(|(_, e)| e.m.clone()).collect();
+    let stds: Vec<DMatrix<f64>> = joint.iter().map(|(_, e)| e.std_m.clone()).collect();
+    let m = super::lambda_coriolis::pooled_inertia(&ms, &stds).or_else(|| ms.first().cloned())?;
+    kept.then(|| CampaignCurrent {
+        estimate: pooled,
+        m,
+        forces: joint
+            .iter()
+            .map(|(u0, e)| (*u0, force(&e.d_bar, dofs, &pooled.v)))
+            .collect(),
+    })
+}
+
+/// The note on the pooled current.
+pub(crate) fn note(c: &CurrentEstimate, kept: bool) -> String {
+    let (s, s_sd) = c.speed();
+    let (b, b_sd) = c.direction();
+    let head = format!(
+        "a current fixed in NED, estimated once for the campaign through the damping of the velocity through the water (ν_r = ν − ν_c(ψ)): {} ± {} m/s towards {}° ± {}° (from north towards east), from {} grid point(s) (χ²/dof between them {:.2}); χ² of no current {:.1} on 2",
+        sig3(s),
+        sig3(s_sd),
+        sig3(b.to_degrees().rem_euclid(360.0)),
+        sig3(b_sd.to_degrees()),
+        c.count,
+        c.birge_ratio_sq,
+        c.chi2_of_zero()
+    );
+    if kept {
+        format!(
+            "{head}: the sub-models were refitted with it known, and predictions integrate the heading from the model's own yaw rate"
+        )
+    } else {
+        format!(
+            "{head}: within the noise (99 % point 9.21), so the model carries no current and the constant loads hold what there is"
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::estimation::lambda::{Inversion, UncertaintyMethod};
+
+    /// An estimate whose F is exactly −D̄_{:,uv} Q(V) with std 1.
+    fn estimate(d: DMatrix<f64>, v: Vector2<f64>) -> LambdaEstimate {
+        let dofs = Dof::HORIZONTAL.to_vec();
+        let f_c = force(&d, &dofs, &v);
+        let mut f = DMatrix::zeros(3, 3);
+        f.columns_mut(1, 2).copy_from(&f_c);
+        let z = DMatrix::zeros(3, 3);
+        LambdaEstimate {
+            dofs,
+            t_lambda: 1.0,
+            h: 0.1,
+            inversion: Inversion::Exact,
+            mask: crate::estimation::lambda::CouplingMask::full(3),
+            a_lambda: z.clone(),
+            b_lambda: z.clone(),
+            a: z.clone(),
+            b: z.clone(),
+            m: DMatrix::identity(3, 3),
+            d_bar: d,
+            param_cov: Vec::new(),
+            std_a: z.clone(),
+            std_b: z.clone(),
+            std_m: z.clone(),
+            std_d_bar: z.clone(),
+            exogenous: vec!["1".into(), COS_PSI.into(), SIN_PSI.into()],
+            k_lambda: z.clone(),
+            force: f,
+            std_force: DMatrix::from_element(3, 3, 1.0),
+            uncertainty: UncertaintyMethod::DeltaMethod,
+            residual_variance: vec![0.0; 3],
+            noise_variance: vec![0.0; 3],
+            n_samples: 100,
+            n_runs: 1,
+            symmetry: None,
+        }
+    }
+
+    fn d_bar() -> DMatrix<f64> {
+        DMatrix::from_row_slice(3, 3, &[80.0, 0.0, 0.0, 0.0, 160.0, 24.0, 0.0, 12.0, 44.0])
+    }
+
+    #[test]
+    fn the_current_seen_in_the_body_frame_is_damped_as_relative_velocity() {
+        // −D̄ ν_c(ψ) at ψ = 30° for a current of 0.5 m/s towards east.
+        let v = Vector2::new(0.0, 0.5);
+        let psi = 30f64.to_radians();
+        let nu_c = [
+            v[0] * psi.cos() + v[1] * psi.sin(),
+            -v[0] * psi.sin() + v[1] * psi.cos(),
+            0.0,
+        ];
+        let d = d_bar();
+        let f = force(&d, &Dof::HORIZONTAL, &v);
+        let e = functions_of(&[psi, psi]);
+        for i in 0..3 {
+            let want = -(0..3).map(|j| d[(i, j)] * nu_c[j]).sum::<f64>();
+            let got = f[(i, 0)] * e[(0, 0)] + f[(i, 1)] * e[(0, 1)];
+            assert!((got - want).abs() < 1e-12, "{i}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn a_points_force_gives_back_its_current() {
+        let v = Vector2::new(0.3, -0.2);
+        let c = current_of(&estimate(d_bar(), v)).unwrap();
+        assert!((c.v - v).norm() < 1e-12);
+        assert!(c.significant());
+        let (s, _) = c.speed();
+        assert!((s - v.norm()).abs() < 1e-12);
+        let (b, b_sd) = c.direction();
+        assert!((b - (-0.2f64).atan2(0.3)).abs() < 1e-12);
+        assert!(b_sd > 0.0 && b_sd < 0.1);
+        // No current: not significant.
+        let none = current_of(&estimate(d_bar(), Vector2::zeros())).unwrap();
+        assert!(!none.significant());
+    }
+
+    #[test]
+    fn pooling_weights_by_covariance_and_inflates_on_disagreement() {
+        let a = CurrentEstimate {
+            v: Vector2::new(1.0, 0.0),
+            cov: Matrix2::identity(),
+            birge_ratio_sq: 1.0,
+            count: 1,
+        };
+        let b = CurrentEstimate {
+            v: Vector2::new(0.0, 0.0),
+            cov: Matrix2::identity() * 4.0,
+            ..a
+        };
+        let p = pool(&[a, b]).unwrap();
+        assert!((p.v[0] - 0.8).abs() < 1e-12 && p.v[1].abs() < 1e-12);
+        assert_eq!(p.count, 2);
+        // χ² = 0.2² + 0.8²/4 = 0.2 on 2: no inflation.
+        assert!((p.cov[(0, 0)] - 0.8).abs() < 1e-12);
+        let far = CurrentEstimate {
+            v: Vector2::new(10.0, 0.0),
+            ..a
+        };
+        let q = pool(&[a, far]).unwrap();
+        assert!(q.birge_ratio_sq > 10.0 && q.cov[(0, 0)] > 0.5);
+    }
+
+    #[test]
+    fn heading_shapes_are_step_averages() {
+        let e = functions_of(&[0.0, 0.2, 0.4]);
+        assert!((e[(0, 0)] - 0.5 * (1.0 + 0.2f64.cos())).abs() < 1e-15);
+        assert!((e[(1, 1)] - 0.5 * (0.2f64.sin() + 0.4f64.sin())).abs() < 1e-15);
+        assert!((e[(2, 0)] - 0.4f64.cos()).abs() < 1e-15);
+        assert!(applies(&Dof::HORIZONTAL));
+        assert!(!applies(&Dof::ALL));
+        assert!(!applies(&[Dof::Surge, Dof::Yaw]));
+    }
+}
