@@ -25,7 +25,7 @@ use super::lambda_information::default_t_lambda;
 use super::lambda_physical::{enforce, unresolved_mode};
 use super::lambda_quadratic;
 use super::lambda_structure::choose_structure;
-use super::lambda_validation::{HeldOut, choose_second_order};
+use super::lambda_validation::{HeldOut, choose_second_order, keep_current};
 use super::ned_current;
 use super::outcome::Identified;
 use super::roles::assign_roles;
@@ -356,7 +356,7 @@ pub fn identify_lambda_campaign(
         )),
         _ => None,
     };
-    let current = if with_current {
+    let mut current = if with_current {
         ned_current::campaign_current(&joint, &dofs, &mut notes)
     } else {
         None
@@ -632,7 +632,7 @@ pub fn identify_lambda_campaign(
         input_names: input_names.clone(),
         ..ValidationSettings::default()
     };
-    let held_out = HeldOut {
+    let mut held_out = HeldOut {
         runs: &roles.validation,
         cols: &cols,
         outputs: &outputs,
@@ -647,8 +647,22 @@ pub fn identify_lambda_campaign(
         }),
         settings: &vsettings,
     };
+    let mut validation = held_out.validate(&lpv)?;
+    if held_out.current.is_some() && !validation.is_empty() {
+        let with = held_out.current.take();
+        let without = held_out.validate(&lpv)?;
+        if keep_current(&validation, &without, &mut notes) {
+            held_out.current = with;
+        } else {
+            validation = without;
+            current = None;
+            for p in &mut lpv_points {
+                p.current_force = None;
+            }
+            parameters.retain(|p| p.group != "current");
+        }
+    }
     let validate_with = |lpv: &LpvModel| held_out.validate(lpv);
-    let validation = validate_with(&lpv)?;
     let (lpv, validation, second_order) =
         choose_second_order(lpv, validation, second_order, &validate_with, &mut notes)?;
     if let Some(j) = dofs.iter().position(|d| *d == Dof::Surge) {

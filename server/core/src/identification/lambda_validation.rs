@@ -135,6 +135,30 @@ pub(crate) fn choose_second_order(
     Ok((lpv, validation, true))
 }
 
+/// A current the data hold beyond their noise is kept only if it makes the
+/// held-out free runs better (`with` against `without` it, summed over runs
+/// and channels) by more than round-off: a heading-correlated remainder of
+/// physics the model lacks can pass the χ² test and still predict nothing.
+/// The note says which and by how much.
+pub(crate) fn keep_current(
+    with: &[RunValidation],
+    without: &[RunValidation],
+    notes: &mut Vec<String>,
+) -> bool {
+    let (with_fit, without_fit) = (free_run_total(with), free_run_total(without));
+    let keep = with_fit > without_fit + SECOND_ORDER_MARGIN;
+    notes.push(if keep {
+        format!(
+            "the current improves the held-out free runs (fit summed over runs and channels {with_fit:.3} with it, {without_fit:.3} without)"
+        )
+    } else {
+        format!(
+            "the current was left out: it did not improve the held-out free runs (fit summed over runs and channels {with_fit:.3} with it, {without_fit:.3} without), so the model names none"
+        )
+    });
+    keep
+}
+
 /// Free-run NRMSE fit summed over runs and channels; a channel without a
 /// fit (diverged, constant output) counts −1, and none counts below −1.
 fn free_run_total(validation: &[RunValidation]) -> f64 {
