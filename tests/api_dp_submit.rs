@@ -14,7 +14,9 @@ use common::flights::planned_campaign;
 use common::{TestApp, dp_profile};
 use seatrial::jobs::{JobRegistry, JobsConfig};
 use seatrial_core::planning::examples::supply_vessel_trial_campaign;
-use seatrial_truth::dp_layouts::{AZ_K, AZ_T, DISPLACEMENT_KG, DpLayout, fly_dp_layout_campaign};
+use seatrial_truth::dp_layouts::{
+    AZ_K, AZ_RATED_RPM, AZ_T, DISPLACEMENT_KG, DpLayout, fly_dp_layout_campaign,
+};
 use seatrial_truth::dp_ship::{self, DpTrial, fly_dp_campaign};
 use serde_json::{Value, json};
 
@@ -81,6 +83,24 @@ async fn identified(app: &TestApp, cid: &str) -> Value {
     let m = app.call("GET", "/api/models/{id}", &[mid], None).await;
     assert_eq!(m.status, 200, "{}", m.text);
     m.json["document"].clone()
+}
+
+/// The four-thruster truth's K″ (the azimuths' shared) and A″_h11, each
+/// within 5 %, in a model document.
+fn assert_four_thrusters(doc: &Value) {
+    let k = doc["dp_ship"]["k"].as_array().unwrap();
+    assert_eq!(k.len(), 4, "{k:?}");
+    assert_eq!(k[2], k[3]);
+    for (j, want) in AZ_K.iter().enumerate() {
+        let got = k[j].as_f64().unwrap();
+        assert!(
+            (got / want - 1.0).abs() < 0.05,
+            "K″ of thr_{}: {got}",
+            j + 1
+        );
+    }
+    let a11 = doc["dp_ship"]["theta"][0].as_f64().unwrap();
+    assert!((a11 / dp_ship::A_H[0][0] - 1.0).abs() < 0.05, "θ″1 = {a11}");
 }
 
 fn id<'a>(ids: &'a [(String, String)], name: &str) -> &'a str {
@@ -248,24 +268,85 @@ async fn a_profile_without_inertia_and_another_thruster_layout_are_identified() 
         upload(&app, &cid4, &log.name, &log.csv, json!({})).await;
     }
     let doc = &identified(&app, &cid4).await;
-    let k = doc["dp_ship"]["k"].as_array().unwrap();
-    assert_eq!(k.len(), 4, "{k:?}");
-    assert_eq!(k[2], k[3]);
-    for (j, want) in AZ_K.iter().enumerate() {
-        let got = k[j].as_f64().unwrap();
-        assert!(
-            (got / want - 1.0).abs() < 0.05,
-            "K″ of thr_{}: {got}",
-            j + 1
-        );
-    }
-    let a11 = doc["dp_ship"]["theta"][0].as_f64().unwrap();
-    assert!((a11 / dp_ship::A_H[0][0] - 1.0).abs() < 0.05, "θ″1 = {a11}");
+    assert_four_thrusters(doc);
     assert_eq!(doc["parameters"].as_array().unwrap().len(), 8);
     let notes = doc["notes"].to_string();
     assert!(
         notes.contains("grouped as the profile says: bow, stern, azimuths"),
         "{notes}"
+    );
+}
+
+/// The four-thruster vessel whose logger records shaft speeds (rpm): with
+/// each thruster's `signal` declared, every run says how `thr_j` was read
+/// and the campaign is identified as from commands; undeclared, the runs
+/// are accepted with the thruster columns named for their units; a bad
+/// signal is a 422 naming its field.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn thrusters_logging_shaft_speed_are_read_as_commands() {
+    let app = TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await;
+    let thr = |name: &str, kind: &str, group: &str, rated: f64| json!({ "name": name, "kind": kind, "max_command": 1.0, "max_rate": 0.1, "coefficient_group": group, "signal": { "kind": "shaft_speed", "rated_rpm": rated } });
+    let mut profile = dp_profile();
+    profile["name"] = json!("tunnels and azimuths, shaft speeds logged");
+    profile["inputs"] = json!({
+        "kind": "thrusters",
+        "thrusters": [thr("bow tunnel", "tunnel", "bow", AZ_RATED_RPM[0]),
+                      thr("stern tunnel", "tunnel", "stern", AZ_RATED_RPM[1]),
+                      thr("port azimuth", "azimuth", "azimuths", AZ_RATED_RPM[2]),
+                      thr("starboard azimuth", "azimuth", "azimuths", AZ_RATED_RPM[3])],
+        "configuration": AZ_T.iter().map(|r| r.to_vec()).collect::<Vec<_>>()
+    });
+    let mut bad = profile.clone();
+    bad["inputs"]["thrusters"][2]["signal"]["rated_rpm"] = json!(-180.0);
+    let r = app.call("POST", "/api/vessels", &[], Some(bad)).await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    assert!(
+        r.text.contains("inputs.thrusters[2].signal.rated_rpm"),
+        "{}",
+        r.text
+    );
+
+    let mut spec = serde_json::to_value(supply_vessel_trial_campaign(3)).unwrap();
+    spec["families"] = json!(["validation"]);
+    let (cid, _) = planned_campaign(&app, profile.clone(), spec.clone()).await;
+    let logs = fly_dp_layout_campaign(&DpTrial::default(), DpLayout::AzimuthsTunnelsShaftSpeed, 11);
+    for log in &logs {
+        let run = upload(&app, &cid, &log.name, &log.csv, json!({})).await;
+        let warnings = run["summary"]["warnings"].to_string();
+        assert!(
+            warnings.contains(
+                "thr_3 (port azimuth) logged as shaft speed n (rpm), u = |n|·n/(180 rpm)²"
+            ),
+            "{warnings}"
+        );
+        assert!(
+            run["summary"].get("check_units").is_none(),
+            "{}",
+            run["summary"]
+        );
+    }
+    let doc = &identified(&app, &cid).await;
+    assert_four_thrusters(doc);
+
+    // The same logs with commands declared: accepted, units doubted.
+    let mut plain = profile;
+    plain["name"] = json!("shaft speeds logged, not declared");
+    for j in 0..4 {
+        plain["inputs"]["thrusters"][j]
+            .as_object_mut()
+            .unwrap()
+            .remove("signal");
+    }
+    let (cid, _) = planned_campaign(&app, plain, spec).await;
+    let run = upload(&app, &cid, &logs[0].name, &logs[0].csv, json!({})).await;
+    let doubted = &run["summary"]["check_units"];
+    assert_eq!(doubted, &json!(["thr_3", "thr_4"]), "{}", run["summary"]);
+    assert!(
+        run["summary"]["warnings"]
+            .to_string()
+            .contains("declare the thruster's signal"),
+        "{}",
+        run["summary"]
     );
 }
 

@@ -85,7 +85,8 @@ impl RunMeta {
 /// A warning about a run, with the file (or step) it concerns.
 #[derive(Debug, Clone, Serialize, utoipa::ToSchema)]
 pub struct RunWarning {
-    /// `file`, `control`, `nav`, `alignment`, `quality` or `description`.
+    /// `file`, `control`, `nav`, `alignment`, `quality`, `description` or
+    /// `thrusters` (what thruster logs were read as).
     pub file: String,
     /// The column it concerns.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -385,6 +386,26 @@ pub fn load_record(
         summary.alignment = Some(report);
         rec
     };
+    let thrusters = seatrial_core::logs::read_thruster_commands(vessel, &mut rec);
+    summary
+        .warnings
+        .extend(thrusters.note.map(|message| RunWarning {
+            file: "thrusters".into(),
+            column: None,
+            message,
+            units: false,
+        }));
+    summary.warnings.extend(
+        thrusters
+            .warnings
+            .into_iter()
+            .map(|(column, message)| RunWarning {
+                file: "thrusters".into(),
+                column: Some(column),
+                message,
+                units: true,
+            }),
+    );
     add_thruster_forces(vessel, &mut rec);
     velocities_from_pose(vessel, &mut rec, summary);
     summary.channels = rec.names.clone();

@@ -13,6 +13,10 @@
 //!   aft tunnels against the bow tunnel; there is no SI3; validation drives
 //!   all four independently. Header
 //!   `t,thr_1,thr_2,thr_3,thr_4,x,y,psi[,u,v,r]`.
+//! - [`DpLayout::AzimuthsTunnelsShaftSpeed`]: the same four thrusters as
+//!   fixed-pitch propellers whose logger records shaft speed (rpm,
+//!   [`AZ_RATED_RPM`]) instead of the command: n = sign(u)·√|u|·n_rated,
+//!   two decimals. Same header.
 //! - [`DpLayout::Forces`]: the paper's thrusters and commands, but the log
 //!   carries the commanded generalized forces τ = T″K″u in SI (the bias b
 //!   is the disturbance and is not included): τ_X, τ_Y = τ″·m·g (N),
@@ -50,6 +54,10 @@ pub const AZ_T: [[f64; 4]; 3] = [
 /// coefficient shared by the two azimuths.
 pub const AZ_K: [f64; 4] = [2.4e-3, 2.0e-3, 6.0e-3, 6.0e-3];
 
+/// Rated shaft speeds (rpm) of [`DpLayout::AzimuthsTunnelsShaftSpeed`]:
+/// bow and stern tunnels, the two azimuths.
+pub const AZ_RATED_RPM: [f64; 4] = [320.0, 290.0, 180.0, 180.0];
+
 /// Which thrusters a campaign flies and what its logs carry.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DpLayout {
@@ -59,6 +67,9 @@ pub enum DpLayout {
     /// Two tunnels and two aft azimuths ([`AZ_T`], [`AZ_K`]), commands
     /// logged; SI1, SI2 and validation only.
     AzimuthsTunnels,
+    /// [`DpLayout::AzimuthsTunnels`] logging shaft speeds
+    /// ([`AZ_RATED_RPM`]).
+    AzimuthsTunnelsShaftSpeed,
     /// The paper's thrusters and commands, generalized forces logged.
     Forces,
 }
@@ -132,6 +143,10 @@ pub fn fly_dp_layout_campaign(trial: &DpTrial, layout: DpLayout, seed: u64) -> V
     let layout = match layout {
         DpLayout::Paper => PAPER,
         DpLayout::AzimuthsTunnels => AZIMUTHS_TUNNELS,
+        DpLayout::AzimuthsTunnelsShaftSpeed => Layout {
+            logged: Logged::ShaftSpeed(&AZ_RATED_RPM),
+            ..AZIMUTHS_TUNNELS
+        },
         DpLayout::Forces => Layout {
             logged: Logged::Forces(DISPLACEMENT_KG),
             ..PAPER
@@ -345,6 +360,39 @@ mod tests {
         }
     }
 
+    /// The shaft-speed log flies the command run (same pose) and records
+    /// n = sign(u)·√|u|·n_rated: |n|·n/n_rated² gives the logged command
+    /// back within the rounding of both logs.
+    #[test]
+    fn shaft_speeds_are_the_commands_through_the_propeller_law() {
+        for trial in [prbs_trial(), DpTrial::default()] {
+            let commands = fly_dp_layout_campaign(&trial, DpLayout::AzimuthsTunnels, 5);
+            let speeds = fly_dp_layout_campaign(&trial, DpLayout::AzimuthsTunnelsShaftSpeed, 5);
+            assert_eq!(commands.len(), speeds.len());
+            let mut turning = 0;
+            for (c, s) in commands.iter().zip(&speeds) {
+                assert_eq!(c.name, s.name);
+                for (lc, ls) in c.csv.lines().zip(s.csv.lines()).skip(1) {
+                    assert_eq!(pose(lc, 5), pose(ls, 5), "{}", c.name);
+                    for (j, rated) in AZ_RATED_RPM.into_iter().enumerate() {
+                        let u: f64 = pose(lc, 1 + j)[0].parse().unwrap();
+                        let n: f64 = pose(ls, 1 + j)[0].parse().unwrap();
+                        // n to 0.005 rpm: |n|n/n² within 2·0.005/n_rated·√|u|.
+                        let slack = 0.01 / rated * u.abs().sqrt() + 5e-7 + 1e-4 / (rated * rated);
+                        assert!(
+                            (n.abs() * n / (rated * rated) - u).abs() <= slack,
+                            "{} thr_{}: n {n} rpm, u {u}",
+                            c.name,
+                            j + 1
+                        );
+                        turning += usize::from(n.abs() > 0.5 * rated);
+                    }
+                }
+            }
+            assert!(turning > 100, "the propellers hardly turn: {turning}");
+        }
+    }
+
     #[test]
     fn every_log_has_its_header_and_finite_values() {
         let thr4 = "t,thr_1,thr_2,thr_3,thr_4,x,y,psi";
@@ -359,6 +407,7 @@ mod tests {
             for (layout, head, runs) in [
                 (DpLayout::Paper, thr6, 7),
                 (DpLayout::AzimuthsTunnels, thr4, 5),
+                (DpLayout::AzimuthsTunnelsShaftSpeed, thr4, 5),
                 (DpLayout::Forces, forces, 7),
             ] {
                 let want = format!("{head}{}", if velocities { ",u,v,r" } else { "" });

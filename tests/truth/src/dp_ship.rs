@@ -310,6 +310,11 @@ pub(crate) enum Logged {
     /// The commanded generalized forces τ″ = T″K″u (bias excluded) in SI,
     /// `tau_X,tau_Y,tau_N` (N, N, N·m), for a displacement mass (kg).
     Forces(f64),
+    /// The propellers' shaft speeds n_j (rpm, signed) in `thr_1 … thr_r`,
+    /// for the rated speeds (rpm) given: fixed-pitch propellers whose
+    /// thrust goes with |n|·n, so the command is u = |n|·n/n_rated² and the
+    /// logger records n = sign(u)·√|u|·n_rated (two decimals).
+    ShaftSpeed(&'static [f64]),
 }
 
 /// A thruster layout on the paper's hull: T″ by rows (3 × r), K″ (r), the
@@ -484,7 +489,9 @@ pub(crate) fn simulate(
     let mut s = [0.0, 0.0, 0.0, 0.0, 0.0, heading0];
     let mut csv = String::from("t");
     match layout.logged {
-        Logged::Commands => (1..=k.len()).for_each(|j| csv.push_str(&format!(",thr_{j}"))),
+        Logged::Commands | Logged::ShaftSpeed(_) => {
+            (1..=k.len()).for_each(|j| csv.push_str(&format!(",thr_{j}")))
+        }
         Logged::Forces(_) => csv.push_str(",tau_X,tau_Y,tau_N"),
     }
     csv.push_str(",x,y,psi");
@@ -504,6 +511,12 @@ pub(crate) fn simulate(
             Logged::Commands => {
                 for c in uk {
                     csv.push_str(&format!(",{c:.6}"));
+                }
+            }
+            Logged::ShaftSpeed(rated) => {
+                for (c, n) in uk.iter().zip(rated) {
+                    // + 0.0 writes −0 as 0.
+                    csv.push_str(&format!(",{:.2}", c.signum() * c.abs().sqrt() * n + 0.0));
                 }
             }
             Logged::Forces(mass) => {

@@ -257,6 +257,7 @@ mod tests {
                 max_command: 1.0,
                 max_rate: 0.1,
                 coefficient_group: groups.map(|g| g[j].to_string()),
+                signal: Default::default(),
             })
             .collect();
         p.inputs = InputChannels::Thrusters {

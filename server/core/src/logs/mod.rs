@@ -10,7 +10,7 @@
 //! |---|---|
 //! | `t` | time (s), strictly increasing |
 //! | `tau_X tau_Y tau_Z tau_K tau_M tau_N` | generalized forces (N, N·m) |
-//! | `thr_1 … thr_n` | thruster commands, instead of τ for thruster-actuated vessels |
+//! | `thr_1 … thr_n` | thruster commands, instead of τ for thruster-actuated vessels (or shaft speed, pitch or thrust, as the profile's `signal` says: [`thruster_signals`]) |
 //! | `u v w p q r` | body velocities (m/s, rad/s) |
 //! | `x y z phi theta psi` | pose (m, rad) |
 //!
@@ -41,6 +41,7 @@ pub mod gaps;
 pub mod measurements;
 pub mod parse;
 pub mod schema;
+pub mod thruster_signals;
 pub mod uniform;
 
 pub use checks::LogWarning;
@@ -51,4 +52,5 @@ pub use schema::{
     LogRole, input_columns, measurement_groups, output_columns, pose_columns, required_columns,
     strict_columns,
 };
+pub use thruster_signals::{ThrusterReading, read_thruster_commands};
 pub use uniform::{MAX_RATE_HZ, MIN_RATE_HZ, check_rate_hz, to_uniform, zoh};

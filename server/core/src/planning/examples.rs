@@ -121,6 +121,7 @@ fn example_thruster(name: &str, kind: ThrusterKind) -> Thruster {
         max_command: 1.0,
         max_rate: 0.1,
         coefficient_group: None,
+        signal: Default::default(),
     }
 }
 

@@ -63,6 +63,115 @@ pub enum ThrusterKind {
     Azimuth,
 }
 
+/// What a log's thruster column `thr_j` records, and how it is read as the
+/// command u_j of τ = T K u. Thrust goes with |p − p₀|(p − p₀) for a
+/// controllable-pitch propeller (Fossen et al. 1995, eq. 5) and with |n|·n
+/// for a fixed-pitch one at shaft speed n (Fossen 2011, sec. 12.2); a
+/// measured thrust is u itself up to scale. Sea-trial loggers record shaft
+/// speed or pitch, not forces.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ThrusterSignal {
+    /// The normalized command u_j itself.
+    #[default]
+    Command,
+    /// Propeller shaft speed n (rpm, signed: negative astern):
+    /// u = |n|·n / n_rated².
+    ShaftSpeed {
+        /// Rated shaft speed n_rated (rpm, > 0): u = ±1 there.
+        rated_rpm: f64,
+    },
+    /// Propeller pitch p in the logger's unit (%, P/D, degrees):
+    /// u = |p − p₀|(p − p₀) / (p_full − p₀)².
+    Pitch {
+        /// Pitch of zero thrust p₀.
+        zero_thrust: f64,
+        /// Pitch of full ahead thrust p_full (≠ p₀): u = 1 there.
+        full_ahead: f64,
+    },
+    /// Measured thrust f (N): u = f / f_rated.
+    Thrust {
+        /// Rated thrust f_rated (N, > 0): u = ±1 there.
+        rated_n: f64,
+    },
+}
+
+impl ThrusterSignal {
+    /// The command u of a logged value `x`.
+    pub fn command(&self, x: f64) -> f64 {
+        match *self {
+            ThrusterSignal::Command => x,
+            ThrusterSignal::ShaftSpeed { rated_rpm } => x.abs() * x / (rated_rpm * rated_rpm),
+            ThrusterSignal::Pitch {
+                zero_thrust,
+                full_ahead,
+            } => {
+                let d = x - zero_thrust;
+                let full = full_ahead - zero_thrust;
+                d.abs() * d / (full * full)
+            }
+            ThrusterSignal::Thrust { rated_n } => x / rated_n,
+        }
+    }
+
+    /// What is logged and how it is read, for notes: e.g. "shaft speed n
+    /// (rpm), u = |n|·n/(180 rpm)²"; `None` for commands.
+    pub fn describe(&self) -> Option<String> {
+        use crate::numbers::sig3;
+        match *self {
+            ThrusterSignal::Command => None,
+            ThrusterSignal::ShaftSpeed { rated_rpm } => Some(format!(
+                "shaft speed n (rpm), u = |n|·n/({} rpm)²",
+                sig3(rated_rpm)
+            )),
+            ThrusterSignal::Pitch {
+                zero_thrust,
+                full_ahead,
+            } => Some(format!(
+                "pitch p, u = |p − p₀|(p − p₀)/(p_full − p₀)² with p₀ = {}, p_full = {}",
+                sig3(zero_thrust),
+                sig3(full_ahead)
+            )),
+            ThrusterSignal::Thrust { rated_n } => {
+                Some(format!("thrust f (N), u = f/({} N)", sig3(rated_n)))
+            }
+        }
+    }
+
+    fn validate(&self, field: &str) -> Result<(), PlanError> {
+        match *self {
+            ThrusterSignal::Command => Ok(()),
+            ThrusterSignal::ShaftSpeed { rated_rpm } => {
+                positive(&format!("{field}.rated_rpm"), rated_rpm).map(drop)
+            }
+            ThrusterSignal::Thrust { rated_n } => {
+                positive(&format!("{field}.rated_n"), rated_n).map(drop)
+            }
+            ThrusterSignal::Pitch {
+                zero_thrust,
+                full_ahead,
+            } => {
+                for (name, v) in [("zero_thrust", zero_thrust), ("full_ahead", full_ahead)] {
+                    if !v.is_finite() {
+                        return Err(PlanError::invalid(
+                            format!("{field}.{name}"),
+                            "must be a finite number",
+                        ));
+                    }
+                }
+                if full_ahead == zero_thrust {
+                    return Err(PlanError::invalid(
+                        format!("{field}.full_ahead"),
+                        "full-ahead pitch must differ from the zero-thrust pitch",
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
 /// One thruster input channel u_i (eq. 5: u_i = |p_i − p_i0|(p_i − p_i0),
 /// normalized so that |u_i| ≤ max_command).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -84,6 +193,14 @@ pub struct Thruster {
     /// each, more thrusters one per kind.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coefficient_group: Option<String>,
+    /// What the log's column `thr_j` records (default: the command u_j);
+    /// read as u_j when a run is loaded, and said so in its summary.
+    #[serde(default, skip_serializing_if = "is_command")]
+    pub signal: ThrusterSignal,
+}
+
+fn is_command(s: &ThrusterSignal) -> bool {
+    *s == ThrusterSignal::Command
 }
 
 /// How the vessel is actuated.
@@ -366,6 +483,8 @@ impl VesselProfile {
                 if let Some(g) = &t.coefficient_group {
                     super::check_name(&format!("inputs.thrusters[{i}].coefficient_group"), g)?;
                 }
+                t.signal
+                    .validate(&format!("inputs.thrusters[{i}].signal"))?;
             }
             if configuration.len() != self.dofs.len() {
                 return Err(PlanError::invalid(

@@ -40,7 +40,10 @@ pub fn parsed(profile: &VesselProfile, logs: Vec<dp_ship::DpLog>) -> Vec<RunInpu
                 &ParseOptions::for_vessel(profile, LogRole::Single, None),
             )
             .expect("a position-only DP log is accepted");
-            let (record, _) = to_uniform(&parsed.table, None).unwrap();
+            let (mut record, _) = to_uniform(&parsed.table, None).unwrap();
+            // As the service loads a run: logged shaft speeds → commands.
+            let reading = seatrial_core::logs::read_thruster_commands(profile, &mut record);
+            assert!(reading.warnings.is_empty(), "{:?}", reading.warnings);
             RunInput {
                 run_id: log.name.clone(),
                 name: log.name,
