@@ -88,14 +88,20 @@ async fn identified(app: &TestApp, cid: &str) -> Value {
 /// The four-thruster truth's K″ (the azimuths' shared) and A″_h11, each
 /// within 5 %, in a model document.
 fn assert_four_thrusters(doc: &Value) {
+    assert_k(doc, &AZ_K);
+}
+
+/// K″ per input column of a model document (the azimuths' columns equal)
+/// and A″_h11, each within 5 % of the four-thruster truth.
+fn assert_k(doc: &Value, want: &[f64]) {
     let k = doc["dp_ship"]["k"].as_array().unwrap();
-    assert_eq!(k.len(), 4, "{k:?}");
-    assert_eq!(k[2], k[3]);
-    for (j, want) in AZ_K.iter().enumerate() {
+    assert_eq!(k.len(), want.len(), "{k:?}");
+    assert!(k[2..].iter().all(|v| *v == k[2]), "{k:?}");
+    for (j, want) in want.iter().enumerate() {
         let got = k[j].as_f64().unwrap();
         assert!(
             (got / want - 1.0).abs() < 0.05,
-            "K″ of thr_{}: {got}",
+            "K″ of input column {}: {got}",
             j + 1
         );
     }
@@ -348,6 +354,54 @@ async fn thrusters_logging_shaft_speed_are_read_as_commands() {
         "{}",
         run["summary"]
     );
+}
+
+/// The four-thruster vessel whose aft azimuths turn during every run and
+/// log their angle in degrees: declared with their positions, each run
+/// says how it was read and the campaign is identified end to end; a
+/// logged angle on a tunnel thruster is a 422 naming it.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn turning_azimuths_are_read_through_their_logged_angle() {
+    let app = TestApp::with_jobs(JobRegistry::production(), JobsConfig::default()).await;
+    let l = dp_ship::LENGTH_M;
+    let thr = |name: &str, kind: &str, group: &str| json!({ "name": name, "kind": kind, "max_command": 1.0, "max_rate": 0.1, "coefficient_group": group });
+    let azimuth = |name: &str, y: f64| {
+        let mut t = thr(name, "azimuth", "azimuths");
+        t["logged_angle"] = json!({ "unit": "deg", "x_m": -0.45 * l, "y_m": y * l });
+        t
+    };
+    let mut profile = dp_profile();
+    profile["name"] = json!("tunnels and turning azimuths");
+    profile["inputs"] = json!({
+        "kind": "thrusters",
+        "thrusters": [thr("bow tunnel", "tunnel", "bow"), thr("stern tunnel", "tunnel", "stern"),
+                      azimuth("port azimuth", -0.06), azimuth("starboard azimuth", 0.06)],
+        "configuration": AZ_T.iter().map(|r| r.to_vec()).collect::<Vec<_>>()
+    });
+    let mut bad = profile.clone();
+    bad["inputs"]["thrusters"][0]["logged_angle"] = json!({ "x_m": 30.0, "y_m": 0.0 });
+    let r = app.call("POST", "/api/vessels", &[], Some(bad)).await;
+    assert_eq!(r.status, 422, "{}", r.text);
+    assert!(
+        r.text.contains("inputs.thrusters[0].logged_angle"),
+        "{}",
+        r.text
+    );
+
+    let mut spec = serde_json::to_value(supply_vessel_trial_campaign(3)).unwrap();
+    spec["families"] = json!(["validation"]);
+    let (cid, _) = planned_campaign(&app, profile, spec).await;
+    for log in fly_dp_layout_campaign(&DpTrial::default(), DpLayout::SteeredAzimuths, 11) {
+        let run = upload(&app, &cid, &log.name, &log.csv, json!({})).await;
+        let warnings = run["summary"]["warnings"].to_string();
+        assert!(
+            warnings.contains("thr_3 (port azimuth) turned as logged in azi_3 (°)"),
+            "{warnings}"
+        );
+    }
+    // Input columns thr_1, thr_2, thr_3_x, thr_3_y, thr_4_x, thr_4_y.
+    let doc = &identified(&app, &cid).await;
+    assert_k(doc, &[AZ_K[0], AZ_K[1], AZ_K[2], AZ_K[2], AZ_K[3], AZ_K[3]]);
 }
 
 /// A DP vessel that logs generalized forces τ (N, N·m): planned with force

@@ -225,13 +225,8 @@ fn parse(
 /// generalized force τ_T = T·u (K = I): its direction is known from the
 /// thruster configuration matrix even though the thrust coefficients are not.
 fn add_thruster_forces(vessel: &VesselProfile, rec: &mut UniformRecord) {
-    let InputChannels::Thrusters {
-        configuration,
-        thrusters,
-    } = &vessel.inputs
-    else {
-        return;
-    };
+    // Commanded inputs: thr_j, or a turning azimuth's two components.
+    let inputs = seatrial_core::logs::commanded_inputs(vessel);
     for ((r, &d), name) in vessel
         .dofs
         .iter()
@@ -240,10 +235,10 @@ fn add_thruster_forces(vessel: &VesselProfile, rec: &mut UniformRecord) {
     {
         debug_assert_eq!(name, format!("{}_T", d.force_column()));
         let mut acc = vec![0.0; rec.len()];
-        for (i, _) in thrusters.iter().enumerate() {
-            if let Some(u) = rec.column(&format!("thr_{}", i + 1)) {
+        for input in &inputs {
+            if let Some(u) = rec.column(&input.column) {
                 for (a, x) in acc.iter_mut().zip(u) {
-                    *a += configuration[r][i] * x;
+                    *a += input.t[r] * x;
                 }
             }
         }

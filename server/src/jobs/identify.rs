@@ -11,7 +11,6 @@ use seatrial_core::identification::{
     EkfCampaignSettings, Identified, IdentifyError, LambdaCampaignSettings, N4sidCampaignSettings,
     identify_ekf_campaign, identify_lambda_campaign, identify_n4sid_campaign,
 };
-use seatrial_core::logs::input_columns;
 use seatrial_core::planning::VesselProfile;
 use seatrial_core::planning::vessel::{InputChannels, VesselKind};
 use serde::de::DeserializeOwned;
@@ -209,7 +208,7 @@ impl JobHandler for Identify {
                     "parallel_ekf" => {
                         let s: EkfCampaignSettings =
                             parse_settings(&settings).map_err(|(f, m)| JobFailure::field(f, m))?;
-                        let thrusters = input_columns(&profile);
+                        let thrusters = seatrial_core::logs::commanded_columns(&profile);
                         identify_ekf_campaign(&profile, &thrusters, &inputs, &s, &mut sub)
                     }
                     _ => {

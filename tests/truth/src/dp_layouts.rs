@@ -17,6 +17,11 @@
 //!   fixed-pitch propellers whose logger records shaft speed (rpm,
 //!   [`AZ_RATED_RPM`]) instead of the command: n = sign(u)·√|u|·n_rated,
 //!   two decimals. Same header.
+//! - [`DpLayout::SteeredAzimuths`]: the four thrusters with the aft
+//!   azimuths turning during each run (levels held 60–180 s; SI1 turns
+//!   them mirrored so that sway and yaw still cancel, validation each
+//!   alone) and logging their angle: header
+//!   `t,thr_1,thr_2,thr_3,thr_4,azi_3,azi_4,x,y,psi[,u,v,r]`, degrees.
 //! - [`DpLayout::Forces`]: the paper's thrusters and commands, but the log
 //!   carries the commanded generalized forces τ = T″K″u in SI (the bias b
 //!   is the disturbance and is not included): τ_X, τ_Y = τ″·m·g (N),
@@ -28,7 +33,10 @@
 //! starboard) pushing at angle α from the bow has the T″ column
 //! (cos α, sin α, x·sin α − y·cos α).
 
-use crate::dp_ship::{DpLog, DpManoeuvre, DpTrial, Group, Layout, Logged, PAPER, fly_layout};
+use crate::dp_ship::{
+    DpLog, DpManoeuvre, DpTrial, Group, Layout, Logged, PAPER, Steering, fly_layout,
+};
+use crate::rng::Rng;
 
 /// Displacement mass m (kg) that turns Bis forces into N (m·g) and moments
 /// into N·m (m·g·L). Fossen, Sagatun & Sørensen (1995) give no displacement
@@ -70,6 +78,9 @@ pub enum DpLayout {
     /// [`DpLayout::AzimuthsTunnels`] logging shaft speeds
     /// ([`AZ_RATED_RPM`]).
     AzimuthsTunnelsShaftSpeed,
+    /// [`DpLayout::AzimuthsTunnels`] with the aft azimuths turning during
+    /// each run and logging their angle (`azi_3`, `azi_4`, degrees).
+    SteeredAzimuths,
     /// The paper's thrusters and commands, generalized forces logged.
     Forces,
 }
@@ -81,7 +92,44 @@ const AZIMUTHS_TUNNELS: Layout = Layout {
     runs: &[(DpManoeuvre::Surge, "SI1"), (DpManoeuvre::SwayYaw, "SI2")],
     plan: azimuths_tunnels_plan,
     logged: Logged::Commands,
+    steering: None,
 };
+
+/// The aft azimuths of [`AZIMUTHS_TUNNELS`] at their positions (in L).
+const AFT_AZIMUTHS: [(usize, f64, f64); 2] = [(2, -0.45, -0.06), (3, -0.45, 0.06)];
+
+/// Angles of [`DpLayout::SteeredAzimuths`]: levels held 60–180 s. SI1
+/// turns both azimuths together, port at +a and starboard at −a with a in
+/// 15°–45°, so their sway forces and yaw moments still cancel; validation
+/// turns each alone (port 10°–60°, starboard −60° … −10°); SI2 holds them
+/// at ±30° (idle).
+fn steered_angles(kind: DpManoeuvre, n: usize, rng: &mut Rng) -> Vec<Vec<f64>> {
+    let deg = std::f64::consts::PI / 180.0;
+    let levels = |rng: &mut Rng, lo: f64, hi: f64| {
+        let mut out = Vec::with_capacity(n);
+        while out.len() < n {
+            let hold = rng.range(60.0, 180.0) as usize;
+            let a = rng.range(lo, hi) * deg;
+            out.extend(std::iter::repeat_n(a, hold.min(n - out.len())));
+        }
+        out
+    };
+    match kind {
+        DpManoeuvre::Surge => levels(rng, 15.0, 45.0)
+            .into_iter()
+            .map(|a| vec![a, -a])
+            .collect(),
+        DpManoeuvre::Validation => {
+            let port = levels(rng, 10.0, 60.0);
+            let starboard = levels(rng, -60.0, -10.0);
+            port.into_iter()
+                .zip(starboard)
+                .map(|(p, s)| vec![p, s])
+                .collect()
+        }
+        _ => vec![vec![30.0 * deg, -30.0 * deg]; n],
+    }
+}
 
 /// Groups of the four-thruster manoeuvres: both azimuths on one command
 /// (SI1, levels as the paper's mains), the stern tunnel against the bow
@@ -145,6 +193,13 @@ pub fn fly_dp_layout_campaign(trial: &DpTrial, layout: DpLayout, seed: u64) -> V
         DpLayout::AzimuthsTunnels => AZIMUTHS_TUNNELS,
         DpLayout::AzimuthsTunnelsShaftSpeed => Layout {
             logged: Logged::ShaftSpeed(&AZ_RATED_RPM),
+            ..AZIMUTHS_TUNNELS
+        },
+        DpLayout::SteeredAzimuths => Layout {
+            steering: Some(Steering {
+                azimuths: &AFT_AZIMUTHS,
+                angles: steered_angles,
+            }),
             ..AZIMUTHS_TUNNELS
         },
         DpLayout::Forces => Layout {
@@ -294,6 +349,7 @@ mod tests {
             &trial,
             &AZIMUTHS_TUNNELS,
             &u,
+            &[],
             &mut Rng::new(3),
         );
         let d11 = -A_H[0][0] * M[0][0];
@@ -393,6 +449,55 @@ mod tests {
         }
     }
 
+    /// Steered azimuths: SI2 holds them at ±30° (idle), so its runs are the
+    /// fixed layout's exactly; SI1 turns them mirrored within 15°–45° and
+    /// validation each within its range, and the logged angle is what
+    /// was flown: SI1's runs still push surge alone (heading held).
+    #[test]
+    fn steered_azimuths_turn_as_logged() {
+        // No bias: the only sway force or yaw moment would be the azimuths'.
+        let trial = DpTrial {
+            log_velocities: true,
+            bias_initial: [0.0; 3],
+            bias_walk: [0.0; 3],
+            ..DpTrial::default()
+        };
+        let fixed = fly_dp_layout_campaign(&trial, DpLayout::AzimuthsTunnels, 6);
+        let steered = fly_dp_layout_campaign(&trial, DpLayout::SteeredAzimuths, 6);
+        for (f, s) in fixed.iter().zip(&steered) {
+            let angles: Vec<(f64, f64)> = col(s, 5).into_iter().zip(col(s, 6)).collect();
+            match s.manoeuvre {
+                DpManoeuvre::SwayYaw => {
+                    for (lf, ls) in f.csv.lines().zip(s.csv.lines()).skip(1) {
+                        assert_eq!(pose(lf, 5), pose(ls, 7), "{}", s.name);
+                    }
+                    assert!(angles.iter().all(|&a| a == (30.0, -30.0)));
+                }
+                DpManoeuvre::Surge => {
+                    assert!(
+                        angles
+                            .iter()
+                            .all(|&(p, q)| p == -q && (15.0..=45.0).contains(&p))
+                    );
+                    let distinct = angles.windows(2).filter(|w| w[0] != w[1]).count();
+                    assert!(distinct >= 3, "{}: {distinct} turns", s.name);
+                    // Mirrored: no sway force, no yaw moment, so r stays ~0.
+                    let r = col(s, 12);
+                    assert!(r.iter().all(|r| r.abs() < 1e-6), "{}", s.name);
+                }
+                _ => {
+                    assert!(
+                        angles
+                            .iter()
+                            .all(|&(p, q)| (10.0..=60.0).contains(&p)
+                                && (-60.0..=-10.0).contains(&q))
+                    );
+                    assert_ne!(f.csv, s.csv);
+                }
+            }
+        }
+    }
+
     #[test]
     fn every_log_has_its_header_and_finite_values() {
         let thr4 = "t,thr_1,thr_2,thr_3,thr_4,x,y,psi";
@@ -408,6 +513,11 @@ mod tests {
                 (DpLayout::Paper, thr6, 7),
                 (DpLayout::AzimuthsTunnels, thr4, 5),
                 (DpLayout::AzimuthsTunnelsShaftSpeed, thr4, 5),
+                (
+                    DpLayout::SteeredAzimuths,
+                    "t,thr_1,thr_2,thr_3,thr_4,azi_3,azi_4,x,y,psi",
+                    5,
+                ),
                 (DpLayout::Forces, forces, 7),
             ] {
                 let want = format!("{head}{}", if velocities { ",u,v,r" } else { "" });

@@ -332,6 +332,21 @@ pub(crate) struct Layout {
     pub plan: fn(DpManoeuvre) -> &'static [Group],
     /// Commands or forces.
     pub logged: Logged,
+    /// Azimuths that turn during a run and log their angle.
+    pub steering: Option<Steering>,
+}
+
+/// Azimuths that turn during a run: their column of T″ follows the angle
+/// α(t), (cos α, sin α, x·sin α − y·cos α) at their position (x, y) in L,
+/// and the log carries `azi_j` (degrees, three decimals) after the
+/// thruster columns.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Steering {
+    /// Steered thruster columns (0-based) with their position (x, y) in L.
+    pub azimuths: &'static [(usize, f64, f64)],
+    /// The angles (rad) a manoeuvre of n samples flies, per sample one per
+    /// steered azimuth, drawn after the commands.
+    pub angles: fn(DpManoeuvre, usize, &mut Rng) -> Vec<Vec<f64>>,
 }
 
 /// The paper's six thrusters, flown as in Fig. 5–7.
@@ -345,6 +360,7 @@ pub(crate) const PAPER: Layout = Layout {
     ],
     plan: paper_plan,
     logged: Logged::Commands,
+    steering: None,
 };
 
 /// Groups of the paper's manoeuvres: mains together (SI1), aft tunnels
@@ -463,17 +479,24 @@ fn fly(kind: DpManoeuvre, name: String, trial: &DpTrial, layout: &Layout, seed: 
     let n = run_samples(kind, trial);
     let groups = (layout.plan)(kind);
     let u = commands(kind, n, &trial.inputs, groups, layout.k.len(), &mut rng);
-    simulate(kind, name, trial, layout, &u, &mut rng)
+    let angles = layout
+        .steering
+        .map(|s| (s.angles)(kind, n, &mut rng))
+        .unwrap_or_default();
+    simulate(kind, name, trial, layout, &u, &angles, &mut rng)
 }
 
-/// Flies the commands `u` (n × r) on `layout`, drawing the initial bias and
-/// heading, the noise and the bias walk from `rng`, and writes the log.
+/// Flies the commands `u` (n × r) on `layout`, its steered azimuths at
+/// `angles` (n × steered, rad; empty without steering), drawing the initial
+/// bias and heading, the noise and the bias walk from `rng`, and writes the
+/// log.
 pub(crate) fn simulate(
     kind: DpManoeuvre,
     name: String,
     trial: &DpTrial,
     layout: &Layout,
     u: &[Vec<f64>],
+    angles: &[Vec<f64>],
     rng: &mut Rng,
 ) -> DpLog {
     let m = mat(&M);
@@ -493,6 +516,10 @@ pub(crate) fn simulate(
             (1..=k.len()).for_each(|j| csv.push_str(&format!(",thr_{j}")))
         }
         Logged::Forces(_) => csv.push_str(",tau_X,tau_Y,tau_N"),
+    }
+    let steered = layout.steering.map_or(&[][..], |s| s.azimuths);
+    for &(j, _, _) in steered {
+        csv.push_str(&format!(",azi_{}", j + 1));
     }
     csv.push_str(",x,y,psi");
     if trial.log_velocities {
@@ -529,6 +556,10 @@ pub(crate) fn simulate(
                 }
             }
         }
+        for (i, _) in steered.iter().enumerate() {
+            // + 0.0 writes −0 as 0.
+            csv.push_str(&format!(",{:.3}", angles[kk][i].to_degrees() + 0.0));
+        }
         csv.push_str(&format!(",{x:.4},{y:.4},{psi:.6}"));
         if trial.log_velocities {
             csv.push_str(&format!(
@@ -541,8 +572,16 @@ pub(crate) fn simulate(
         csv.push('\n');
         let mut f = Vector3::new(b[0], b[1], b[2]);
         for (j, &c) in uk.iter().enumerate() {
+            let col = match steered.iter().position(|&(s, _, _)| s == j) {
+                Some(i) => {
+                    let (_, ax, ay) = steered[i];
+                    let (sa, ca) = angles[kk][i].sin_cos();
+                    [ca, sa, ax * sa - ay * ca]
+                }
+                None => [t[0][j], t[1][j], t[2][j]],
+            };
             for i in 0..3 {
-                f[i] += t[i][j] * k[j] * c;
+                f[i] += col[i] * k[j] * c;
             }
         }
         for _ in 0..steps {

@@ -106,7 +106,7 @@ fn realise(
         ),
         Prior::Dp(_) => identify_ekf_campaign(
             profile,
-            &inputs,
+            &crate::logs::commanded_columns(profile),
             &runs,
             &EkfCampaignSettings::default(),
             progress,
@@ -399,8 +399,10 @@ pub(super) fn run_input(
         &ParseOptions::for_vessel(profile, LogRole::Single, None),
     )
     .map_err(|err| DesignError::new(field(), format!("simulated log unreadable: {err}")))?;
-    let (record, _) = to_uniform(&parsed.table, None)
+    let (mut record, _) = to_uniform(&parsed.table, None)
         .map_err(|err| DesignError::new(field(), format!("simulated log unreadable: {err}")))?;
+    // As the service loads a run (turning azimuths split into components).
+    crate::logs::read_thruster_commands(profile, &mut record);
     Ok(RunInput {
         run_id: e.code.clone(),
         name: e.code.clone(),

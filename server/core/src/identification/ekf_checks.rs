@@ -94,7 +94,8 @@ pub fn check_ekf_job(
         }
     }
     let pose = EKF_POSE.map(String::from);
-    let inputs = input_columns(profile);
+    let mut inputs = input_columns(profile);
+    inputs.extend(crate::logs::schema::azimuth_angle_columns(profile));
     let mut counts = [0usize; 3];
     let mut validation = 0;
     for r in runs {

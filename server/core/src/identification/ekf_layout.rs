@@ -67,7 +67,7 @@ pub(crate) fn is_paper_layout(profile: &VesselProfile) -> bool {
 /// The EKF layout of a DP profile (surge, sway, yaw) whose Bis length is
 /// `length_m`.
 pub fn ekf_layout(profile: &VesselProfile, length_m: f64) -> Result<EkfLayout, IdentifyError> {
-    let columns = crate::logs::input_columns(profile);
+    let columns = crate::logs::commanded_columns(profile);
     let (thrust, force_ref_n, note) = match &profile.inputs {
         InputChannels::GeneralizedForces => {
             let f = profile.limit(Dof::Surge).max_force;
@@ -89,11 +89,9 @@ pub fn ekf_layout(profile: &VesselProfile, length_m: f64) -> Result<EkfLayout, I
                 note,
             )
         }
-        InputChannels::Thrusters {
-            thrusters,
-            configuration,
-        } => {
-            let t = nalgebra::DMatrix::from_fn(3, thrusters.len(), |i, j| configuration[i][j]);
+        InputChannels::Thrusters { thrusters, .. } => {
+            let inputs = crate::logs::commanded_inputs(profile);
+            let t = nalgebra::DMatrix::from_fn(3, inputs.len(), |i, c| inputs[c].t[i]);
             let (groups, note) = if is_paper_layout(profile) {
                 (
                     ThrustLayout::paper().groups,
@@ -163,6 +161,8 @@ pub fn ekf_layout(profile: &VesselProfile, length_m: f64) -> Result<EkfLayout, I
                     ),
                 )
             };
+            // A turning azimuth's two components share its coefficient.
+            let groups = inputs.iter().map(|c| groups[c.thruster]).collect();
             (ThrustLayout { t, groups }, None, note)
         }
     };
@@ -258,6 +258,7 @@ mod tests {
                 max_rate: 0.1,
                 coefficient_group: groups.map(|g| g[j].to_string()),
                 signal: Default::default(),
+                logged_angle: None,
             })
             .collect();
         p.inputs = InputChannels::Thrusters {

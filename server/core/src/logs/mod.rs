@@ -52,5 +52,7 @@ pub use schema::{
     LogRole, input_columns, measurement_groups, output_columns, pose_columns, required_columns,
     strict_columns,
 };
-pub use thruster_signals::{ThrusterReading, read_thruster_commands};
+pub use thruster_signals::{
+    CommandedInput, ThrusterReading, commanded_columns, commanded_inputs, read_thruster_commands,
+};
 pub use uniform::{MAX_RATE_HZ, MIN_RATE_HZ, check_rate_hz, to_uniform, zoh};

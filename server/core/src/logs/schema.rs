@@ -76,6 +76,22 @@ pub fn input_columns(vessel: &VesselProfile) -> Vec<String> {
     }
 }
 
+/// Column of azimuth `i`'s logged angle, counted from 1: `azi_1`, ….
+pub fn azimuth_angle_column(i: usize) -> String {
+    format!("azi_{i}")
+}
+
+/// The logged-angle columns `azi_j` of the thrusters that declare one.
+pub fn azimuth_angle_columns(vessel: &VesselProfile) -> Vec<String> {
+    vessel
+        .thrusters()
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| t.logged_angle.is_some())
+        .map(|(j, _)| azimuth_angle_column(j + 1))
+        .collect()
+}
+
 /// Output columns: body velocities of the modeled DOFs (`u`, `v`, `r`, …).
 pub fn output_columns(vessel: &VesselProfile) -> Vec<String> {
     vessel
@@ -111,6 +127,7 @@ pub fn required_columns(
     let mut groups = Vec::new();
     if matches!(role, LogRole::Single | LogRole::Control) {
         groups.push(input_columns(vessel));
+        groups.push(azimuth_angle_columns(vessel));
     }
     if matches!(role, LogRole::Single | LogRole::Nav) {
         groups.push(output_columns(vessel));

@@ -1,12 +1,95 @@
 //! Thruster logs as loggers record them: the column `thr_j` may carry the
 //! propeller's shaft speed, pitch or measured thrust instead of the command
-//! u_j of τ = T K u; [`read_thruster_commands`] turns it into u_j (see
-//! [`ThrusterSignal`]) before anything reads the record.
+//! u_j of τ = T K u, and an azimuth may log its angle α_j (`azi_j`);
+//! [`read_thruster_commands`] turns them into the commanded inputs (see
+//! [`ThrusterSignal`], [`commanded_inputs`]) before anything reads the
+//! record.
 
-use crate::planning::vessel::{ThrusterSignal, VesselProfile};
+use crate::planning::vessel::{
+    HeadingUnit, InputChannels, ThrusterSignal, VesselKind, VesselProfile,
+};
 use crate::timeseries::UniformRecord;
 
-use super::schema::thruster_column;
+use super::schema::{azimuth_angle_column, input_columns, thruster_column};
+
+/// One input of τ = Σ_c T_c·K_{g(c)}·u_c as identification regresses on it:
+/// a thruster's command `thr_j`, or an azimuth with a logged angle split
+/// into its body-axis components `thr_j_x` = u_j cos α_j and `thr_j_y` =
+/// u_j sin α_j, whose columns of T″ are then fixed: (1, 0, −l_y/L) and
+/// (0, 1, l_x/L).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CommandedInput {
+    /// Record column.
+    pub column: String,
+    /// Its column of T (one entry per modeled DOF; T″ of a DP vessel).
+    pub t: Vec<f64>,
+    /// The thruster it belongs to (0-based), for its thrust coefficient.
+    pub thruster: usize,
+}
+
+/// Derived column of the body-x component of azimuth `i` (from 1).
+pub fn azimuth_x_column(i: usize) -> String {
+    format!("thr_{i}_x")
+}
+
+/// Derived column of the body-y component of azimuth `i` (from 1).
+pub fn azimuth_y_column(i: usize) -> String {
+    format!("thr_{i}_y")
+}
+
+/// The commanded inputs of a thruster-actuated profile, in thruster order
+/// (an azimuth with a logged angle gives two); empty for a vessel logging
+/// τ. Only for a validated profile (a logged angle implies a DP vessel
+/// with its length).
+pub fn commanded_inputs(vessel: &VesselProfile) -> Vec<CommandedInput> {
+    let InputChannels::Thrusters {
+        thrusters,
+        configuration,
+    } = &vessel.inputs
+    else {
+        return Vec::new();
+    };
+    let length = vessel
+        .dp_prior
+        .as_ref()
+        .filter(|_| vessel.kind == VesselKind::Dp3)
+        .map(|p| p.length_m);
+    let mut out = Vec::new();
+    for (j, th) in thrusters.iter().enumerate() {
+        match (th.logged_angle, length) {
+            (Some(a), Some(l)) => {
+                out.push(CommandedInput {
+                    column: azimuth_x_column(j + 1),
+                    t: a.column(0.0, l).to_vec(),
+                    thruster: j,
+                });
+                out.push(CommandedInput {
+                    column: azimuth_y_column(j + 1),
+                    t: a.column(std::f64::consts::FRAC_PI_2, l).to_vec(),
+                    thruster: j,
+                });
+            }
+            _ => out.push(CommandedInput {
+                column: thruster_column(j + 1),
+                t: configuration.iter().map(|r| r[j]).collect(),
+                thruster: j,
+            }),
+        }
+    }
+    out
+}
+
+/// The record columns identification reads as inputs: the commanded
+/// inputs' columns, or `tau_*` of a vessel logging τ.
+pub fn commanded_columns(vessel: &VesselProfile) -> Vec<String> {
+    match &vessel.inputs {
+        InputChannels::GeneralizedForces => input_columns(vessel),
+        InputChannels::Thrusters { .. } => commanded_inputs(vessel)
+            .into_iter()
+            .map(|c| c.column)
+            .collect(),
+    }
+}
 
 /// A command beyond this multiple of the thruster's `max_command` is not a
 /// command: most likely shaft speed or pitch logged undeclared.
@@ -62,6 +145,43 @@ pub fn read_thruster_commands(vessel: &VesselProfile, rec: &mut UniformRecord) -
             *x = signal.command(*x);
         }
         read.push(format!("{name} ({}) logged as {how}", th.name));
+    }
+    for (j, th) in vessel.thrusters().iter().enumerate() {
+        let Some(a) = th.logged_angle else { continue };
+        let (Some(u), Some(alpha)) = (
+            rec.column(&thruster_column(j + 1)),
+            rec.column(&azimuth_angle_column(j + 1)),
+        ) else {
+            continue;
+        };
+        let scale = match a.unit {
+            HeadingUnit::Rad => 1.0,
+            HeadingUnit::Deg => std::f64::consts::PI / 180.0,
+        };
+        let (x, y): (Vec<f64>, Vec<f64>) = u
+            .iter()
+            .zip(alpha)
+            .map(|(u, a)| {
+                let (s, c) = (a * scale).sin_cos();
+                (u * c, u * s)
+            })
+            .unzip();
+        rec.names.push(azimuth_x_column(j + 1));
+        rec.data.push(x);
+        rec.names.push(azimuth_y_column(j + 1));
+        rec.data.push(y);
+        read.push(format!(
+            "{} ({}) turned as logged in {} ({}): split into {} = u cos α and {} = u sin α",
+            thruster_column(j + 1),
+            th.name,
+            azimuth_angle_column(j + 1),
+            match a.unit {
+                HeadingUnit::Rad => "rad",
+                HeadingUnit::Deg => "°",
+            },
+            azimuth_x_column(j + 1),
+            azimuth_y_column(j + 1)
+        ));
     }
     ThrusterReading {
         note: (!read.is_empty()).then(|| {
@@ -142,6 +262,105 @@ mod tests {
         assert!(
             message.contains("reaches 160") && message.contains("declare"),
             "{message}"
+        );
+    }
+
+    /// An azimuth logging its angle in degrees: u split into u cos α and
+    /// u sin α, T″ columns (1, 0, −y/L) and (0, 1, x/L); its configuration
+    /// column must be T″ at some angle from its position.
+    #[test]
+    fn a_turning_azimuth_is_split_into_body_components() {
+        use crate::planning::vessel::{HeadingUnit, LoggedAngle};
+        let mut v = supply_vessel();
+        let l = v.dp_prior.as_ref().unwrap().length_m;
+        let (x, y) = (30.0, -2.0);
+        let InputChannels::Thrusters {
+            thrusters,
+            configuration,
+        } = &mut v.inputs
+        else {
+            unreachable!()
+        };
+        // The bow azimuth (thr_6), planned at 90°: column (0, 1, x/L).
+        for (r, value) in configuration.iter_mut().zip([0.0, 1.0, x / l]) {
+            r[5] = value;
+        }
+        thrusters[5].logged_angle = Some(LoggedAngle {
+            unit: HeadingUnit::Deg,
+            x_m: x,
+            y_m: y,
+        });
+        v.validate().unwrap();
+        let inputs = commanded_inputs(&v);
+        let cols: Vec<&str> = inputs.iter().map(|c| c.column.as_str()).collect();
+        assert_eq!(
+            cols,
+            [
+                "thr_1", "thr_2", "thr_3", "thr_4", "thr_5", "thr_6_x", "thr_6_y"
+            ]
+        );
+        assert_eq!(inputs[5].t, vec![1.0, 0.0, -y / l]);
+        assert!((inputs[6].t[0]).abs() < 1e-15 && inputs[6].t[1] == 1.0);
+        assert!((inputs[6].t[2] - x / l).abs() < 1e-15);
+        assert_eq!(inputs[6].thruster, 5);
+        assert_eq!(
+            crate::logs::schema::required_columns(&v, crate::logs::LogRole::Single, None)
+                .iter()
+                .filter(|c| c.starts_with("azi_"))
+                .collect::<Vec<_>>(),
+            ["azi_6"]
+        );
+
+        let mut rec = record(&[
+            ("t", vec![0.0, 1.0]),
+            ("thr_6", vec![0.5, -1.0]),
+            ("azi_6", vec![60.0, -90.0]),
+        ]);
+        let note = read_thruster_commands(&v, &mut rec).note.unwrap();
+        assert!(
+            note.contains("thr_6 (bow azimuth thruster) turned as logged in azi_6 (°)"),
+            "{note}"
+        );
+        let x_col = rec.column("thr_6_x").unwrap();
+        let y_col = rec.column("thr_6_y").unwrap();
+        assert!(
+            (x_col[0] - 0.25).abs() < 1e-15 && (y_col[0] - 0.5 * 3f64.sqrt() / 2.0).abs() < 1e-15
+        );
+        assert!(x_col[1].abs() < 1e-15 && (y_col[1] - 1.0).abs() < 1e-15);
+        // Σ T″_c u_c over the components is T″(α)·u.
+        let alpha = 60f64.to_radians();
+        let want = [
+            alpha.cos(),
+            alpha.sin(),
+            (x * alpha.sin() - y * alpha.cos()) / l,
+        ];
+        for (i, w) in want.iter().enumerate() {
+            let got = inputs[5].t[i] * x_col[0] + inputs[6].t[i] * y_col[0];
+            assert!((got - 0.5 * w).abs() < 1e-15, "row {i}");
+        }
+
+        // A column that is no direction at the position, a tunnel, no L.
+        let mut bad = v.clone();
+        if let InputChannels::Thrusters { configuration, .. } = &mut bad.inputs {
+            configuration[2][5] = 0.0;
+        }
+        assert_eq!(
+            bad.validate().unwrap_err().field,
+            "inputs.configuration (column 5)"
+        );
+        let mut bad = v.clone();
+        if let InputChannels::Thrusters { thrusters, .. } = &mut bad.inputs {
+            thrusters[5].kind = crate::planning::vessel::ThrusterKind::Tunnel;
+        }
+        assert_eq!(
+            bad.validate().unwrap_err().field,
+            "inputs.thrusters[5].logged_angle"
+        );
+        let mut bad = v;
+        bad.dp_prior = None;
+        assert_eq!(
+            bad.validate().unwrap_err().field,
+            "inputs.thrusters[5].logged_angle"
         );
     }
 

@@ -122,6 +122,7 @@ fn example_thruster(name: &str, kind: ThrusterKind) -> Thruster {
         max_rate: 0.1,
         coefficient_group: None,
         signal: Default::default(),
+        logged_angle: None,
     }
 }
 

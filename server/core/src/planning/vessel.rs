@@ -197,6 +197,38 @@ pub struct Thruster {
     /// read as u_j when a run is loaded, and said so in its summary.
     #[serde(default, skip_serializing_if = "is_command")]
     pub signal: ThrusterSignal,
+    /// An azimuth whose logger records its angle α_j (column `azi_j`):
+    /// its force then points along α(t) and its yaw moment follows from
+    /// its position, so T″ varies over the run. Its column of
+    /// `configuration` is T″ at the angle the plan holds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub logged_angle: Option<LoggedAngle>,
+}
+
+/// An azimuth thruster's logged angle and position (Fossen 2011, sec.
+/// 11.2.1: a thruster at (l_x, l_y) pushing at α gives the column
+/// (cos α, sin α, l_x sin α − l_y cos α) of T).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+#[serde(deny_unknown_fields)]
+pub struct LoggedAngle {
+    /// Unit of `azi_j`: the angle from the bow, positive to starboard
+    /// (default radians).
+    #[serde(default)]
+    pub unit: HeadingUnit,
+    /// Position forward of the origin l_x (m).
+    pub x_m: f64,
+    /// Position to starboard of the origin l_y (m).
+    pub y_m: f64,
+}
+
+impl LoggedAngle {
+    /// The column of T″ (Bis: direction cosines, yaw arm over the ship
+    /// length `length_m`) at angle `alpha` (rad).
+    pub fn column(&self, alpha: f64, length_m: f64) -> [f64; 3] {
+        let (s, c) = alpha.sin_cos();
+        [c, s, (self.x_m * s - self.y_m * c) / length_m]
+    }
 }
 
 fn is_command(s: &ThrusterSignal) -> bool {
@@ -359,6 +391,70 @@ impl VesselProfile {
         }
     }
 
+    /// An azimuth's logged angle needs a DP vessel with its length (the
+    /// yaw arm in T″ is over L), a finite position, and a configuration
+    /// column that is the thruster's T″ at some angle (a unit direction,
+    /// the yaw arm its position gives there, within 0.02).
+    fn check_logged_angle(
+        &self,
+        i: usize,
+        t: &Thruster,
+        a: &LoggedAngle,
+        configuration: &[Vec<f64>],
+    ) -> Result<(), PlanError> {
+        let field = format!("inputs.thrusters[{i}].logged_angle");
+        if t.kind != ThrusterKind::Azimuth {
+            return Err(PlanError::invalid(
+                field,
+                "only an azimuth thruster turns: its kind must be azimuth",
+            ));
+        }
+        let Some(length) = self
+            .dp_prior
+            .as_ref()
+            .filter(|_| self.kind == VesselKind::Dp3)
+            .map(|p| p.length_m)
+        else {
+            return Err(PlanError::invalid(
+                field,
+                "a logged azimuth angle needs a DP vessel with dp_prior.length_m (T″'s yaw arm is over L)",
+            ));
+        };
+        for (name, v) in [("x_m", a.x_m), ("y_m", a.y_m)] {
+            if !v.is_finite() || v.abs() > 10.0 * length {
+                return Err(PlanError::invalid(
+                    format!("{field}.{name}"),
+                    "must be a finite position within the ship (m from the origin)",
+                ));
+            }
+        }
+        let col: Vec<f64> = configuration
+            .iter()
+            .filter_map(|r| r.get(i))
+            .copied()
+            .collect();
+        if col.len() == 3 {
+            let alpha = col[1].atan2(col[0]);
+            let want = a.column(alpha, length);
+            if col.iter().zip(want).any(|(c, w)| (c - w).abs() > 0.02) {
+                return Err(PlanError::invalid(
+                    format!("inputs.configuration (column {i})"),
+                    format!(
+                        "thruster '{}' logs its angle: its column of T″ must be (cos α, sin α, (x sin α − y cos α)/L) at the planned angle α; at α = {}° its position gives ({}), the column is ({})",
+                        t.name,
+                        crate::numbers::sig3(alpha.to_degrees()),
+                        want.map(crate::numbers::sig3).join(", "),
+                        col.iter()
+                            .map(|v| crate::numbers::sig3(*v))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Checks the profile for completeness and physical sense.
     pub fn validate(&self) -> Result<(), PlanError> {
         super::check_name("name", &self.name)?;
@@ -485,6 +581,9 @@ impl VesselProfile {
                 }
                 t.signal
                     .validate(&format!("inputs.thrusters[{i}].signal"))?;
+                if let Some(a) = &t.logged_angle {
+                    self.check_logged_angle(i, t, a, configuration)?;
+                }
             }
             if configuration.len() != self.dofs.len() {
                 return Err(PlanError::invalid(

@@ -11,7 +11,7 @@ use seatrial_core::identification::outcome::Identified;
 use seatrial_core::identification::{
     EkfCampaignSettings, ModelDocument, RunInput, identify_ekf_campaign,
 };
-use seatrial_core::logs::{LogRole, ParseOptions, input_columns, parse_log, to_uniform};
+use seatrial_core::logs::{LogRole, ParseOptions, parse_log, to_uniform};
 use seatrial_core::planning::VesselProfile;
 use seatrial_core::planning::campaign::ExperimentFamily;
 use seatrial_truth::dp_ship::{self, DpManoeuvre, DpTrial, fly_dp_campaign};
@@ -64,7 +64,7 @@ pub fn identify_validated(
 ) -> Identified {
     identify_ekf_campaign(
         profile,
-        &input_columns(profile),
+        &seatrial_core::logs::commanded_columns(profile),
         runs,
         settings,
         &mut NoProgress,

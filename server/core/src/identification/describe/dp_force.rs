@@ -22,10 +22,20 @@ const MOVING_COLUMN: f64 = 0.1;
 /// over the DOF's force limit of one that logs forces), and whether surge
 /// inputs and lateral inputs move; None without a moving command.
 fn force_shares(rec: &UniformRecord, profile: &VesselProfile) -> Option<([f64; 3], bool, bool)> {
-    let cols = crate::logs::input_columns(profile);
+    let cols = crate::logs::commanded_columns(profile);
+    // The thruster of each column: a turning azimuth's two components are
+    // judged together.
+    let owner: Vec<usize> = match &profile.inputs {
+        InputChannels::Thrusters { .. } => crate::logs::commanded_inputs(profile)
+            .iter()
+            .map(|c| c.thruster)
+            .collect(),
+        InputChannels::GeneralizedForces => (0..cols.len()).collect(),
+    };
     let t: Vec<[f64; 3]> = match &profile.inputs {
-        InputChannels::Thrusters { configuration, .. } => (0..cols.len())
-            .map(|j| std::array::from_fn(|i| configuration[i][j]))
+        InputChannels::Thrusters { .. } => crate::logs::commanded_inputs(profile)
+            .iter()
+            .map(|c| std::array::from_fn(|i| c.t[i]))
             .collect(),
         InputChannels::GeneralizedForces => Dof::HORIZONTAL
             .iter()
@@ -67,17 +77,22 @@ fn force_shares(rec: &UniformRecord, profile: &VesselProfile) -> Option<([f64; 3
     if total <= 0.0 {
         return None;
     }
-    // Each column's force std, and whether it pushes mostly in surge.
+    // Each thruster's force std (over its columns), and whether it pushes
+    // mostly in surge: one column pushes along its T column, a turning
+    // azimuth mostly along the component that moves more.
     let norm = |tj: &[f64; 3]| tj.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let levels: Vec<f64> = data
-        .iter()
-        .zip(&t)
-        .map(|(col, tj)| mean_std(rec, col).1 * norm(tj))
-        .collect();
+    let n_owners = owner.iter().max().map_or(0, |m| m + 1);
+    let (mut level_sq, mut surge_sq) = (vec![0.0; n_owners], vec![0.0; n_owners]);
+    for ((col, tj), &o) in data.iter().zip(&t).zip(&owner) {
+        let s = mean_std(rec, col).1;
+        level_sq[o] += (s * norm(tj)).powi(2);
+        surge_sq[o] += (s * tj[0]).powi(2);
+    }
+    let levels: Vec<f64> = level_sq.iter().map(|v| v.sqrt()).collect();
     let top = levels.iter().copied().fold(0.0, f64::max);
     let moving = |surge: bool| {
-        levels.iter().zip(&t).any(|(&l, tj)| {
-            l >= MOVING_COLUMN * top && (tj[0].abs() >= SURGE_COLUMN * norm(tj)) == surge
+        levels.iter().zip(&surge_sq).any(|(&l, &sx)| {
+            l > 0.0 && l >= MOVING_COLUMN * top && (sx.sqrt() >= SURGE_COLUMN * l) == surge
         })
     };
     Some((var.map(|v| v / total), moving(true), moving(false)))

@@ -191,6 +191,9 @@ fn dp_csv(
     let mut rng = crate::rng::SplitMix64::new(crate::rng::mix(seed ^ 0x5eed));
     let cols = required_columns(profile, LogRole::Single, None);
     let inputs = input_columns(profile);
+    // A turning azimuth is held at the angle of its column of T″ (the one
+    // it is flown with), logged in its declared unit.
+    let held_angles: Vec<(String, f64)> = planned_azimuth_angles(profile);
     let mut out = cols.join(",");
     out.push('\n');
     for k in 0..run.t.len() {
@@ -204,10 +207,13 @@ fn dp_csv(
                 "x" => run.eta[(k, 0)] * l,
                 "y" => run.eta[(k, 1)] * l,
                 "psi" => wrap_pi(run.eta[(k, 2)]),
-                input => inputs
-                    .iter()
-                    .position(|c| c == input)
-                    .map_or(0.0, |j| run.u[(k, j)]),
+                input => match held_angles.iter().find(|(c, _)| c == input) {
+                    Some(&(_, alpha)) => alpha,
+                    None => inputs
+                        .iter()
+                        .position(|c| c == input)
+                        .map_or(0.0, |j| run.u[(k, j)]),
+                },
             };
             row.push(val.to_string());
         }
@@ -215,6 +221,31 @@ fn dp_csv(
         out.push('\n');
     }
     out
+}
+
+/// Column `azi_j` and the angle (in its declared unit) of each azimuth that
+/// logs its angle, at the angle of its column of T″: atan2(T″_2j, T″_1j).
+fn planned_azimuth_angles(profile: &VesselProfile) -> Vec<(String, f64)> {
+    let crate::planning::vessel::InputChannels::Thrusters {
+        thrusters,
+        configuration,
+    } = &profile.inputs
+    else {
+        return Vec::new();
+    };
+    thrusters
+        .iter()
+        .enumerate()
+        .filter_map(|(j, th)| {
+            let a = th.logged_angle?;
+            let alpha = configuration[1][j].atan2(configuration[0][j]);
+            let alpha = match a.unit {
+                crate::planning::vessel::HeadingUnit::Rad => alpha,
+                crate::planning::vessel::HeadingUnit::Deg => alpha.to_degrees(),
+            };
+            Some((crate::logs::schema::azimuth_angle_column(j + 1), alpha))
+        })
+        .collect()
 }
 
 #[cfg(test)]
