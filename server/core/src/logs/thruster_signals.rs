@@ -5,9 +5,7 @@
 //! [`ThrusterSignal`], [`commanded_inputs`]) before anything reads the
 //! record.
 
-use crate::planning::vessel::{
-    HeadingUnit, InputChannels, ThrusterSignal, VesselKind, VesselProfile,
-};
+use crate::planning::vessel::{InputChannels, ThrusterSignal, VesselKind, VesselProfile};
 use crate::timeseries::UniformRecord;
 
 use super::schema::{azimuth_angle_column, input_columns, thruster_column};
@@ -154,10 +152,7 @@ pub fn read_thruster_commands(vessel: &VesselProfile, rec: &mut UniformRecord) -
         ) else {
             continue;
         };
-        let scale = match a.unit {
-            HeadingUnit::Rad => 1.0,
-            HeadingUnit::Deg => std::f64::consts::PI / 180.0,
-        };
+        let scale = a.unit.radians();
         let (x, y): (Vec<f64>, Vec<f64>) = u
             .iter()
             .zip(alpha)
@@ -175,10 +170,7 @@ pub fn read_thruster_commands(vessel: &VesselProfile, rec: &mut UniformRecord) -
             thruster_column(j + 1),
             th.name,
             azimuth_angle_column(j + 1),
-            match a.unit {
-                HeadingUnit::Rad => "rad",
-                HeadingUnit::Deg => "°",
-            },
+            a.unit.symbol(),
             azimuth_x_column(j + 1),
             azimuth_y_column(j + 1)
         ));

@@ -331,6 +331,24 @@ pub enum HeadingUnit {
     Deg,
 }
 
+impl HeadingUnit {
+    /// Radians in one unit.
+    pub fn radians(self) -> f64 {
+        match self {
+            HeadingUnit::Rad => 1.0,
+            HeadingUnit::Deg => std::f64::consts::PI / 180.0,
+        }
+    }
+
+    /// The unit's symbol: "rad" or "°".
+    pub fn symbol(self) -> &'static str {
+        match self {
+            HeadingUnit::Rad => "rad",
+            HeadingUnit::Deg => "°",
+        }
+    }
+}
+
 /// A vessel as the planner needs it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]

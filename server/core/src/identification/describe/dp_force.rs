@@ -23,19 +23,12 @@ const MOVING_COLUMN: f64 = 0.1;
 /// inputs and lateral inputs move; None without a moving command.
 fn force_shares(rec: &UniformRecord, profile: &VesselProfile) -> Option<([f64; 3], bool, bool)> {
     let cols = crate::logs::commanded_columns(profile);
-    // The thruster of each column: a turning azimuth's two components are
-    // judged together.
-    let owner: Vec<usize> = match &profile.inputs {
+    // Each column's T and its thruster (a turning azimuth's two components
+    // are judged together).
+    let (t, owner): (Vec<[f64; 3]>, Vec<usize>) = match &profile.inputs {
         InputChannels::Thrusters { .. } => crate::logs::commanded_inputs(profile)
             .iter()
-            .map(|c| c.thruster)
-            .collect(),
-        InputChannels::GeneralizedForces => (0..cols.len()).collect(),
-    };
-    let t: Vec<[f64; 3]> = match &profile.inputs {
-        InputChannels::Thrusters { .. } => crate::logs::commanded_inputs(profile)
-            .iter()
-            .map(|c| std::array::from_fn(|i| c.t[i]))
+            .map(|c| (std::array::from_fn(|i| c.t[i]), c.thruster))
             .collect(),
         InputChannels::GeneralizedForces => Dof::HORIZONTAL
             .iter()
@@ -43,7 +36,7 @@ fn force_shares(rec: &UniformRecord, profile: &VesselProfile) -> Option<([f64; 3
             .map(|(i, &d)| {
                 let mut c = [0.0; 3];
                 c[i] = 1.0 / profile.limit(d).max_force;
-                c
+                (c, i)
             })
             .collect(),
     };

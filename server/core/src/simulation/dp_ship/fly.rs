@@ -239,10 +239,7 @@ fn planned_azimuth_angles(profile: &VesselProfile) -> Vec<(String, f64)> {
         .filter_map(|(j, th)| {
             let a = th.logged_angle?;
             let alpha = configuration[1][j].atan2(configuration[0][j]);
-            let alpha = match a.unit {
-                crate::planning::vessel::HeadingUnit::Rad => alpha,
-                crate::planning::vessel::HeadingUnit::Deg => alpha.to_degrees(),
-            };
+            let alpha = alpha / a.unit.radians();
             Some((crate::logs::schema::azimuth_angle_column(j + 1), alpha))
         })
         .collect()
