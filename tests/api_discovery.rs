@@ -233,7 +233,7 @@ async fn discovery_names_the_righting_moment_and_stores_the_augmented_model() {
         // Nothing more found, or something named that the held-out gate
         // refused: either way no new version, and the summary says which.
         None => assert!(
-            summary.contains("Nothing found beyond the model's discovered terms")
+            summary.contains("Nothing found beyond the terms the model carries")
                 || summary.contains("The augmented model was not stored: "),
             "{summary}"
         ),
@@ -242,7 +242,7 @@ async fn discovery_names_the_righting_moment_and_stores_the_augmented_model() {
             assert_eq!(v3.json["model"]["version"], 3);
             assert_eq!(v3.json["model"]["name"], new.json["model"]["name"]);
             assert!(
-                summary.contains("Continued from the model's discovered terms"),
+                summary.contains("Continued from the terms the model carries"),
                 "{summary}"
             );
         }

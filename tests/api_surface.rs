@@ -4,8 +4,8 @@
 //! a constant current, with its Munk moment, quadratic surge and
 //! cross-flow drag) uploaded without a plan and identified by `lambda_kf`:
 //! one current for the campaign, the model validated with the heading in
-//! the loop. A vessel logging thruster commands is refused `lambda_kf` at
-//! submit.
+//! the loop; discovery continues from it with the current carried. A
+//! vessel logging thruster commands is refused `lambda_kf` at submit.
 
 mod common;
 
@@ -86,6 +86,36 @@ async fn a_vessel_logging_forces_gets_a_physical_model_with_its_current() {
         let fit = ch["fit_simulation"].as_f64().unwrap();
         assert!(fit > 0.6, "{}: free run {fit}", ch["output"]);
     }
+
+    // Discovery continues from the model with its current carried as a
+    // term (the logs have no z, φ, θ), and does not name it again.
+    let job = common::run_job(
+        &app,
+        json!({ "kind": "discover", "campaign_id": cid, "model_id": mid }),
+    )
+    .await;
+    let did = job["result"]["discrepancy_id"].as_str().unwrap();
+    let d = app
+        .call("GET", "/api/discrepancies/{id}", &[did], None)
+        .await;
+    assert_eq!(d.status, 200, "{}", d.text);
+    let report = &d.json["report"];
+    let point = &report["points"][0]["report"];
+    assert_eq!(
+        point["carried"],
+        json!([{ "effect": "current" }]),
+        "{report:.600}"
+    );
+    for e in report["effects"].as_array().unwrap() {
+        assert_ne!(e["effect"]["effect"], "current", "named again: {e}");
+    }
+    assert!(
+        report["summary"].as_array().unwrap().iter().any(|l| l
+            .as_str()
+            .unwrap()
+            .contains("5 samples of the slowest log (1 Hz)")),
+        "{report:.600}"
+    );
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

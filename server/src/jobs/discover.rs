@@ -61,15 +61,6 @@ impl JobHandler for Discover {
                     ),
                 ));
             }
-            if model.document["lpv"]["current"].is_object() {
-                return Err(ApiError::invalid(
-                    "model_id",
-                    format!(
-                        "model '{}' is a surface vessel's model with a current fixed in NED; discovery does not yet continue from such a model (its library would not see the relative velocity)",
-                        model.summary.id
-                    ),
-                ));
-            }
             if let Some(cid) = &req.campaign_id
                 && cid != &model.summary.campaign_id
             {

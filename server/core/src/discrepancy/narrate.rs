@@ -199,7 +199,7 @@ pub(super) fn summary(
     } else {
         let labels: Vec<String> = carried.iter().map(Effect::label).collect();
         out.push(format!(
-            "Started from the model's discovered terms ({}): kept, refitted with any new term, not tested again.",
+            "Started from the terms the model carries ({}): kept, refitted with any new term, not tested again.",
             labels.join("; ")
         ));
         "The model"

@@ -2,8 +2,11 @@
 //! segments (N × channels matrices, one row per sample), each with its own
 //! initial state — runs and gap-separated blocks are never concatenated.
 
+use std::borrow::Cow;
+
 use nalgebra::DMatrix;
 
+use crate::logs::schema::pose_column;
 use crate::planning::Dof;
 use crate::planning::campaign::ExperimentFamily;
 use crate::timeseries::UniformRecord;
@@ -93,6 +96,29 @@ fn gather(
         }
     }
     Ok(m)
+}
+
+/// A horizontal (surge, sway, yaw) model's η is (x, y, 0, 0, 0, ψ): a
+/// surface vessel's log need not carry z, φ, θ. The run with those columns
+/// added as zeros where it lacks them; borrowed unchanged when nothing is
+/// missing or the model has other DOFs (whose η must be logged).
+pub fn level_attitude<'a>(run: &'a RunInput, dofs: &[Dof]) -> Cow<'a, RunInput> {
+    let horizontal = dofs.iter().all(|d| Dof::HORIZONTAL.contains(d));
+    let missing: Vec<&str> = [Dof::Heave, Dof::Roll, Dof::Pitch]
+        .iter()
+        .map(|d| pose_column(*d))
+        .filter(|c| run.record.column(c).is_none())
+        .collect();
+    if !horizontal || missing.is_empty() {
+        return Cow::Borrowed(run);
+    }
+    let mut run = run.clone();
+    let n = run.record.len();
+    for c in missing {
+        run.record.names.push(c.to_string());
+        run.record.data.push(vec![0.0; n]);
+    }
+    Cow::Owned(run)
 }
 
 /// The valid blocks of `run` at least `min_samples` long, with the given

@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::augmented::{augmented_at, pieces_by_speed};
-use super::dataset::{RunInput, segments};
+use super::dataset::{RunInput, level_attitude, segments};
 use super::document::{ModelDocument, ModelKind};
 use super::error::IdentifyError;
 use super::outcome::Identified;
@@ -23,6 +23,7 @@ use crate::discrepancy::{
     DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, Record, Verdict, discover_from,
 };
 use crate::estimation::Progress;
+use crate::estimation::lambda::MIN_T_OVER_H;
 use crate::logs::schema::pose_column;
 use crate::numbers::sig3;
 use crate::planning::VesselProfile;
@@ -146,6 +147,8 @@ fn records(
     min_len: usize,
 ) -> Result<Vec<(Record, usize)>, IdentifyError> {
     let n = dofs.len();
+    let run = level_attitude(run, dofs);
+    let run = &*run;
     let cols: Vec<String> = forces
         .iter()
         .cloned()
@@ -199,6 +202,29 @@ fn records(
     Ok(out)
 }
 
+/// The state-variable filter must span [`MIN_T_OVER_H`] samples of the
+/// slowest log, as the λ identification's does: a DP vessel logged at 1 Hz
+/// gets T ≥ 5 s (a 10 Hz ROV log keeps the default 0.5 s). Raises `s`'s T
+/// when shorter and says so.
+fn slow_enough_filter(s: &mut DiscoverySettings, runs: &[RunInput]) -> Option<String> {
+    let h = runs
+        .iter()
+        .map(|r| 1.0 / r.record.sample_rate_hz)
+        .filter(|h| h.is_finite())
+        .fold(0.0, f64::max);
+    let floor = MIN_T_OVER_H * h;
+    (s.svf_time_constant_s < floor).then(|| {
+        let note = format!(
+            "The state-variable filter's time constant was raised from {} s to {} s: it must span {MIN_T_OVER_H} samples of the slowest log ({} Hz).",
+            sig3(s.svf_time_constant_s),
+            sig3(floor),
+            sig3(1.0 / h)
+        );
+        s.svf_time_constant_s = floor;
+        note
+    })
+}
+
 /// The shortest record discovery accepts: the filter transient and the
 /// k-step horizon (as `discover` checks), plus room to fit.
 fn min_record_len(s: &DiscoverySettings, h: f64) -> usize {
@@ -228,6 +254,7 @@ pub fn discover_campaign(
     settings: &DiscoverCampaignSettings,
     progress: &mut dyn Progress,
 ) -> Result<CampaignDiscovery, IdentifyError> {
+    let doc = &*start::with_current_as_term(doc);
     if doc.kind != ModelKind::Lpv {
         return Err(IdentifyError::invalid(
             "model_id",
@@ -284,6 +311,7 @@ pub fn discover_campaign(
     if dset.vessel.is_none() {
         dset.vessel = Some(profile.clone());
     }
+    let filter_note = slow_enough_filter(&mut dset, runs);
 
     // Records per grid point. Static runs (attitude holds) went into g(η);
     // discovery looks at the dynamics.
@@ -393,6 +421,7 @@ pub fn discover_campaign(
     };
     let mut summary = summarize(&points, &effects, &skipped);
     summary.extend(overall);
+    summary.extend(filter_note);
     let augmented = augmented.map(|mut a| {
         a.document.notes.extend(summary.iter().cloned());
         a
@@ -481,13 +510,13 @@ fn summarize(
             )
         } else {
             format!(
-                "Nothing found beyond the model's discovered terms ({}) at {n} grid speed(s): no new version is stored.",
+                "Nothing found beyond the terms the model carries ({}) at {n} grid speed(s): no new version is stored.",
                 carried.join("; ")
             )
         });
     } else if !carried.is_empty() {
         out.push(format!(
-            "Continued from the model's discovered terms ({}): kept and refitted with the new ones.",
+            "Continued from the terms the model carries ({}): kept and refitted with the new ones.",
             carried.join("; ")
         ));
     }
@@ -616,6 +645,7 @@ fn summarize(
 
 mod assemble;
 mod keep;
+mod start;
 
 use assemble::Assembly;
 use keep::keep_better;

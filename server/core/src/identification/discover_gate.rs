@@ -1,8 +1,8 @@
 //! Only a better model is kept: an augmented model found by discovery is
 //! stored as a new version only when, on the held-out runs, it improves the
 //! baseline's fit beyond noise in some channel and worsens none — 1-step,
-//! k-step and the 10 s restarted free run — and simulates wherever the
-//! baseline did.
+//! k-step, the 10 s restarted free run and the free run over the whole run
+//! — and simulates wherever the baseline did.
 
 use nalgebra::DMatrix;
 
@@ -76,6 +76,7 @@ fn changes(run: &str, b: &ChannelValidation, a: &ChannelValidation) -> Vec<Chang
         c("1-step", b.fit_one_step, a.fit_one_step),
         c("k-step", b.fit_k_step, a.fit_k_step),
         c("10 s restarted free-run", b.fit_restarted, a.fit_restarted),
+        c("whole-run free-run", b.fit_simulation, a.fit_simulation),
     ]
 }
 

@@ -7,7 +7,7 @@ use nalgebra::{DMatrix, DVector, Matrix3};
 use super::attitude_loop::AttitudeLoop;
 use super::augmented::{AugmentedLpv, is_augmented};
 use super::bis::{BisScale, SiDpShip, unwrap_heading};
-use super::dataset::{RunInput, segments};
+use super::dataset::{RunInput, level_attitude, segments};
 use super::document::{ModelDocument, ModelKind, from_rows};
 use super::error::IdentifyError;
 use super::heading_loop::HeadingLoop;
@@ -274,6 +274,8 @@ pub fn validation_data(
         return Ok((seg.h, seg.u, y));
     }
     let n = doc.dofs.len();
+    let run = level_attitude(run, &doc.dofs);
+    let run = &*run;
     let outputs: Vec<String> = doc
         .dofs
         .iter()

@@ -1,7 +1,7 @@
 //! Only what is better is kept. The model with every grid speed's findings
 //! is kept if, on the held-out runs, it is better than the start model
 //! beyond noise in some fit and worse in none (1-step, k-step, 10 s
-//! restarted free run), simulates wherever that model did, and keeps M
+//! restarted and whole-run free run), simulates wherever that model did, and keeps M
 //! positive definite. Otherwise the grid speeds' augmentations are added
 //! one at a time, strongest evidence first, each staying only if the model
 //! with it passes the same test against the model without it and against

@@ -451,7 +451,7 @@ fn discovery_continues_from_an_augmented_model() {
     );
     assert!(again.augmented.is_none());
     assert!(
-        again.report.summary[0].starts_with("Nothing found beyond the model's discovered terms"),
+        again.report.summary[0].starts_with("Nothing found beyond the terms the model carries"),
         "{:?}",
         again.report.summary
     );
@@ -467,7 +467,7 @@ fn discovery_continues_from_an_augmented_model() {
         assert!(p.report.carried.contains(&roll), "{:?}", p.report.carried);
         assert!(!chosen(p).contains(&roll), "{:#?}", p.report.summary);
         assert!(chosen(p).iter().any(is_pitch), "{:#?}", p.report.summary);
-        assert!(p.report.summary[0].starts_with("Started from the model's discovered terms"));
+        assert!(p.report.summary[0].starts_with("Started from the terms the model carries"));
     }
     let v2 = second
         .augmented
