@@ -4,6 +4,7 @@ import { api } from './api.js';
 import { renameControl } from './rename.js';
 import { vesselTrash } from './parenttrash.js';
 import { thrusterLayout } from './thrusterlayout.js';
+import { signalText, angleText, signalCell, angleCell, collectSignal } from './thrustersignals.js';
 import { deletedBadge } from './manage.js';
 import {
   DOFS, KIND_LABEL, dofUnits, fmt, fmtDate, fmtU, knots, FAMILY_LABEL,
@@ -108,9 +109,10 @@ export function thrusterTables(v) {
     h('table', { class: 'grid-table compact' },
       h('caption', null, 'Thrusters'),
       h('thead', null, h('tr', null, h('th', null, '#'), h('th', null, 'Name'), h('th', null, 'Kind'),
-        h('th', { class: 'num' }, 'Max command'), h('th', { class: 'num' }, 'Max rate'))),
-      h('tbody', null, th.map((t, i) => h('tr', null, h('td', null, `thr_${i + 1}`), h('td', null, t.name),
-        h('td', null, t.kind), h('td', { class: 'num' }, fmt(t.max_command)), h('td', { class: 'num' }, `${fmt(t.max_rate)} /s`))))),
+        h('th', { class: 'num' }, 'Max command'), h('th', { class: 'num' }, 'Max rate'), h('th', null, 'Logged as'), h('th', null, 'Angle'))),
+      h('tbody', { 'data-testid': 'thruster-rows' }, th.map((t, i) => h('tr', null, h('td', null, `thr_${i + 1}`), h('td', null, t.name),
+        h('td', null, t.kind), h('td', { class: 'num' }, fmt(t.max_command)), h('td', { class: 'num' }, `${fmt(t.max_rate)} /s`),
+        h('td', null, signalText(t.signal)), h('td', null, angleText(t, i)))))),
     h('table', { class: 'grid-table compact tmatrix' },
       h('caption', null, 'Configuration matrix T (rows: DOFs, columns: thrusters)'),
       h('thead', null, h('tr', null, h('th', null, ''), th.map((_, i) => h('th', { class: 'num' }, `thr_${i + 1}`)))),
@@ -134,6 +136,8 @@ export async function vesselPage(view, id) {
       h('dt', null, 'Inputs'), h('dd', null, inputsText(v)),
       h('dt', null, 'Controller rate'), h('dd', null, `${fmt(v.controller_rate_hz)} Hz`),
       h('dt', null, 'Logger rate'), h('dd', null, `${fmt(v.logger_rate_hz)} Hz`),
+      h('dt', null, 'Heading ψ logged in'), h('dd', { 'data-testid': 'heading-unit' }, v.heading_unit === 'deg' ? 'degrees' : 'radians'),
+      v.kind === 'dp3' ? [h('dt', null, 'Ship length L'), h('dd', { 'data-testid': 'ship-length' }, v.dp_prior ? fmtU(v.dp_prior.length_m, 'm') : 'not given (no prior)')] : null,
       h('dt', null, 'Created'), h('dd', null, fmtDate(v.created_at)),
       h('dt', null, 'Id'), h('dd', { class: 'mono' }, v.id)),
     h('h2', null, 'Limits'),
@@ -167,8 +171,10 @@ function modelFrom(profile) {
     inputKind: p.inputs && p.inputs.kind === 'thrusters' ? 'thrusters' : 'generalized_forces',
     thrusters: [],
     tmatrix: {},
-    // Fields the form does not edit, carried over from the template.
-    keep: Object.fromEntries(['dp_prior', 'heading_unit'].filter((k) => p[k] != null).map((k) => [k, p[k]])),
+    headingUnit: p.heading_unit === 'deg' ? 'deg' : 'rad',
+    // The DP prior: the form edits L; M″ (inertia_bis) is carried over.
+    dpPrior: p.dp_prior ?? null,
+    lengthM: p.dp_prior?.length_m ?? null,
     autopilotOn: p.autopilot != null,
     autopilot: {},
     feedForward: {
@@ -253,12 +259,18 @@ export async function vesselForm(view, query) {
       Object.entries(KIND_LABEL).map(([k, l]) => h('option', { value: k, selected: k === m.kind }, l)));
     const ctl = numInput(m.controller_rate_hz, 'controller_rate_hz', 'Controller rate (Hz)', (x) => { m.controller_rate_hz = x; });
     const log = numInput(m.logger_rate_hz, 'logger_rate_hz', 'Logger rate (Hz)', (x) => { m.logger_rate_hz = x; });
+    const psi = h('select', { 'data-field': 'heading_unit', 'data-testid': 'heading-unit', onChange: (e) => { m.headingUnit = e.target.value; } },
+      [['rad', 'radians'], ['deg', 'degrees']].map(([k, l]) => h('option', { value: k, selected: m.headingUnit === k }, l)));
     return h('fieldset', null, h('legend', null, 'Vessel'),
       h('div', { class: 'row' },
         labelled('Name', name),
         labelled('Kind', kind),
         labelled('Controller rate [Hz]', ctl, 'references are fed at this rate'),
-        labelled('Logger rate [Hz]', log)));
+        labelled('Logger rate [Hz]', log),
+        labelled('Heading ψ logged in', psi)),
+      m.kind === 'dp3' ? h('div', { class: 'row' },
+        labelled('Ship length L [m]', numInput(m.lengthM, 'dp_prior.length_m', 'Ship length L (m)', (x) => { m.lengthM = x; }, { placeholder: 'none', 'data-testid': 'ship-length' }),
+          'Bis units (T″, K″) and a logged azimuth angle need it; without it the EKF starts from the data')) : null);
   }
 
   function setKind(kind) {
@@ -379,10 +391,12 @@ export async function vesselForm(view, query) {
     const trows = m.thrusters.map((t, i) => h('tr', { 'data-field': `inputs.thrusters[${i}]` },
       h('td', { class: 'mono' }, `thr_${i + 1}`),
       h('td', { 'data-error-host': '' }, h('input', { type: 'text', value: t.name, 'data-field': `inputs.thrusters[${i}].name`, 'aria-label': `Thruster ${i + 1} name`, onInput: (e) => { t.name = e.target.value; } })),
-      h('td', { 'data-error-host': '' }, h('select', { 'data-field': `inputs.thrusters[${i}].kind`, 'aria-label': `Thruster ${i + 1} kind`, onChange: (e) => { t.kind = e.target.value; } },
+      h('td', { 'data-error-host': '' }, h('select', { 'data-field': `inputs.thrusters[${i}].kind`, 'aria-label': `Thruster ${i + 1} kind`, onChange: (e) => { t.kind = e.target.value; render(); } },
         THRUSTER_KINDS.map((k) => h('option', { value: k, selected: k === t.kind }, k)))),
       h('td', { 'data-error-host': '' }, numInput(t.max_command, `inputs.thrusters[${i}].max_command`, `Thruster ${i + 1} max command`, (x) => { t.max_command = x; })),
       h('td', { 'data-error-host': '' }, h('div', { class: 'unit-input' }, numInput(t.max_rate, `inputs.thrusters[${i}].max_rate`, `Thruster ${i + 1} max rate (per s)`, (x) => { t.max_rate = x; }), h('span', { class: 'unit' }, '/s'))),
+      signalCell(t, i, numInput, render),
+      angleCell(t, i, numInput, render),
       h('td', null, h('button', { type: 'button', class: 'btn small', 'aria-label': `Remove thruster ${i + 1}`, onClick: () => { removeThruster(i); render(); } }, '−'))));
 
     const mrows = m.dofs.map((d, r) => h('tr', { 'data-field': `inputs.configuration[${r}]` },
@@ -392,7 +406,7 @@ export async function vesselForm(view, query) {
     box.append(
       h('table', { class: 'grid-table edit', 'data-field': 'inputs.thrusters', 'data-testid': 'thruster-editor' },
         h('caption', null, 'Thrusters (column order of T)'),
-        h('thead', null, h('tr', null, h('th', null, 'Col'), h('th', null, 'Name'), h('th', null, 'Kind'), h('th', null, 'Max command'), h('th', null, 'Max rate'), h('th', null, ''))),
+        h('thead', null, h('tr', null, h('th', null, 'Col'), h('th', null, 'Name'), h('th', null, 'Kind'), h('th', null, 'Max command'), h('th', null, 'Max rate'), h('th', null, 'Logged as'), h('th', null, 'Azimuth angle'), h('th', null, ''))),
         h('tbody', null, trows)),
       h('button', { type: 'button', class: 'btn small', 'data-testid': 'add-thruster', onClick: () => { addThruster(); render(); } }, '+ thruster'),
       h('table', { class: 'grid-table edit tmatrix', 'data-field': 'inputs.configuration', 'data-testid': 'tmatrix-editor' },
@@ -427,8 +441,10 @@ export async function vesselForm(view, query) {
       }
       body.limits[d] = l;
     }
-    Object.assign(body, m.keep);
-    if (m.kind !== 'dp3') delete body.dp_prior;
+    if (m.headingUnit === 'deg') body.heading_unit = 'deg';
+    if (m.kind === 'dp3' && m.lengthM != null) {
+      body.dp_prior = { ...(m.dpPrior ?? {}), length_m: need(m.lengthM, 'dp_prior.length_m') };
+    }
     if (m.kind === 'rov6' && m.autopilotOn) {
       const loops = {};
       for (const d of m.dofs) {
@@ -455,6 +471,7 @@ export async function vesselForm(view, query) {
           name: t.name, kind: t.kind,
           max_command: need(t.max_command, `inputs.thrusters[${i}].max_command`),
           max_rate: need(t.max_rate, `inputs.thrusters[${i}].max_rate`),
+          ...collectSignal(t, i, need),
         })),
         configuration: m.dofs.map((d, r) => m.thrusters.map((_, c) => need(m.tmatrix[d][c], `inputs.configuration[${r}][${c}]`))),
       };

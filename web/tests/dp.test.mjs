@@ -28,6 +28,55 @@ before(async () => {
 
 after(() => H.stop());
 
+test('the vessel form declares shaft-speed logs and a logged azimuth angle; the page says how each column is read', async () => {
+  const VESSEL_422 = { method: 'POST', status: 422, path: /^\/api\/vessels$/ };
+  await H.withPage([VESSEL_422], async (page) => {
+    await page.goto(`${H.base}/#/vessels/new`);
+    await page.click(tid('template-dp'));
+    await page.fill(tid('vessel-name'), 'Supply vessel, shaft speeds and a turning azimuth');
+    await page.selectOption(tid('heading-unit'), 'deg');
+    await page.fill('[data-field="dp_prior.length_m"]', '76.2');
+    // The port main propeller's column is its shaft speed.
+    await page.selectOption(tid('thruster-signal-1'), 'shaft_speed');
+    await page.fill('[data-field="inputs.thrusters[0].signal.rated_rpm"]', '150');
+    // The bow azimuth (T column (0, 1, 0.3373) = pushing to starboard) logs α.
+    await page.check(tid('thruster-angle-6'));
+    await page.selectOption('[data-field="inputs.thrusters[5].logged_angle.unit"]', 'deg');
+    // A position its T column cannot come from: the server's 422 is shown on T.
+    await page.fill('[data-field="inputs.thrusters[5].logged_angle.x_m"]', '10');
+    await page.fill('[data-field="inputs.thrusters[5].logged_angle.y_m"]', '0');
+    await page.click(tid('create-vessel'));
+    const err = page.locator(`${tid('field-error')}[data-for="inputs.configuration"]`);
+    await err.waitFor();
+    assert.match(await err.textContent(), /column thr_6: thruster .bow azimuth thruster. logs its angle/);
+    // Where it is: x = 0.3373 L forward on the centreline.
+    await page.fill('[data-field="inputs.thrusters[5].logged_angle.x_m"]', '25.70');
+    await page.click(tid('create-vessel'));
+    await page.waitForURL(/#\/vessels\/[0-9a-f-]{36}$/);
+    const id = page.url().split('/').pop();
+    const v = await H.api('GET', `/api/vessels/${id}`);
+    assert.equal(v.status, 200);
+    const prof = v.json.profile;
+    const th = prof.inputs.thrusters;
+    assert.deepEqual(th[0].signal, { kind: 'shaft_speed', rated_rpm: 150 });
+    assert.deepEqual(th[5].logged_angle, { unit: 'deg', x_m: 25.7, y_m: 0 });
+    assert.equal(th[2].signal?.kind ?? 'command', 'command');
+    assert.equal(prof.heading_unit, 'deg');
+    assert.equal(prof.dp_prior.length_m, 76.2);
+    const rows = await page.locator(`${tid('thruster-rows')} tr`).allTextContents();
+    assert.match(rows[0], /shaft speed n, u = \|n\|n \/ \(150 rpm\)²/);
+    assert.match(rows[5], /azi_6 logged in degrees, at x = 25\.70* m, y = 0 m/);
+    assert.match(rows[4], /command u/);
+    assert.equal(await page.textContent(tid('heading-unit')), 'degrees');
+    assert.match(await page.textContent(tid('ship-length')), /^76\.20* m$/);
+    // Copied as a new vessel, the form carries both declarations over.
+    await page.goto(`${H.base}/#/vessels/new?from=${id}`);
+    assert.equal(await page.inputValue('[data-field="inputs.thrusters[0].signal.rated_rpm"]'), '150');
+    assert.ok(await page.isChecked(tid('thruster-angle-6')));
+    assert.equal(await page.inputValue('[data-field="inputs.thrusters[5].logged_angle.x_m"]'), '25.7');
+  });
+});
+
 test('identify the demo supply vessel by the parallel EKF and read its model page', async () => {
   await H.withPage([], async (page) => {
     await page.goto(`${H.base}/#/campaigns/${cid}`);

@@ -456,9 +456,10 @@ impl VesselProfile {
             let want = a.column(alpha, length);
             if col.iter().zip(want).any(|(c, w)| (c - w).abs() > 0.02) {
                 return Err(PlanError::invalid(
-                    format!("inputs.configuration (column {i})"),
+                    "inputs.configuration",
                     format!(
-                        "thruster '{}' logs its angle: its column of T″ must be (cos α, sin α, (x sin α − y cos α)/L) at the planned angle α; at α = {}° its position gives ({}), the column is ({})",
+                        "column thr_{}: thruster '{}' logs its angle: its column of T″ must be (cos α, sin α, (x sin α − y cos α)/L) at the planned angle α; at α = {}° its position gives ({}), the column is ({})",
+                        i + 1,
                         t.name,
                         crate::numbers::sig3(alpha.to_degrees()),
                         want.map(crate::numbers::sig3).join(", "),
@@ -634,9 +635,10 @@ impl VesselProfile {
             for c in 0..thrusters.len() {
                 if configuration.iter().all(|row| row[c] == 0.0) {
                     return Err(PlanError::invalid(
-                        format!("inputs.configuration (column {c})"),
+                        "inputs.configuration",
                         format!(
-                            "thruster '{}' acts on no modeled DOF: its column of T is zero",
+                            "column thr_{}: thruster '{}' acts on no modeled DOF: its column of T is zero",
+                            c + 1,
                             thrusters[c].name
                         ),
                     ));
