@@ -112,9 +112,9 @@ test('discover the demo ROV\'s missing restoring from the model page and read th
     await page.waitForURL((u) => /#\/discrepancies\/[0-9a-f-]{36}$/.test(u.toString()) && u.toString() !== reportUrl, { timeout: 180000 });
     await page.locator(tid('discovery-summary')).waitFor();
     const again = await page.textContent(tid('discovery-summary'));
-    assert.match(again, /(Nothing found beyond|Continued from) the model's discovered terms \(.*restoring/, again);
+    assert.match(again, /(Nothing found beyond|Continued from) the terms the model carries \(.*restoring/, again);
     assert.doesNotMatch(again, /restoring cos θ sin φ in roll: named/, again);
-    assert.match(await page.locator(tid('discovery-point')).first().textContent(), /Started from the model's discovered terms/);
+    assert.match(await page.locator(tid('discovery-point')).first().textContent(), /Started from the terms the model carries/);
     // Back on the examined model the report is listed.
     await page.goto(`${H.base}/#/models/${mid}`);
     await page.locator(tid('discover-report-link')).first().waitFor();

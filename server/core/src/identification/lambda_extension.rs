@@ -206,13 +206,18 @@ pub(crate) fn choose_extension(
 /// Notes on validation run `run`'s forward speeds `u` outside the `grid`
 /// (≥ 5 % of the run on a side, with [`super::roles::beyond_grid`]'s
 /// margin): where the model extrapolates (`ext`) or holds its end
-/// sub-model, and how much of the run lies beyond the extension.
+/// sub-model, and how much of the run lies beyond the extension. None for
+/// a station-keeping model (one sub-model at 0 m/s): it is identified from
+/// manoeuvres that move both ways about zero, as its validation runs do.
 pub(crate) fn speed_coverage_notes(
     run: &str,
     u: &[f64],
     grid: &[f64],
     ext: Option<Extension>,
 ) -> Vec<String> {
+    if grid.len() == 1 && grid[0].abs() < 1e-9 {
+        return Vec::new();
+    }
     let (below, above) = super::roles::beyond_grid(u, grid);
     let (lo, hi) = (grid[0], grid[grid.len() - 1]);
     let (below_ext, above_ext) = match ext {
@@ -316,5 +321,18 @@ mod tests {
         assert!(!note.contains("none"), "{note}");
         // Two grid points: no extension.
         assert!(choose_extension(&lpv(&[0.5, 1.0], |_| 300.0), false, None, BOTH).is_none());
+    }
+
+    /// A DP run surging ±0.3 m/s about its one sub-model at 0 m/s is not
+    /// "below the identified speeds"; a run at 0.1 m/s against a single
+    /// sub-model at 0.5 m/s is.
+    #[test]
+    fn station_keeping_runs_are_not_flagged_below_the_grid() {
+        let u: Vec<f64> = (0..600).map(|k| 0.3 * (0.05 * k as f64).sin()).collect();
+        assert!(speed_coverage_notes("VAL", &u, &[0.0], None).is_empty());
+        let slow = vec![0.1; 600];
+        let notes = speed_coverage_notes("VAL", &slow, &[0.5], None);
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(notes[0].contains("100 % of it was flown below"), "{notes:?}");
     }
 }
