@@ -27,6 +27,16 @@ export function gridText(c) {
 
 // ---- list -----------------------------------------------------------------
 
+/**
+ * The families a vessel can fly: its kind's, without the azimuth manoeuvre
+ * (SI3) when it has no azimuth thruster — a vessel logging forces τ
+ * determines every θ″ from SI1 and SI2.
+ */
+function familiesFor(v) {
+  const azimuth = v.inputs?.kind === 'thrusters' && v.inputs.thrusters.some((t) => t.kind === 'azimuth');
+  return (FAMILIES[v.kind] || []).filter((f) => f !== 'dp_azimuth' || azimuth);
+}
+
 export async function campaignList(view) {
   const [campaigns, vessels] = await Promise.all([api.campaigns(), api.vessels()]);
   const byId = new Map(vessels.map((v) => [v.id, v]));
@@ -86,7 +96,7 @@ export async function campaignForm(view, query) {
   };
   const setVessel = (v) => {
     m.vessel = v;
-    m.families = new Set(FAMILIES[v.kind] || []);
+    m.families = new Set(familiesFor(v));
     for (const d of DOFS) if (!m.perDof[d]) m.perDof[d] = { signal: '', amplitude: null, clock_period_s: null, prbs_order: null };
   };
   setVessel(m.vessel);
@@ -211,7 +221,7 @@ export async function campaignForm(view, query) {
   }
 
   function renderFamilies() {
-    const fams = FAMILIES[m.vessel.kind] || [];
+    const fams = familiesFor(m.vessel);
     fill(famBox, h('legend', null, `Experiment families (${KIND_LABEL[m.vessel.kind]})`),
       h('div', { class: 'checks' }, fams.map((f) => h('label', { class: 'check' },
         h('input', {
@@ -297,7 +307,7 @@ export async function campaignForm(view, query) {
       else if (!Number.isFinite(x)) errs.push({ field: `grid.speeds[${i}]`, message: 'not a number' });
       return x;
     });
-    const fams = (FAMILIES[m.vessel.kind] || []).filter((f) => m.families.has(f));
+    const fams = familiesFor(m.vessel).filter((f) => m.families.has(f));
     // Server paths index the submitted array: families[i] is the i-th checked box.
     famBox.querySelectorAll('input[type=checkbox]').forEach((cb) => {
       const i = fams.indexOf(cb.value);

@@ -11,6 +11,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { harness, tid, inked } from './harness.mjs';
+import { SUPPLY_VESSEL } from '../templates.js';
 
 const H = harness({ extraArgs: ['--demo'] });
 let cid;
@@ -74,6 +75,23 @@ test('the vessel form declares shaft-speed logs and a logged azimuth angle; the 
     assert.equal(await page.inputValue('[data-field="inputs.thrusters[0].signal.rated_rpm"]'), '150');
     assert.ok(await page.isChecked(tid('thruster-angle-6')));
     assert.equal(await page.inputValue('[data-field="inputs.thrusters[5].logged_angle.x_m"]'), '25.7');
+  });
+});
+
+test('a DP vessel logging forces τ is offered no azimuth manoeuvre; one with an azimuth is', async () => {
+  const tau = { ...SUPPLY_VESSEL, name: 'Supply vessel logging τ', inputs: { kind: 'generalized_forces' } };
+  const made = await H.api('POST', '/api/vessels', tau);
+  assert.equal(made.status, 201, JSON.stringify(made.json));
+  await H.withPage([], async (page) => {
+    await page.goto(`${H.base}/#/campaigns/new?vessel=${made.json.id}`);
+    await page.locator(tid('family-dp_surge')).waitFor();
+    assert.equal(await page.locator(tid('family-dp_azimuth')).count(), 0);
+    assert.ok(await page.isChecked(tid('family-dp_sway_yaw')));
+    const withAzimuth = await H.api('POST', '/api/vessels', { ...SUPPLY_VESSEL, name: 'Supply vessel with its azimuth' });
+    assert.equal(withAzimuth.status, 201);
+    await page.goto(`${H.base}/#/campaigns/new?vessel=${withAzimuth.json.id}`);
+    await page.locator(tid('family-dp_azimuth')).waitFor();
+    assert.ok(await page.isChecked(tid('family-dp_azimuth')));
   });
 });
 
