@@ -333,6 +333,9 @@ mod tests {
         let slow = vec![0.1; 600];
         let notes = speed_coverage_notes("VAL", &slow, &[0.5], None);
         assert_eq!(notes.len(), 1, "{notes:?}");
-        assert!(notes[0].contains("100 % of it was flown below"), "{notes:?}");
+        assert!(
+            notes[0].contains("100 % of it was flown below"),
+            "{notes:?}"
+        );
     }
 }
