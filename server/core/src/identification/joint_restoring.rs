@@ -85,14 +85,28 @@ pub(crate) fn specification(profile: &VesselProfile, dofs: &[Dof], which: Functi
         1 => matches!(dofs[i], Dof::Surge | Dof::Pitch),
         _ => matches!(dofs[i], Dof::Sway | Dof::Roll),
     });
-    let force_std = dofs
-        .iter()
-        .map(|&d| 10.0 * profile.limit(d).max_force.abs().max(1.0))
-        .collect();
     Exogenous {
         names,
         pattern,
-        force_std,
+        force_std: weak_force_std(profile, dofs),
+    }
+}
+
+/// Prior std of an exogenous force in each DOF: ten times its force limit,
+/// weak, so the data decide.
+pub(crate) fn weak_force_std(profile: &VesselProfile, dofs: &[Dof]) -> Vec<f64> {
+    dofs.iter()
+        .map(|&d| 10.0 * profile.limit(d).max_force.abs().max(1.0))
+        .collect()
+}
+
+/// No exogenous functions yet, with [`weak_force_std`] priors for those
+/// that will be added.
+pub(crate) fn no_exogenous(profile: &VesselProfile, dofs: &[Dof]) -> Exogenous {
+    Exogenous {
+        names: Vec::new(),
+        pattern: DMatrix::from_element(dofs.len(), 0, false),
+        force_std: weak_force_std(profile, dofs),
     }
 }
 

@@ -126,14 +126,7 @@ pub(crate) fn specification(
         return spec;
     }
     let n = dofs.len();
-    let base = spec.unwrap_or_else(|| Exogenous {
-        names: Vec::new(),
-        pattern: DMatrix::from_element(n, 0, false),
-        force_std: dofs
-            .iter()
-            .map(|&d| 10.0 * profile.limit(d).max_force.abs().max(1.0))
-            .collect(),
-    });
+    let base = spec.unwrap_or_else(|| super::joint_restoring::no_exogenous(profile, dofs));
     let q0 = base.names.len();
     let mut names = base.names.clone();
     names.extend(cols.iter().map(|&i| name(dofs[i])));

@@ -97,14 +97,7 @@ pub(crate) fn specification(
     dofs: &[Dof],
 ) -> Exogenous {
     let n = dofs.len();
-    let base = base.unwrap_or_else(|| Exogenous {
-        names: Vec::new(),
-        pattern: DMatrix::from_element(n, 0, false),
-        force_std: dofs
-            .iter()
-            .map(|&d| 10.0 * profile.limit(d).max_force.abs().max(1.0))
-            .collect(),
-    });
+    let base = base.unwrap_or_else(|| super::joint_restoring::no_exogenous(profile, dofs));
     let q = base.names.len();
     let mut names = base.names.clone();
     names.extend([COS_PSI.to_string(), SIN_PSI.to_string()]);

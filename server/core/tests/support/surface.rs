@@ -90,17 +90,28 @@ impl SurfaceReport {
     }
 }
 
+/// One DOF's limits as a user states them: top velocity, force, force
+/// rate and time constant.
+fn limits(
+    max_velocity: f64,
+    max_force: f64,
+    max_force_rate: f64,
+    time_constant_s: f64,
+) -> DofLimits {
+    DofLimits {
+        max_velocity,
+        max_force,
+        max_force_rate,
+        max_accel: None,
+        time_constant_s,
+        max_angle: None,
+    }
+}
+
 /// The profile a user writes for a DP vessel logging τ: force limits of
 /// twice the largest logged, rough time constants, its length.
 pub fn supply_profile(vessel: &SurfaceVessel, trial: &SupplyTrial) -> VesselProfile {
-    let lim = |v: f64, f: f64, t: f64| DofLimits {
-        max_velocity: v,
-        max_force: f,
-        max_force_rate: f / 10.0,
-        max_accel: None,
-        time_constant_s: t,
-        max_angle: None,
-    };
+    let lim = |v, f: f64, t| limits(v, f, f / 10.0, t);
     let f = trial.force_max;
     VesselProfile {
         name: format!("{} (drawn)", vessel.name),
@@ -268,14 +279,7 @@ fn grade(
 /// logging τ (its two propellers' forces; τ_Y = 0), force limits of twice
 /// the largest logged.
 pub fn otter_profile(vessel: &SurfaceVessel) -> VesselProfile {
-    let lim = |v: f64, f: f64, t: f64| DofLimits {
-        max_velocity: v,
-        max_force: f,
-        max_force_rate: f,
-        max_accel: None,
-        time_constant_s: t,
-        max_angle: None,
-    };
+    let lim = |v, f, t| limits(v, f, f, t);
     VesselProfile {
         name: format!("{} (drawn)", vessel.name),
         kind: VesselKind::Dp3,
