@@ -103,13 +103,15 @@ fn gather(
 /// added as zeros where it lacks them; borrowed unchanged when nothing is
 /// missing or the model has other DOFs (whose η must be logged).
 pub fn level_attitude<'a>(run: &'a RunInput, dofs: &[Dof]) -> Cow<'a, RunInput> {
-    let horizontal = dofs.iter().all(|d| Dof::HORIZONTAL.contains(d));
+    if !dofs.iter().all(|d| Dof::HORIZONTAL.contains(d)) {
+        return Cow::Borrowed(run);
+    }
     let missing: Vec<&str> = [Dof::Heave, Dof::Roll, Dof::Pitch]
         .iter()
         .map(|d| pose_column(*d))
         .filter(|c| run.record.column(c).is_none())
         .collect();
-    if !horizontal || missing.is_empty() {
+    if missing.is_empty() {
         return Cow::Borrowed(run);
     }
     let mut run = run.clone();

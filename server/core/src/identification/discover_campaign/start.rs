@@ -39,6 +39,8 @@ pub fn with_current_as_term(doc: &ModelDocument) -> Cow<'_, ModelDocument> {
             d_ref: p.d_bar.clone(),
             terms: vec![term.clone()],
         });
+        // The term is now the current's one representation: an augmented
+        // model is predicted from its terms, never from F.
         p.current_force = None;
     }
     Cow::Owned(out)
