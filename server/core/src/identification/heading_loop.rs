@@ -6,8 +6,10 @@
 //! The current's force turns with the vessel, so a free run integrates ψ
 //! from the model's own yaw rate; the measured ψ only starts a prediction.
 //! One step holds τ (ZOH) and averages F·e(ψ) over the step (trapezoid, the
-//! identification's held shapes): a Heun predictor–corrector on ψ. F is
-//! scheduled on forward speed with the LPV model's own weights.
+//! identification's held shapes): a Heun predictor–corrector on ψ. The
+//! sub-models and F are scheduled on the forward speed through the water
+//! u_r = u − u_c(ψ), about which each sub-model is linearized, with the LPV
+//! model's own weights.
 
 use nalgebra::{DMatrix, DVector, Vector2};
 
@@ -65,7 +67,7 @@ impl HeadingLoop {
     /// C(δ)δ).
     fn drive(&self, nu: &DVector<f64>, psi: f64) -> DVector<f64> {
         let g = self.lpv.grid_speeds();
-        let (lo, hi, w) = match self.lpv.weights(nu[self.surge], self.lpv.scheduling()) {
+        let (lo, hi, w) = match self.lpv.weights(self.speed(nu, psi), self.lpv.scheduling()) {
             Ok(w) => (w.lower, w.upper, w.w_lower),
             Err(_) => (0, 0, 1.0),
         };
@@ -84,6 +86,14 @@ impl HeadingLoop {
         .drive(nu, psi, u0, &f)
     }
 
+    /// The forward speed through the water u_r = u − u_c(ψ) (m/s), which
+    /// schedules the sub-models: each is linearized about its speed
+    /// through the water.
+    fn speed(&self, nu: &DVector<f64>, psi: f64) -> f64 {
+        let (s, c) = psi.sin_cos();
+        nu[self.surge] - (self.v[0] * c + self.v[1] * s)
+    }
+
     /// ν(k+1) and ψ(k+1) from ν(k), ψ(k) and τ(k).
     fn step(
         &self,
@@ -94,11 +104,12 @@ impl HeadingLoop {
         tau: &DVector<f64>,
     ) -> (DVector<f64>, f64) {
         let scheduling = self.lpv.scheduling();
+        let speed = Some(self.speed(nu, psi));
         let f0 = self.drive(nu, psi);
-        let predicted = lpv.step(nu, &(tau + &f0), scheduling);
+        let predicted = lpv.step_at(nu, &(tau + &f0), scheduling, speed);
         let psi_p = psi + 0.5 * h * (nu[self.yaw] + predicted[self.yaw]);
         let f1 = self.drive(&predicted, psi_p);
-        let next = lpv.step(nu, &(tau + (&f0 + &f1) * 0.5), scheduling);
+        let next = lpv.step_at(nu, &(tau + (&f0 + &f1) * 0.5), scheduling, speed);
         let psi_next = psi + 0.5 * h * (nu[self.yaw] + next[self.yaw]);
         (next, psi_next)
     }

@@ -25,10 +25,12 @@ use super::lambda_information::default_t_lambda;
 use super::lambda_physical::{enforce, unresolved_mode};
 use super::lambda_quadratic;
 use super::lambda_structure::choose_structure;
+use super::lambda_unforced;
 use super::lambda_validation::{HeldOut, choose_second_order, keep_current};
 use super::ned_current;
 use super::outcome::Identified;
 use super::roles::assign_roles;
+use super::through_water;
 use crate::estimation::lambda::{
     Experiment, LambdaEstimate, LambdaSettings, MIN_T_OVER_H, Prior, RegressorNoise,
 };
@@ -91,6 +93,21 @@ pub fn identify_lambda_campaign(
     settings: &LambdaCampaignSettings,
     progress: &mut dyn Progress,
 ) -> Result<Identified, IdentifyError> {
+    identify(profile, grid, inputs, runs, settings, progress, None)
+}
+
+/// [`identify_lambda_campaign`]; `regridded`: the note of runs a first
+/// pass moved to the grid point of their speed through the water (they are
+/// not examined again).
+fn identify(
+    profile: &VesselProfile,
+    grid: &[f64],
+    inputs: &[String],
+    runs: &[RunInput],
+    settings: &LambdaCampaignSettings,
+    progress: &mut dyn Progress,
+    regridded: Option<String>,
+) -> Result<Identified, IdentifyError> {
     let dofs = profile.dofs.clone();
     let n = dofs.len();
     if inputs.len() != n {
@@ -132,6 +149,8 @@ pub fn identify_lambda_campaign(
         .collect();
     let six_dof = n == 6;
     let mut notes = Vec::new();
+    let regrid_again = regridded.is_none();
+    notes.extend(regridded);
     progress.update(0.0, "collecting estimation data")?;
 
     // Columns: τ, then η when g(η) is part of the model.
@@ -225,6 +244,18 @@ pub fn identify_lambda_campaign(
     // A controller faster than the log: the fit returns M − c K_ν, and
     // M itself is what must be symmetric.
     let logged: Vec<&Segment> = data.segments.iter().flatten().collect();
+    // A DOF no run forced: C(ν) of M would act through its undetermined mass.
+    let unforced = lambda_unforced::unforced_dofs(&logged, &dofs, profile);
+    let coriolis_from_m = settings.coriolis_from_m && unforced.is_empty();
+    if !unforced.is_empty() {
+        let m0: Vec<f64> = (0..n).map(|i| lambda_settings.prior.m0[(i, i)]).collect();
+        notes.push(lambda_unforced::note(
+            &unforced,
+            &dofs,
+            &m0,
+            settings.coriolis_from_m,
+        ));
+    }
     let h_log = logged.first().map_or(0.0, |s| s.h);
     let rate_hz = settings
         .controller_rate_hz
@@ -314,7 +345,7 @@ pub fn identify_lambda_campaign(
         let joint = fit_points(
             &points_of(with_quadratic(first)),
             &lambda_settings,
-            settings.coriolis_from_m,
+            coriolis_from_m,
             &mut sub,
             &mut notes,
         )
@@ -361,6 +392,22 @@ pub fn identify_lambda_campaign(
     } else {
         None
     };
+    // Sub-models hold the runs flown at their speed through the water.
+    if let (Some(c), Some(surge), true) = (&current, surge, regrid_again)
+        && let Some((moved, note)) =
+            through_water::regrid(runs, &roles, &data, grid, surge, n, c.estimate.v)
+    {
+        let mut sub = SubProgress::new(progress, 0.4, 1.0);
+        return identify(
+            profile,
+            grid,
+            inputs,
+            &moved,
+            settings,
+            &mut sub,
+            Some(note),
+        );
+    }
     let relative = current.as_ref().map(|c| ned_current::Relative {
         dofs: dofs.clone(),
         v: c.estimate.v,
@@ -414,7 +461,7 @@ pub fn identify_lambda_campaign(
         fit_points(
             &points_of(exps.clone()),
             &lambda_settings,
-            settings.coriolis_from_m,
+            coriolis_from_m,
             &mut sub,
             &mut fit_notes,
         )
@@ -438,7 +485,7 @@ pub fn identify_lambda_campaign(
         estimates = fit_points(
             &points_of(exps.clone()),
             &lambda_settings,
-            settings.coriolis_from_m,
+            coriolis_from_m,
             &mut sub,
             &mut fit_notes,
         )
@@ -480,14 +527,7 @@ pub fn identify_lambda_campaign(
     for (speed, est) in &estimates {
         let idx = grid.iter().position(|g| g == speed).unwrap_or(0);
         let (load, load_std) = joint_load(est, n);
-        let physical = enforce(
-            &dofs,
-            est,
-            &load,
-            &exps[idx],
-            *speed,
-            settings.coriolis_from_m,
-        )?;
+        let physical = enforce(&dofs, est, &load, &exps[idx], *speed, coriolis_from_m)?;
         findings.extend(physical.findings);
         let model = physical.model;
         findings.extend(unresolved_mode(&dofs, model.a(), est.h, *speed));
@@ -610,7 +650,7 @@ pub fn identify_lambda_campaign(
                 below: settings.extend_below_grid,
                 above: settings.extend_above_grid,
             };
-            choose_extension(&v, settings.coriolis_from_m, g, sides)
+            choose_extension(&v, coriolis_from_m, g, sides)
         });
     let lpv = match &extension {
         Some((ext, note)) => {

@@ -62,6 +62,7 @@ mod lambda_physical;
 mod lambda_quadratic;
 mod lambda_settings;
 mod lambda_structure;
+mod lambda_unforced;
 mod lambda_validation;
 pub mod mat;
 pub mod n4sid_campaign;
@@ -71,6 +72,7 @@ pub mod outcome;
 pub mod predictor;
 pub mod roles;
 pub mod state_space;
+mod through_water;
 
 pub use dataset::{DatasetError, RunInput, Segment, segments};
 pub use describe::{DescribeError, DofActivity, InferredDescription, infer_description};

@@ -533,8 +533,21 @@ impl DiscreteLpv {
     /// first grid point. A non-finite speed schedules on the first grid point
     /// too (its prediction is non-finite anyway).
     pub fn step(&self, x: &DVector<f64>, u: &DVector<f64>, scheduling: Scheduling) -> DVector<f64> {
-        let ((l, wl, kl, sl), (m, wm, km, sm)) = match self.surge {
-            Some(i) if x[i].is_finite() => self.pair(x[i], scheduling),
+        self.step_at(x, u, scheduling, self.surge.map(|i| x[i]))
+    }
+
+    /// [`DiscreteLpv::step`] scheduled on `speed` (m/s) instead of the
+    /// surge entry of `x`: a model in a current is scheduled on its speed
+    /// through the water. `None` or non-finite: the first grid point.
+    pub fn step_at(
+        &self,
+        x: &DVector<f64>,
+        u: &DVector<f64>,
+        scheduling: Scheduling,
+        speed: Option<f64>,
+    ) -> DVector<f64> {
+        let ((l, wl, kl, sl), (m, wm, km, sm)) = match speed {
+            Some(s) if s.is_finite() => self.pair(s, scheduling),
             _ => self.pair(self.grid_speeds[0], Scheduling::Nearest),
         };
         let blend = |force: &dyn Fn(usize, f64) -> DVector<f64>| {

@@ -333,3 +333,20 @@ pub fn otter_case(
         settings,
     )
 }
+
+/// The Otter's grid as its crew states it: the steady speed through the
+/// water of each of the campaign's command levels on a straight course
+/// (both propellers at the level), to the nearest 0.05 m/s — what the
+/// surge runs' mean speeds show in still water.
+pub fn otter_grid(vessel: &SurfaceVessel, effects: &Effects) -> Vec<f64> {
+    use seatrial_truth::usv::{OTTER_THRUST_N, UsvTrial};
+    UsvTrial::default()
+        .levels
+        .iter()
+        .map(|level| {
+            let u =
+                vessel.steady_surge_speed(2.0 * level * OTTER_THRUST_N, effects.quadratic_surge);
+            (u / 0.05).round() * 0.05
+        })
+        .collect()
+}
