@@ -51,6 +51,19 @@ impl Change {
         fit_gain(self.before, self.after)
     }
 
+    /// Whether the fit fell beyond noise: by more than [`FIT_NOISE`] of the
+    /// normalized error 1 − fit (at least [`FIT_NOISE`]), on the raw fits,
+    /// so a channel already below zero cannot get worse unseen (the gain's
+    /// floor at 0 would hide sway falling from −5.0 to −16.6); a fit lost
+    /// where there was one is worse.
+    fn is_worse(&self) -> bool {
+        match (self.before, self.after) {
+            (Some(b), Some(a)) => b - a > FIT_NOISE * (1.0 - b).max(1.0),
+            (Some(_), None) => true,
+            (None, _) => false,
+        }
+    }
+
     fn text(&self) -> String {
         let f = |v: Option<f64>| v.map_or("no fit".to_string(), |x| format!("{x:.3}"));
         format!(
@@ -151,7 +164,10 @@ pub fn compare_against(
             reason: format!("{} ({against} did not diverge)", diverged.join("; ")),
         };
     }
-    let mut worse: Vec<&Change> = all.iter().filter(|c| c.gain() < -FIT_NOISE).collect();
+    let mut worse: Vec<&Change> = all
+        .iter()
+        .filter(|c| c.gain() < -FIT_NOISE || c.is_worse())
+        .collect();
     worse.sort_by(|x, y| x.gain().total_cmp(&y.gain()));
     if !worse.is_empty() {
         let shown: Vec<String> = worse.iter().take(3).map(|c| c.text()).collect();
@@ -276,6 +292,38 @@ mod tests {
         let mut within_noise = better.clone();
         shift(&mut within_noise, "r", -0.5 * FIT_NOISE);
         assert!(compare_held_out(&base, &within_noise).keep);
+    }
+
+    #[test]
+    fn a_channel_below_zero_that_falls_further_is_worse() {
+        let base = held_out();
+        let set = |v: &mut [RunValidation], sway: f64, surge_gain: f64| {
+            for r in v.iter_mut() {
+                for c in r.report.channels.iter_mut() {
+                    match c.output.as_str() {
+                        "v" => c.fit_simulation = Some(sway),
+                        "u" => c.fit_simulation = c.fit_simulation.map(|f| f + surge_gain),
+                        _ => {}
+                    }
+                }
+            }
+        };
+        let mut before = base.clone();
+        set(&mut before, -4.97, 0.0);
+        let mut after = base.clone();
+        set(&mut after, -16.6, 0.05);
+        let v = compare_held_out(&before, &after);
+        assert!(!v.keep, "{}", v.text());
+        assert!(
+            v.text()
+                .contains("v on 'run-2' (whole-run free-run fit -4.970 → -16.600)"),
+            "{}",
+            v.text()
+        );
+        // Within the noise of its normalized error (1 − fit = 5.97): kept.
+        let mut close = base.clone();
+        set(&mut close, -4.99, 0.05);
+        assert!(compare_held_out(&before, &close).keep);
     }
 
     #[test]
