@@ -126,7 +126,7 @@ impl<'a> Prepared<'a> {
         let h = records.first()?.h;
         let svf = Svf::new(svf_t, h);
         let n = baseline.n();
-        let runs = records
+        let runs: Vec<PrepRun> = records
             .iter()
             .map(|rec| {
                 let mut p = PrepRun {
@@ -157,10 +157,12 @@ impl<'a> Prepared<'a> {
                 p
             })
             .collect();
+        let unforced = unforced_rows(&runs, baseline);
         let structure = (0..n)
             .map(|i| {
                 let mf = (0..n)
                     .filter(|&j| baseline.m[(i, j)] != 0.0 || i == j)
+                    .filter(|&j| !(j == i && unforced.contains(&i)))
                     .collect();
                 let df = (0..n)
                     .filter(|&j| baseline.d_bar[(i, j)] != 0.0 || i == j)
@@ -597,6 +599,34 @@ impl<'a> Prepared<'a> {
         v.sort_by(|a, b| a.total_cmp(b));
         v
     }
+}
+
+/// A row whose known force [λτ_i] − [λg_i] stays below this fraction of
+/// the baseline's own inertial and damping force in it, RMS over the runs,
+/// is taken as never forced.
+const UNFORCED_FRACTION: f64 = 1e-3;
+
+/// The rows no run forced (an underactuated vessel's sway, τ_Y = 0): their
+/// equation M_i· ν̇ + D̄_i· ν + θ φ = 0 is homogeneous and fits best with
+/// everything zero, so M_ii is held at the baseline's value (the scale the
+/// identification gave it) and the rest of the row is fitted against it.
+fn unforced_rows(runs: &[PrepRun], baseline: &Baseline) -> Vec<usize> {
+    (0..baseline.n())
+        .filter(|&i| {
+            let (mut tau, mut own, mut count) = (0.0, 0.0, 0usize);
+            for r in runs {
+                let (t, g) = (&r.lam_tau[i], &r.lam_g[i]);
+                let (a, v) = (&r.dlam_nu[i], &r.lam_nu[i]);
+                for k in 0..t.len().min(g.len()).min(a.len()).min(v.len()) {
+                    let f = baseline.m[(i, i)] * a[k] + baseline.d_bar[(i, i)] * v[k];
+                    tau += (t[k] - g[k]) * (t[k] - g[k]);
+                    own += f * f;
+                    count += 1;
+                }
+            }
+            count > 0 && own > 0.0 && tau <= UNFORCED_FRACTION * UNFORCED_FRACTION * own
+        })
+        .collect()
 }
 
 /// Smallest Cholesky pivot of the Jacobi-scaled normal matrix accepted as

@@ -206,3 +206,60 @@ fn fits_from_kept_baseline_blocks_equal_fresh_ones() {
         plain.theta
     );
 }
+
+/// Sway never forced (τ_Y = 0), moved only by yaw through the coupling
+/// D̄_vr: M_v v̇ + D_v v + D_vr r = 0, M_r ṙ + D_r r = τ_N. The sway row is
+/// homogeneous, so its mass is held at the baseline's and the row's
+/// damping comes back from the data instead of collapsing to zero.
+#[test]
+fn an_unforced_row_keeps_its_mass_and_fits_the_rest_against_it() {
+    let (mv, dv, dvr, mr, dr) = (160.0, 150.0, 40.0, 40.0, 45.0);
+    let (n, h, sub) = (3000, 0.1, 20);
+    let (mut tau, mut nu) = (DMatrix::zeros(n, 2), DMatrix::zeros(n, 2));
+    let (mut v, mut r) = (0.0_f64, 0.0_f64);
+    for k in 0..n {
+        let t = k as f64 * h;
+        let tn = 8.0 * (0.4 * t).sin() + 5.0 * (1.3 * t).sin();
+        nu[(k, 0)] = v;
+        nu[(k, 1)] = r;
+        tau[(k, 1)] = tn;
+        let dt = h / sub as f64;
+        for _ in 0..sub {
+            let vd = (-dv * v - dvr * r) / mv;
+            let rd = (tn - dr * r) / mr;
+            v += dt * vd;
+            r += dt * rd;
+        }
+    }
+    let records = [Record {
+        name: "turns".into(),
+        h,
+        tau,
+        nu,
+        eta: DMatrix::zeros(n, 6),
+    }];
+    let baseline = Baseline {
+        dofs: vec![Dof::Sway, Dof::Yaw],
+        m: DMatrix::from_row_slice(2, 2, &[mv, 0.0, 0.0, mr]),
+        d_bar: DMatrix::from_row_slice(2, 2, &[dv, dvr, 0.0, dr]),
+        restoring: Default::default(),
+        coriolis: None,
+        quadratic: None,
+    };
+    let prep = Prepared::new(&baseline, &records, 0.5, 10, 5).expect("prepared");
+    assert!(prep.structure[0].0.is_empty(), "sway's M_vv is held");
+    assert_eq!(prep.structure[1].0, vec![1], "yaw's M_rr is fitted");
+    let f = prep.fit(&[], &[0], &[0], false).expect("sway row");
+    let (m_free, d_free) = &f.base[0];
+    assert!(m_free.is_empty());
+    assert!(
+        (d_free[0] - dv).abs() < 0.02 * dv,
+        "D_v {} against {dv}",
+        d_free[0]
+    );
+    assert!(
+        (d_free[1] - dvr).abs() < 0.02 * dvr,
+        "D_vr {} against {dvr}",
+        d_free[1]
+    );
+}
