@@ -10,7 +10,7 @@ use super::error::IdentifyError;
 use super::intersample::logged_equivalent;
 use super::lambda_coriolis::document_inertia;
 use crate::discrepancy::model::{Drive, State, free_run, k_step};
-use crate::discrepancy::{AugmentedModel, Baseline, Record, Restoring};
+use crate::discrepancy::{AugmentedModel, Baseline, Effect, Record, Restoring};
 use crate::models::quadratic_damping::QuadraticDamping;
 use crate::models::{LpvModel, Scheduling};
 use crate::planning::dof::Dof;
@@ -138,6 +138,10 @@ pub struct AugmentedLpv {
     /// Index in `models` of the first grid point (where the model is
     /// scheduled without a surge DOF).
     first_grid: usize,
+    /// V = [V_N, V_E] (m/s) of a current the model carries (its first grid
+    /// point's term): the model is then scheduled on the forward speed
+    /// through the water u − u_c(ψ), as the identification's heading loop.
+    current: Option<[f64; 2]>,
 }
 
 impl AugmentedLpv {
@@ -175,6 +179,12 @@ impl AugmentedLpv {
                 }
             }
         }
+        let current = grid.iter().find_map(|m| {
+            m.terms
+                .iter()
+                .find(|t| t.effect == Effect::Current && t.coefficients.len() == 2)
+                .map(|t| [t.coefficients[0], t.coefficients[1]])
+        });
         below.reverse();
         let first_grid = below.len();
         let (speeds, models) = below
@@ -187,6 +197,7 @@ impl AugmentedLpv {
             models,
             surge: doc.dofs.iter().position(|d| *d == Dof::Surge),
             first_grid,
+            current,
         })
     }
 
@@ -215,8 +226,12 @@ impl AugmentedLpv {
 
     /// One scheduled step k → k+1 from `x`.
     fn step(&self, rec: &Record, drives: &[Drive], k: usize, x: &State) -> State {
+        let through_water = |u: f64| match (self.current, rec.eta.get((k, 5))) {
+            (Some(v), Some(psi)) => u - (v[0] * psi.cos() + v[1] * psi.sin()),
+            _ => u,
+        };
         let pair = match self.surge {
-            Some(j) if self.speeds.len() > 1 => self.weights(x.nu[j]),
+            Some(j) if self.speeds.len() > 1 => self.weights(through_water(x.nu[j])),
             _ => [(self.first_grid, 1.0), (self.first_grid, 0.0)],
         };
         let parts: Vec<(f64, State)> = pair
