@@ -9,6 +9,7 @@ use super::document::{LpvPoint, ModelDocument, from_rows};
 use super::error::IdentifyError;
 use super::intersample::logged_equivalent;
 use super::lambda_coriolis::document_inertia;
+use super::ned_current::surge_component;
 use crate::discrepancy::model::{Drive, State, free_run, k_step};
 use crate::discrepancy::{AugmentedModel, Baseline, Effect, Record, Restoring};
 use crate::models::quadratic_damping::QuadraticDamping;
@@ -227,7 +228,7 @@ impl AugmentedLpv {
     /// One scheduled step k → k+1 from `x`.
     fn step(&self, rec: &Record, drives: &[Drive], k: usize, x: &State) -> State {
         let through_water = |u: f64| match (self.current, rec.eta.get((k, 5))) {
-            (Some(v), Some(psi)) => u - (v[0] * psi.cos() + v[1] * psi.sin()),
+            (Some(v), Some(&psi)) => u - surge_component(v, psi),
             _ => u,
         };
         let pair = match self.surge {

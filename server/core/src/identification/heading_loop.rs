@@ -13,7 +13,7 @@
 
 use nalgebra::{DMatrix, DVector, Vector2};
 
-use super::ned_current::Relative;
+use super::ned_current::{Relative, surge_component};
 use crate::models::predict::no_prediction;
 use crate::models::{DiscreteLpv, LpvModel};
 use crate::planning::dof::Dof;
@@ -90,8 +90,7 @@ impl HeadingLoop {
     /// schedules the sub-models: each is linearized about its speed
     /// through the water.
     fn speed(&self, nu: &DVector<f64>, psi: f64) -> f64 {
-        let (s, c) = psi.sin_cos();
-        nu[self.surge] - (self.v[0] * c + self.v[1] * s)
+        nu[self.surge] - surge_component([self.v[0], self.v[1]], psi)
     }
 
     /// ν(k+1) and ψ(k+1) from ν(k), ψ(k) and τ(k).

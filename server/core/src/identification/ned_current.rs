@@ -256,6 +256,14 @@ pub(crate) fn force(d_bar: &DMatrix<f64>, dofs: &[Dof], v: &Vector2<f64>) -> DMa
     })
 }
 
+/// The current's surge component in the body frame,
+/// u_c(ψ) = V_N cos ψ + V_E sin ψ (m/s), V = [V_N, V_E]: the forward speed
+/// through the water is u − u_c(ψ).
+pub(crate) fn surge_component(v: [f64; 2], psi: f64) -> f64 {
+    let (s, c) = psi.sin_cos();
+    v[0] * c + v[1] * s
+}
+
 /// What a known current adds to the forces that drive a horizontal
 /// sub-model M ν̇ + D̄ ν + b = γ_eff at grid speed u₀ (see [`Relative::drive`]).
 #[derive(Debug, Clone)]
@@ -274,7 +282,7 @@ impl Relative {
     pub fn nu_c(&self, psi: f64) -> DVector<f64> {
         let (s, c) = psi.sin_cos();
         let (u_c, v_c) = (
-            self.v[0] * c + self.v[1] * s,
+            surge_component([self.v[0], self.v[1]], psi),
             -self.v[0] * s + self.v[1] * c,
         );
         DVector::from_iterator(

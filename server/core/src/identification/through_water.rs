@@ -14,6 +14,7 @@ use nalgebra::Vector2;
 
 use super::dataset::RunInput;
 use super::lambda_data::PointData;
+use super::ned_current::surge_component;
 use super::roles::{Roles, nearest_grid_index};
 use crate::numbers::sig3;
 
@@ -54,10 +55,9 @@ pub(crate) fn regrid(
             let rows = s.y.nrows();
             let (mut ground, mut water) = (0.0, 0.0);
             for k in 0..rows {
-                let (sn, cs) = s.u[(k, psi_col)].sin_cos();
                 let u = s.y[(k, surge)];
                 ground += u;
-                water += u - (v[0] * cs + v[1] * sn);
+                water += u - surge_component([v[0], v[1]], s.u[(k, psi_col)]);
             }
             let entry = match speeds.iter_mut().find(|e| e.id == s.run_id) {
                 Some(e) => e,
