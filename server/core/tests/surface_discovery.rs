@@ -22,7 +22,7 @@ use seatrial_core::planning::VesselProfile;
 use seatrial_core::planning::dof::Dof;
 use seatrial_truth::usv::{self, Current, Effects, SupplyTrial, UsvTrial, fly_usv_campaign};
 use support::surface::{
-    SurfaceReport, inputs, otter_case, otter_profile, supply_case, supply_profile,
+    SurfaceReport, inputs, otter_case, otter_grid, otter_profile, supply_case, supply_profile,
 };
 
 const SEEDS: [u64; 4] = [1, 2, 3, 4];
@@ -193,8 +193,49 @@ fn otter_discovered() -> &'static [Case] {
     })
 }
 
+/// The Otter with every hydrodynamic effect in a current of 0.05–0.3 m/s,
+/// identified with constant loads only (`ned_current: false`) on the
+/// crew's grid (the levels' steady speeds): the current is concealed from
+/// the baseline, which also holds runs at the grid point of their speed
+/// over ground.
+fn otter_concealed_current() -> &'static [Case] {
+    static CASES: std::sync::OnceLock<Vec<Case>> = std::sync::OnceLock::new();
+    CASES.get_or_init(|| {
+        let settings = LambdaCampaignSettings {
+            ned_current: false,
+            ..LambdaCampaignSettings::default()
+        };
+        SEEDS
+            .iter()
+            .map(|&seed| {
+                let vessel = usv::otter().draw(seed);
+                let effects = Effects::all(Current::random_constant(seed + 100, 0.05, 0.3));
+                let grid = otter_grid(&vessel, &effects);
+                let (report, base) = otter_case(
+                    "Otter all, current concealed",
+                    &vessel,
+                    effects,
+                    seed,
+                    &grid,
+                    &settings,
+                );
+                let trial = UsvTrial {
+                    effects,
+                    ..UsvTrial::default()
+                };
+                let profile = otter_profile(&vessel);
+                let runs = inputs(&profile, &fly_usv_campaign(&vessel, &trial, seed));
+                examine(report, base, &profile, &runs)
+            })
+            .collect()
+    })
+}
+
 fn all_cases() -> impl Iterator<Item = &'static Case> {
-    discovered().iter().chain(otter_discovered())
+    discovered()
+        .iter()
+        .chain(otter_discovered())
+        .chain(otter_concealed_current())
 }
 
 /// Where no hydrodynamic effect is concealed, discovery names nothing: the
@@ -271,4 +312,121 @@ fn the_identified_current_is_carried_not_named_again() {
             c.found.report.summary
         );
     }
+}
+
+/// A current the baseline does not carry is found once for the campaign:
+/// the first-named effect is a force fixed in NED pointing the current's
+/// way (within 10°), pooled over the grid speeds; named as the current,
+/// its speed is within 20 % and the way to a model that has it throughout
+/// is named (the identification's own current, which places runs by their
+/// speed through the water); named as a pull fixed in NED, the text names
+/// the current as its look-alike. Every grid point of a stored model holds
+/// the one value, and the refitted models are stored where the held-out
+/// runs are better with them. (Named as a pull on 3 of 4 seeds: the Otter's
+/// sway damping is cross-flow drag, not linear, so at one speed the
+/// current's force is as near a constant NED force as a linear-damping
+/// current; telling them apart across speeds is not built yet.)
+#[test]
+fn a_concealed_current_is_found_once_for_the_campaign() {
+    use seatrial_core::discrepancy::Effect;
+    let mut stored = 0;
+    for c in otter_concealed_current() {
+        let seed = c.report.seed;
+        let first = c
+            .found
+            .report
+            .effects
+            .first()
+            .unwrap_or_else(|| panic!("seed {seed}: nothing named"));
+        assert!(
+            matches!(first.effect, Effect::Current | Effect::TetherPull),
+            "seed {seed}: {:?}",
+            c.found.report.summary
+        );
+        // Pooled where two or more speeds named it; else the one speed's.
+        let values: Vec<f64> = match &first.campaign_estimate {
+            Some(once) => once.coefficients.iter().map(|c| c.value).collect(),
+            None => {
+                assert_eq!(first.grid_speeds_mps.len(), 1, "seed {seed}: not pooled");
+                c.found
+                    .report
+                    .points
+                    .iter()
+                    .flat_map(|p| &p.report.findings)
+                    .find(|f| f.effect == first.effect)
+                    .map(|f| f.coefficients.iter().map(|c| c.value).collect())
+                    .expect("the finding")
+            }
+        };
+        let (n, e) = (values[0], values[1]);
+        let (speed, dir) = c.report.current_true.expect("flown in a current");
+        let ddir = (e.atan2(n) - dir + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        println!(
+            "seed {seed}: current {:.3} m/s → {:.0}°; named first: {}, for the campaign {:.3} → {:.0}° ({:+.1}°); stored {}",
+            speed,
+            dir.to_degrees().rem_euclid(360.0),
+            first.label,
+            n.hypot(e),
+            e.atan2(n).to_degrees().rem_euclid(360.0),
+            ddir.to_degrees(),
+            c.found.augmented.is_some()
+        );
+        assert!(
+            ddir.abs() <= 10f64.to_radians(),
+            "seed {seed}: direction off by {ddir} rad"
+        );
+        if first.effect == Effect::Current {
+            let err = (n.hypot(e) - speed) / speed;
+            assert!(err.abs() <= 0.2, "seed {seed}: speed off by {err}");
+        }
+        // The re-identification the current calls for (with the runs it
+        // moves when the current was named; as the pull's look-alike else).
+        assert!(
+            c.found
+                .report
+                .summary
+                .iter()
+                .any(|l| l.contains("identified without a current")
+                    || l.contains("a current looks the same at one forward speed")),
+            "seed {seed}: {:?}",
+            c.found.report.summary
+        );
+        if let Some(aug) = c
+            .found
+            .augmented
+            .as_ref()
+            .filter(|_| first.campaign_estimate.is_some())
+        {
+            stored += 1;
+            let lpv = aug.document.lpv.as_ref().expect("LPV");
+            // Every grid point examined (one without held-out runs keeps
+            // the baseline's sub-model).
+            let examined: Vec<f64> = c
+                .found
+                .report
+                .points
+                .iter()
+                .map(|p| p.grid_speed_mps)
+                .collect();
+            for p in lpv
+                .points
+                .iter()
+                .filter(|p| examined.contains(&p.speed_mps))
+            {
+                let held = p
+                    .augmentation
+                    .as_ref()
+                    .and_then(|a| a.terms.iter().find(|t| t.effect == first.effect))
+                    .map(|t| &t.coefficients);
+                assert_eq!(
+                    held,
+                    Some(&vec![n, e]),
+                    "seed {seed} at {} m/s",
+                    p.speed_mps
+                );
+            }
+        }
+    }
+    assert!(stored >= 2, "{stored} of {} stored", SEEDS.len());
 }

@@ -268,6 +268,14 @@ impl Effect {
         }
     }
 
+    /// A force fixed in NED (a current, a pull). Its mean over a campaign
+    /// flown near one heading is a constant body-frame load, which a
+    /// baseline identified without it has absorbed into its constant loads:
+    /// those are refitted with it, or its mean would be counted twice.
+    pub fn fixed_in_ned(&self) -> bool {
+        matches!(self, Effect::Current | Effect::TetherPull)
+    }
+
     /// It changes the force acting in `dof` (actuator effects).
     pub fn acts_on(&self, dof: Dof) -> bool {
         self.shape().is_some()

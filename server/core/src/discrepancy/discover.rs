@@ -13,8 +13,8 @@ use super::locate::{
     Predictions, capital, channel_fits, force_residual, locate, predict, residual,
 };
 use super::lookalike::{Selection, look_alikes};
-use super::model::AugmentedModel;
-use super::narrate::{hypothesis, plot_series, rows_of, summary, unexplained};
+use super::model::{AugmentedModel, ModelTerm};
+use super::narrate::{hypothesis, plot_series, summary, unexplained};
 use super::report::*;
 use super::residual::whiteness;
 use super::select::{Criteria, Scored, step};
@@ -225,9 +225,7 @@ pub fn discover_from(
         .map(|r| r.h)
         .find(|h| h.is_finite() && *h > 0.0)
         .unwrap_or(estimation_runs[0].h);
-    let skip = ((5.0 * settings.svf_time_constant_s / h).ceil() as usize)
-        .max((settings.max_delay_s / h).ceil() as usize + 1)
-        .max(settings.k_step);
+    let skip = transient(settings, h);
     let min_len = skip + settings.k_step + 64;
     // One bad or short run is set aside with its reason; only a set with
     // no usable run fails.
@@ -286,13 +284,7 @@ pub fn discover_from(
 
     check(progress, 0.1, "filtering the runs")?;
     let hac_lags = ((settings.hac_window_s / h).ceil() as usize).max(1);
-    let prep = Prepared::new(baseline, &est, settings.svf_time_constant_s, skip, hac_lags)
-        .ok_or_else(|| {
-            DiscoveryError::invalid(
-                "estimation_runs",
-                "no samples left after the filter transient",
-            )
-        })?;
+    let prep = prepare(baseline, &est, settings, skip, hac_lags)?;
     let lib = library(
         &baseline.dofs,
         &baseline.m,
@@ -362,36 +354,7 @@ pub fn discover_from(
             .map(|t| t.shape_std)
             .chain(winners.iter().map(|w| w.shape_std))
             .collect();
-        // Three fits of the chosen terms: couplings of the touched rows held,
-        // free, or every row refitted (a baseline that absorbed the effect
-        // through its couplings in other rows gives it back).
-        let all_rows: Vec<usize> = (0..n).collect();
-        let fit_variant = |v: usize, hac: bool| match v {
-            0 => prep.fit_for_model(chosen, &runs, hac),
-            1 => prep.fit(chosen, &[], &runs, hac),
-            _ => prep.fit(chosen, &all_rows, &runs, hac),
-        };
-        let fitted: Vec<&Record> = est.iter().collect();
-        let base_on_fitted: Vec<Predictions> =
-            fitted.iter().map(|r| predict(&base_model, r, k)).collect();
-        // A variant whose M is not positive definite is not a vessel: it is
-        // taken only when no variant is.
-        let mut best: Option<(usize, (bool, f64, f64))> = None;
-        for v in 0..3 {
-            let Some(f) = fit_variant(v, false) else {
-                continue;
-            };
-            let candidate = prep.model(chosen, &f, &[]);
-            let (harm, gain) = change_score(&base_on_fitted, &candidate, &fitted, k);
-            let score = (candidate.inertia_positive(), harm, gain);
-            if best.is_none_or(|(_, b)| score > b) {
-                best = Some((v, score));
-            }
-        }
-        best.and_then(|(v, _)| fit_variant(v, true)).map_or_else(
-            || base_model.clone(),
-            |f| prep.model(chosen, &f, &shape_std),
-        )
+        fit_chosen(&prep, &base_model, &est, chosen, &shape_std, k)
     };
     let mut model = fit_model(&chosen, &winners);
 
@@ -643,21 +606,150 @@ pub fn discover_from(
         hypotheses,
         findings,
         current_drift,
-        model: ModelReport {
-            dofs: model.dofs.clone(),
-            m: rows_of(&model.m),
-            d_bar: rows_of(&model.d_bar),
-            restoring: model.restoring,
-            terms: model.terms.clone(),
-            m_ref: rows_of(&model.m_ref),
-            d_ref: rows_of(&model.d_ref),
-        },
+        model: ModelReport::of(&model),
         validation,
         plots,
         ambiguities,
         unexplained,
         carried,
     })
+}
+
+/// Samples dropped at the start of each run: the filter transient, the
+/// longest input delay tried, the k-step horizon.
+fn transient(settings: &DiscoverySettings, h: f64) -> usize {
+    ((5.0 * settings.svf_time_constant_s / h).ceil() as usize)
+        .max((settings.max_delay_s / h).ceil() as usize + 1)
+        .max(settings.k_step)
+}
+
+/// The runs filtered for the fits ([`Prepared::new`]).
+fn prepare<'a>(
+    baseline: &'a Baseline,
+    est: &'a [Record],
+    settings: &DiscoverySettings,
+    skip: usize,
+    hac_lags: usize,
+) -> Result<Prepared<'a>, DiscoveryError> {
+    Prepared::new(baseline, est, settings.svf_time_constant_s, skip, hac_lags).ok_or_else(|| {
+        DiscoveryError::invalid(
+            "estimation_runs",
+            "no samples left after the filter transient",
+        )
+    })
+}
+
+/// The model of the terms `chosen` fitted on every run of `prep`: three
+/// fits — the touched rows' couplings held, free, or every row refitted (a
+/// baseline that absorbed the effect through its couplings in other rows
+/// gives it back) — of which the one that harms the estimation runs' fits
+/// least, then gains most, is kept; a fit whose M is not positive definite
+/// is not a vessel and is taken only when no fit is. `base_model` when
+/// nothing can be fitted.
+pub(crate) fn fit_chosen(
+    prep: &Prepared<'_>,
+    base_model: &AugmentedModel,
+    est: &[Record],
+    chosen: &[Spec],
+    shape_std: &[Option<f64>],
+    k: usize,
+) -> AugmentedModel {
+    let n = prep.baseline.n();
+    let runs: Vec<usize> = (0..est.len()).collect();
+    let all_rows: Vec<usize> = (0..n).collect();
+    let fit_variant = |v: usize, hac: bool| match v {
+        0 => prep.fit_for_model(chosen, &runs, hac),
+        1 => prep.fit(chosen, &[], &runs, hac),
+        _ => prep.fit(chosen, &all_rows, &runs, hac),
+    };
+    let fitted: Vec<&Record> = est.iter().collect();
+    let base_on_fitted: Vec<Predictions> =
+        fitted.iter().map(|r| predict(base_model, r, k)).collect();
+    let mut best: Option<(usize, (bool, f64, f64))> = None;
+    for v in 0..3 {
+        let Some(f) = fit_variant(v, false) else {
+            continue;
+        };
+        let candidate = prep.model(chosen, &f, &[]);
+        let (harm, gain) = change_score(&base_on_fitted, &candidate, &fitted, k);
+        let score = (candidate.inertia_positive(), harm, gain);
+        if best.is_none_or(|(_, b)| score > b) {
+            best = Some((v, score));
+        }
+    }
+    best.and_then(|(v, _)| fit_variant(v, true))
+        .map_or_else(|| base_model.clone(), |f| prep.model(chosen, &f, shape_std))
+}
+
+/// The terms of `start` and `terms` refitted on `estimation_runs` with the
+/// coefficients of `held` fixed: a force the campaign shares (a current, a
+/// pull fixed in NED), estimated once for it, enters each grid speed's
+/// model at that value, and M, D̄ and the speed's other terms are fitted
+/// around it as [`discover_from`] fits its chosen terms. A run too short or
+/// malformed is left out (as `discover_from` sets it aside).
+///
+/// # Errors
+/// [`DiscoveryError::Invalid`] for a malformed start model or settings, or
+/// when no run is usable.
+pub fn refit_holding(
+    start: &AugmentedModel,
+    estimation_runs: &[Record],
+    settings: &DiscoverySettings,
+    terms: &[ModelTerm],
+    held: &[ModelTerm],
+) -> Result<AugmentedModel, DiscoveryError> {
+    let baseline = &start.baseline();
+    baseline.validate()?;
+    settings.validate()?;
+    let n = baseline.n();
+    let h = estimation_runs
+        .iter()
+        .map(|r| r.h)
+        .find(|h| h.is_finite() && *h > 0.0)
+        .ok_or_else(|| DiscoveryError::invalid("estimation_runs", "at least one run is needed"))?;
+    let skip = transient(settings, h);
+    let min_len = skip + settings.k_step + 64;
+    let est: Vec<Record> = estimation_runs
+        .iter()
+        .enumerate()
+        .filter(|(i, r)| {
+            r.validate(n, min_len, &format!("estimation_runs[{i}]"))
+                .is_ok()
+                && (r.h - h).abs() <= 1e-9 * h
+        })
+        .map(|(_, r)| r.clone())
+        .collect();
+    if est.is_empty() {
+        return Err(DiscoveryError::invalid(
+            "estimation_runs",
+            "no run long enough to refit on",
+        ));
+    }
+    let hac_lags = ((settings.hac_window_s / h).ceil() as usize).max(1);
+    let prep = prepare(baseline, &est, settings, skip, hac_lags)?.holding(held.to_vec());
+    // The start's terms, then the others; a held effect once.
+    let mut all: Vec<&ModelTerm> = Vec::new();
+    for t in start.terms.iter().chain(terms).chain(held) {
+        if !all.iter().any(|a| a.effect == t.effect) {
+            all.push(t);
+        }
+    }
+    let chosen: Vec<Spec> = all
+        .iter()
+        .map(|t| Spec {
+            effect: t.effect,
+            shape: t.shape,
+        })
+        .collect();
+    let shape_std: Vec<Option<f64>> = all.iter().map(|t| t.shape_std).collect();
+    Ok(fit_chosen(
+        &prep,
+        start,
+        &est,
+        &chosen,
+        &shape_std,
+        settings.k_step,
+    ))
 }
 
 /// A change of an NRMSE fit (1 − NRMSE) below this is noise.

@@ -38,6 +38,8 @@ pub(crate) struct PrepRun {
     dlam_nu: Vec<Vec<f64>>,
     lam_tau: Vec<Vec<f64>>,
     lam_g: Vec<Vec<f64>>,
+    /// [λ1]: a constant load's filtered regressor.
+    lam_one: Vec<f64>,
 }
 
 /// Everything the fits share: the runs, their filtered signals, the
@@ -53,6 +55,9 @@ pub(crate) struct Prepared<'a> {
     structure: Vec<(Vec<usize>, Vec<usize>)>,
     /// The baseline's M and D̄ are held, not refitted ([`Self::frozen`]).
     frozen: bool,
+    /// Terms whose coefficients are held ([`Self::holding`]): a force
+    /// shared by the campaign, estimated once for it.
+    held: Vec<ModelTerm>,
     /// 1/σ_i of the baseline's equation error per row.
     pub weights: Vec<f64>,
     /// Long-run variance inflation of the residuals (≥ 1).
@@ -101,11 +106,20 @@ pub(crate) struct FitOut {
     pub d_ref: DMatrix<f64>,
     /// M the C(ν)ν regressors were built with.
     pub m_ref: DMatrix<f64>,
+    /// Per row of `rows`: the change of its constant load b, refitted with
+    /// a force fixed in NED ([`Effect::fixed_in_ned`]); `None` when held.
+    pub loads: Vec<Option<f64>>,
+    /// Per spec: its coefficients were held ([`Prepared::holding`]), not
+    /// fitted.
+    pub held: Vec<bool>,
 }
 
 impl FitOut {
     /// HAC covariance of spec `s`'s coefficients.
     pub fn theta_cov(&self, s: usize) -> Option<DMatrix<f64>> {
+        if self.held.get(s).copied().unwrap_or(false) {
+            return None;
+        }
         let cov = self.cov.as_ref()?;
         let k = self.theta.get(s)?.len();
         let i = self.theta_index[s] - self.theta_index[0];
@@ -135,6 +149,7 @@ impl<'a> Prepared<'a> {
                     dlam_nu: vec![],
                     lam_tau: vec![],
                     lam_g: vec![],
+                    lam_one: svf.zoh(&vec![1.0; rec.len()]),
                 };
                 // g(η) and, when the baseline carries it, C(δ)δ at the
                 // measured ν: the forces the baseline already explains.
@@ -178,6 +193,7 @@ impl<'a> Prepared<'a> {
             runs,
             structure,
             frozen: false,
+            held: vec![],
             weights: vec![1.0; n],
             kappa: 1.0,
             hac_lags,
@@ -211,6 +227,20 @@ impl<'a> Prepared<'a> {
             *s = (vec![], vec![]);
         }
         self
+    }
+
+    /// The same runs with the coefficients of `terms` held: a spec of one
+    /// of their effects adds its force at those values to the known side
+    /// and fits nothing of its own (M, D̄ and the other terms are fitted
+    /// around it).
+    pub fn holding(mut self, terms: Vec<ModelTerm>) -> Self {
+        self.held = terms;
+        self
+    }
+
+    /// The held coefficients of `effect`, if it is held.
+    fn held_values(&self, effect: Effect) -> Option<&ModelTerm> {
+        self.held.iter().find(|t| t.effect == effect)
     }
 
     /// Columns of row `r` a fit of `rows` frees: the baseline's free
@@ -352,8 +382,23 @@ impl<'a> Prepared<'a> {
         let mut theta_index = Vec::with_capacity(specs.len());
         for s in specs {
             theta_index.push(p);
-            p += s.effect.n_linear();
+            if self.held_values(s.effect).is_none() {
+                p += s.effect.n_linear();
+            }
         }
+        // The constant loads of the rows, after the terms' θ, when a force
+        // fixed in NED is fitted (not when M, D̄ are held: a short window's
+        // heading barely turns, and the force would be the load).
+        let free_loads = !self.frozen && specs.iter().any(|s| s.effect.fixed_in_ned());
+        let load_index: Vec<Option<usize>> = rows
+            .iter()
+            .map(|_| {
+                free_loads.then(|| {
+                    p += 1;
+                    p - 1
+                })
+            })
+            .collect();
         let ctx = TermContext { dofs, m_ref, d_ref };
         let mut hmat = DMatrix::<f64>::zeros(p, p);
         let mut bvec = vec![0.0; p];
@@ -380,14 +425,36 @@ impl<'a> Prepared<'a> {
                     }
                 });
                 let (mf, df) = &freed[ri];
-                let bb = self.base_block(run, r, w, mf, df, lam_tau_a);
+                let mut bb = self.base_block(run, r, w, mf, df, lam_tau_a);
+                // Held terms' forces go to the known side.
+                let held: Vec<&ModelTerm> = specs
+                    .iter()
+                    .filter_map(|s| self.held_values(s.effect))
+                    .filter(|t| t.effect.rows(dofs, &self.baseline.d_bar).contains(&r))
+                    .collect();
+                if !held.is_empty() {
+                    let mut y = bb.y.as_ref().clone();
+                    for t in &held {
+                        for (pi, c) in t.coefficients.iter().enumerate() {
+                            let f = self.filtered_regressor(t.effect, pi, r, run, &ctx);
+                            for (yk, fk) in y.iter_mut().zip(&f[self.skip..]) {
+                                *yk -= c * w * fk;
+                            }
+                        }
+                    }
+                    bb.by = blocks::products(&y, &bb.cols);
+                    bb.y = Rc::new(y);
+                }
                 let nb = bb.cols.len();
                 let y = Rc::clone(&bb.y);
                 let mut idx: Vec<usize> = (base_index[ri]..base_index[ri] + nb).collect();
                 let mut cols: Vec<Rc<Vec<f64>>> = bb.cols.clone();
                 for (si, s) in specs.iter().enumerate() {
                     let nl = s.effect.n_linear();
-                    if nl == 0 || !s.effect.rows(dofs, &self.baseline.d_bar).contains(&r) {
+                    if nl == 0
+                        || self.held_values(s.effect).is_some()
+                        || !s.effect.rows(dofs, &self.baseline.d_bar).contains(&r)
+                    {
                         continue;
                     }
                     if let Effect::Coupling { from, .. } = s.effect {
@@ -403,6 +470,10 @@ impl<'a> Prepared<'a> {
                         idx.push(theta_index[si] + pi);
                         cols.push(Rc::new(weighted(&f[self.skip..], w)));
                     }
+                }
+                if let Some(li) = load_index[ri] {
+                    idx.push(li);
+                    cols.push(Rc::new(weighted(&pr.lam_one[self.skip..], w)));
                 }
                 // The baseline block's products come from the cache; the
                 // terms' columns are multiplied with every column.
@@ -519,7 +590,18 @@ impl<'a> Prepared<'a> {
         let theta = specs
             .iter()
             .zip(&theta_index)
-            .map(|(s, &i)| theta_all[i..i + s.effect.n_linear()].to_vec())
+            .map(|(s, &i)| match self.held_values(s.effect) {
+                Some(t) => t.coefficients.clone(),
+                None => theta_all[i..i + s.effect.n_linear()].to_vec(),
+            })
+            .collect();
+        let held = specs
+            .iter()
+            .map(|s| self.held_values(s.effect).is_some())
+            .collect();
+        let loads = load_index
+            .iter()
+            .map(|li| li.map(|i| theta_all[i]))
             .collect();
         Some(FitOut {
             rows,
@@ -533,6 +615,8 @@ impl<'a> Prepared<'a> {
             block_rows,
             d_ref: d_ref.clone(),
             m_ref: m_ref.clone(),
+            loads,
+            held,
         })
     }
 
@@ -541,8 +625,21 @@ impl<'a> Prepared<'a> {
     pub fn model(&self, specs: &[Spec], f: &FitOut, shape_std: &[Option<f64>]) -> AugmentedModel {
         let b = self.baseline;
         let (m, d) = self.refitted(specs, f, &b.m, &b.d_bar);
+        let mut restoring = b.restoring;
+        for (&r, load) in f.rows.iter().zip(&f.loads) {
+            if let Some(db) = load {
+                restoring.constant[b.dofs[r].index()] += db;
+            }
+        }
         let mut terms = Vec::with_capacity(specs.len());
         for (si, s) in specs.iter().enumerate() {
+            if let Some(t) = self.held_values(s.effect) {
+                terms.push(ModelTerm {
+                    shape: s.shape,
+                    ..t.clone()
+                });
+                continue;
+            }
             let covariance = f
                 .theta_cov(si)
                 .map(|c| {
@@ -563,7 +660,7 @@ impl<'a> Prepared<'a> {
             b.dofs.clone(),
             m,
             d,
-            b.restoring,
+            restoring,
             f.m_ref.clone(),
             f.d_ref.clone(),
             terms,
@@ -601,25 +698,30 @@ impl<'a> Prepared<'a> {
     }
 }
 
-/// A row whose known force [λτ_i] − [λg_i] stays below this fraction of
-/// the baseline's own inertial and damping force in it, RMS over the runs,
-/// is taken as never forced.
+/// A row whose known force [λτ_i] − [λg_i] (without its constant load)
+/// stays below this fraction of the baseline's own inertial and damping
+/// force in it, RMS over the runs, is taken as never forced.
 const UNFORCED_FRACTION: f64 = 1e-3;
 
 /// The rows no run forced (an underactuated vessel's sway, τ_Y = 0): their
 /// equation M_i· ν̇ + D̄_i· ν + θ φ = 0 is homogeneous and fits best with
 /// everything zero, so M_ii is held at the baseline's value (the scale the
 /// identification gave it) and the rest of the row is fitted against it.
+/// A constant load does not force the row: it is the offset of the
+/// damping's linearization, or a force fixed in NED the baseline absorbed,
+/// and is refitted with such a force.
 fn unforced_rows(runs: &[PrepRun], baseline: &Baseline) -> Vec<usize> {
     (0..baseline.n())
         .filter(|&i| {
+            let b = baseline.restoring.constant[baseline.dofs[i].index()];
             let (mut tau, mut own, mut count) = (0.0, 0.0, 0usize);
             for r in runs {
-                let (t, g) = (&r.lam_tau[i], &r.lam_g[i]);
+                let (t, g, one) = (&r.lam_tau[i], &r.lam_g[i], &r.lam_one);
                 let (a, v) = (&r.dlam_nu[i], &r.lam_nu[i]);
                 for k in 0..t.len().min(g.len()).min(a.len()).min(v.len()) {
                     let f = baseline.m[(i, i)] * a[k] + baseline.d_bar[(i, i)] * v[k];
-                    tau += (t[k] - g[k]) * (t[k] - g[k]);
+                    let known = t[k] - g[k] + b * one[k];
+                    tau += known * known;
                     own += f * f;
                     count += 1;
                 }

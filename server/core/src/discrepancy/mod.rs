@@ -145,7 +145,7 @@ pub mod svf;
 
 pub use candidates::{Effect, Family, LibrarySettings, RestoringShape};
 pub use data::{Baseline, Record, Restoring};
-pub use discover::{DiscoverySettings, discover, discover_from};
+pub use discover::{DiscoverySettings, discover, discover_from, refit_holding};
 pub use error::DiscoveryError;
 pub use experiment::ExperimentProposal;
 pub use model::{AugmentedModel, ModelTerm};

@@ -15,12 +15,6 @@ use super::residual::{BandPower, residual_spectrum};
 use super::select::{Criteria, Scored};
 use crate::numbers::sig3;
 
-pub(super) fn rows_of(m: &nalgebra::DMatrix<f64>) -> Vec<Vec<f64>> {
-    (0..m.nrows())
-        .map(|i| m.row(i).iter().copied().collect())
-        .collect()
-}
-
 pub(super) fn hypothesis(
     s: &Scored,
     step: usize,

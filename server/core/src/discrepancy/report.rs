@@ -192,6 +192,26 @@ pub struct ModelReport {
     pub d_ref: Vec<Vec<f64>>,
 }
 
+impl ModelReport {
+    /// The report of a fitted model.
+    pub fn of(model: &super::AugmentedModel) -> Self {
+        let rows = |m: &nalgebra::DMatrix<f64>| {
+            (0..m.nrows())
+                .map(|i| m.row(i).iter().copied().collect())
+                .collect()
+        };
+        ModelReport {
+            dofs: model.dofs.clone(),
+            m: rows(&model.m),
+            d_bar: rows(&model.d_bar),
+            restoring: model.restoring,
+            terms: model.terms.clone(),
+            m_ref: rows(&model.m_ref),
+            d_ref: rows(&model.d_ref),
+        }
+    }
+}
+
 /// Everything discovery found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]

@@ -89,6 +89,11 @@ pub struct EffectAcrossGrid {
     /// Why it was kept or left out, with the deciding held-out fits.
     #[serde(default)]
     pub held_out_verdict: Option<String>,
+    /// A force the campaign shares (a current, a pull fixed in NED): its
+    /// one estimate, pooled over the grid speeds, at which every speed's
+    /// model holds it (`null` for effects that may vary with speed).
+    #[serde(default)]
+    pub campaign_estimate: Option<CampaignEstimate>,
 }
 
 impl EffectAcrossGrid {
@@ -396,10 +401,48 @@ pub fn discover_campaign(
         .collect();
 
     let mut effects = effects_across(&points);
+    // Forces the campaign shares: one estimate, held at every grid speed.
+    let pooled = shared::pool_all(&points);
+    let mut shared_notes = Vec::new();
+    for (term, estimate) in &pooled {
+        match effects.iter_mut().find(|e| e.effect == term.effect) {
+            Some(e) => e.campaign_estimate = Some(estimate.clone()),
+            None => shared_notes.push(estimate.text.clone()),
+        }
+    }
+    // A current found (pooled, or at the one speed that found it) that the
+    // model was identified without.
+    let found_current = pooled
+        .iter()
+        .map(|(t, _)| t)
+        .chain(points.iter().flat_map(|p| &p.report.model.terms))
+        .find(|t| t.effect == Effect::Current && t.coefficients.len() == 2)
+        .filter(|_| effects.iter().any(|e| e.effect == Effect::Current));
+    if let Some(t) = found_current {
+        let v = [t.coefficients[0], t.coefficients[1]];
+        shared_notes.extend(shared::reidentify_note(doc, runs, est_ids, &grid, v));
+    } else if effects.iter().any(|e| e.effect == Effect::TetherPull) {
+        shared_notes.extend(shared::pull_or_current_note(doc));
+    }
+    let assembled = if pooled.is_empty() {
+        None
+    } else {
+        progress.update(
+            0.9,
+            "refitting every grid speed with the shared forces held",
+        )?;
+        let mut out = Vec::with_capacity(points.len());
+        for (k, p) in points.iter().enumerate() {
+            let i = todo[k];
+            let start = augmented_at(doc, &lpv.points[i])?;
+            out.push(shared::held_at(p, &start, &est[i].0, &dset, &pooled)?);
+        }
+        Some(out)
+    };
     progress.update(0.9, "validating the baseline on the held-out runs")?;
     let asm = Assembly {
         doc,
-        points: &points,
+        points: assembled.as_deref().unwrap_or(&points),
         forces,
         runs,
         est_ids,
@@ -420,6 +463,7 @@ pub fn discover_campaign(
         (gate.model, Some(gate.overall.text()))
     };
     let mut summary = summarize(&points, &effects, &skipped);
+    summary.extend(shared_notes);
     summary.extend(overall);
     summary.extend(filter_note);
     let augmented = augmented.map(|mut a| {
@@ -449,6 +493,7 @@ fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
                 held_out_gains: vec![],
                 kept: None,
                 held_out_verdict: None,
+                campaign_estimate: None,
             });
             e.grid_speeds_mps.push(p.grid_speed_mps);
             let gain = p
@@ -552,8 +597,13 @@ fn summarize(
             (Some(false), Some(v)) => format!(" Left out: {v}."),
             _ => String::new(),
         };
+        let once = e
+            .campaign_estimate
+            .as_ref()
+            .map(|c| format!(" {}", c.text))
+            .unwrap_or_default();
         out.push(format!(
-            "{}: named {scope}; {range}; held-out fit gained {:.3} (summed over speeds and channels).{gate}",
+            "{}: named {scope}; {range}; held-out fit gained {:.3} (summed over speeds and channels).{once}{gate}",
             e.label,
             e.evidence()
         ));
@@ -645,7 +695,10 @@ fn summarize(
 
 mod assemble;
 mod keep;
+mod shared;
 mod start;
+
+pub use shared::CampaignEstimate;
 
 use assemble::Assembly;
 use keep::keep_better;

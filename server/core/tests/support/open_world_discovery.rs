@@ -81,6 +81,12 @@ pub struct DiscoveryCase {
     /// The first-named effect's values (coefficients, then shape) at each
     /// grid speed that chose it.
     pub first_values: Vec<Vec<f64>>,
+    /// The first-named effect's one estimate for the campaign, when it is a
+    /// force the campaign shares (coefficients).
+    pub campaign_values: Option<Vec<f64>>,
+    /// Per grid point of the stored model: the coefficients of its term of
+    /// the first-named effect (`None` where it has none).
+    pub stored_values: Vec<Option<Vec<f64>>>,
     /// Per named effect (same order): whether the stored model keeps it,
     /// and the held-out verdict that decided it.
     pub kept: Vec<(Option<bool>, Option<String>)>,
@@ -249,6 +255,31 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
                 .collect()
         })
         .unwrap_or_default();
+    let campaign_values = out
+        .report
+        .effects
+        .first()
+        .and_then(|e| e.campaign_estimate.as_ref())
+        .map(|c| c.coefficients.iter().map(|c| c.value).collect());
+    let stored_values = match (&out.augmented, out.report.effects.first()) {
+        (Some(a), Some(e)) => a
+            .document
+            .lpv
+            .as_ref()
+            .map(|l| {
+                l.points
+                    .iter()
+                    .map(|p| {
+                        p.augmentation
+                            .as_ref()
+                            .and_then(|a| a.terms.iter().find(|t| t.effect == e.effect))
+                            .map(|t| t.coefficients.clone())
+                    })
+                    .collect()
+            })
+            .unwrap_or_default(),
+        _ => vec![],
+    };
     let kept = out
         .report
         .effects
@@ -353,6 +384,8 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
             _ => concealed.truth_text(&vessel),
         },
         first_values,
+        campaign_values,
+        stored_values,
         truth_values: out
             .report
             .effects

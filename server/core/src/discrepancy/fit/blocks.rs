@@ -122,7 +122,7 @@ impl Prepared<'_> {
 }
 
 /// `cᵀy` for every column c.
-fn products(y: &[f64], cols: &[Rc<Vec<f64>>]) -> Vec<f64> {
+pub(super) fn products(y: &[f64], cols: &[Rc<Vec<f64>>]) -> Vec<f64> {
     let ys: Vec<&[f64]> = cols.iter().map(|c| c.as_slice()).collect();
     let mut out = vec![0.0; ys.len()];
     crate::kernels::dots(y, &ys, &mut out);

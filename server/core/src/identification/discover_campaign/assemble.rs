@@ -6,6 +6,7 @@ use std::collections::BTreeSet;
 
 use nalgebra::DMatrix;
 
+use super::super::augmented::load_of;
 use super::super::dataset::RunInput;
 use super::super::document::ModelDocument;
 use super::super::document::{Method, ParameterRow, PointAugmentation, to_rows};
@@ -93,6 +94,16 @@ impl Assembly<'_> {
                     format!("augmented M at {} m/s is singular", p.grid_speed_mps),
                 )
             })?;
+            // A force fixed in NED is refitted with the constant loads it
+            // had been absorbed into.
+            let load: Vec<f64> = doc
+                .dofs
+                .iter()
+                .map(|d| model.restoring.constant[d.index()])
+                .collect();
+            if load != load_of(doc, pt).as_slice() {
+                pt.load = Some(load);
+            }
             pt.augmentation = Some(PointAugmentation {
                 m_ref: model.m_ref.clone(),
                 d_ref: model.d_ref.clone(),

@@ -1,0 +1,412 @@
+//! Forces the campaign shares, estimated once for it. A current or a pull
+//! fixed in NED acts at every forward speed alike, so the grid speeds'
+//! estimates of it are pooled by inverse covariance (the least-squares
+//! estimate of one value from independent estimates of it), and every grid
+//! speed's model is refitted with it held at that value: the LPV model then
+//! carries one current, not one per speed. Where the speeds' estimates
+//! scatter more than their standard deviations allow, the pooled standard
+//! deviation is widened by √(χ²/dof) (the Birge ratio) and the text says so.
+
+use nalgebra::{Matrix2, Vector2};
+use serde::{Deserialize, Serialize};
+
+use super::super::dataset::RunInput;
+use super::super::document::ModelDocument;
+use super::super::error::IdentifyError;
+use super::super::ned_current::{self, surge_component};
+use super::super::roles::nearest_grid_index;
+use super::PointDiscovery;
+use super::speeds_text;
+use crate::discrepancy::report::{Estimate, Finding, ModelReport};
+use crate::discrepancy::{
+    AugmentedModel, DiscoverySettings, Effect, ModelTerm, Record, refit_holding,
+};
+use crate::logs::schema::pose_column;
+use crate::numbers::sig3;
+use crate::planning::campaign::ExperimentFamily;
+use crate::planning::dof::Dof;
+
+/// One force the campaign shares, estimated once for it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
+pub struct CampaignEstimate {
+    /// Its coefficients ± std, pooled over the grid speeds.
+    pub coefficients: Vec<Estimate>,
+    /// Grid speeds (m/s) whose estimates were pooled.
+    pub grid_speeds_mps: Vec<f64>,
+    /// χ² of the speeds' estimates about the pooled one.
+    pub chi2: f64,
+    /// Its degrees of freedom (2 per speed beyond the first).
+    pub dof: usize,
+    /// Size and direction in words, and how the speeds agree.
+    pub text: String,
+}
+
+/// The 95 % point of χ² with `dof` degrees of freedom (Wilson–Hilferty;
+/// 5.93 for 2 against the exact 5.99): above it the speeds' estimates
+/// disagree, and the std is widened.
+fn chi2_95(dof: usize) -> f64 {
+    let k = dof as f64;
+    let a = 2.0 / (9.0 * k);
+    k * (1.0 - a + 1.645 * a.sqrt()).powi(3)
+}
+
+/// The pooled term of every NED-fixed effect that at least two grid
+/// speeds' models carry (chosen there, or carried from the model examined).
+pub(super) fn pool_all(points: &[PointDiscovery]) -> Vec<(ModelTerm, CampaignEstimate)> {
+    let terms: Vec<(f64, &ModelTerm)> = points
+        .iter()
+        .flat_map(|p| p.report.model.terms.iter().map(|t| (p.grid_speed_mps, t)))
+        .collect();
+    [Effect::Current, Effect::TetherPull]
+        .into_iter()
+        .filter_map(|e| pool(&terms, e))
+        .collect()
+}
+
+/// The inverse-covariance pool of `effect`'s [N, E] coefficients over the
+/// grid speeds' terms (speed, term) with a usable covariance.
+fn pool(terms: &[(f64, &ModelTerm)], effect: Effect) -> Option<(ModelTerm, CampaignEstimate)> {
+    let mut speeds = Vec::new();
+    let mut ests: Vec<(Vector2<f64>, Matrix2<f64>)> = Vec::new();
+    for &(speed, t) in terms.iter().filter(|(_, t)| t.effect == effect) {
+        let (Some(x), Some(c)) = (two(&t.coefficients), covariance(&t.covariance)) else {
+            continue;
+        };
+        let Some(w) = c.try_inverse().filter(|w| w.iter().all(|v| v.is_finite())) else {
+            continue;
+        };
+        speeds.push(speed);
+        ests.push((x, w));
+    }
+    if ests.len() < 2 {
+        return None;
+    }
+    let w_sum: Matrix2<f64> = ests.iter().map(|(_, w)| w).sum();
+    let cov = w_sum.try_inverse()?;
+    let wx: Vector2<f64> = ests.iter().map(|(x, w)| w * x).sum();
+    let mean = cov * wx;
+    let chi2: f64 = ests
+        .iter()
+        .map(|(x, w)| {
+            let d = x - mean;
+            (d.transpose() * w * d)[(0, 0)]
+        })
+        .sum();
+    let dof = 2 * (ests.len() - 1);
+    let ratio = chi2 / dof as f64;
+    let disagree = chi2 > chi2_95(dof);
+    let cov = if disagree { cov * ratio } else { cov };
+    if !(mean.iter().chain(cov.iter()).all(|v| v.is_finite())) {
+        return None;
+    }
+    let term = ModelTerm {
+        effect,
+        coefficients: vec![mean[0], mean[1]],
+        covariance: (0..2)
+            .map(|i| (0..2).map(|j| cov[(i, j)]).collect())
+            .collect(),
+        shape: None,
+        shape_std: None,
+    };
+    let names = effect.coefficient_names();
+    let coefficients = (0..2)
+        .map(|j| Estimate {
+            name: names.get(j).cloned().unwrap_or_default(),
+            value: mean[j],
+            std: Some(cov[(j, j)].sqrt()),
+        })
+        .collect();
+    let agreement = if disagree {
+        format!(
+            "the speeds' estimates scatter more than their standard deviations allow (χ² {} on {dof} degrees of freedom), so the standard deviation is widened {}×: the force changed during the campaign, or a speed's other terms traded against it",
+            sig3(chi2),
+            sig3(ratio.sqrt())
+        )
+    } else {
+        format!(
+            "the speeds' estimates agree within their standard deviations (χ² {} on {dof} degrees of freedom)",
+            sig3(chi2)
+        )
+    };
+    let text = format!(
+        "{} for the campaign: {}, pooled from the estimates at {} grid speeds ({} m/s); {agreement}. Every grid speed's model is refitted with it held there.",
+        capital_first(&effect.label()),
+        polar(effect, &mean, &cov),
+        ests.len(),
+        speeds_text(&speeds)
+    );
+    Some((
+        term,
+        CampaignEstimate {
+            coefficients,
+            grid_speeds_mps: speeds,
+            chi2,
+            dof,
+            text,
+        },
+    ))
+}
+
+/// Point `p` with the pooled terms held: its model refitted on its
+/// estimation runs with them at the campaign's values, its findings of
+/// them showing those values, and a finding added where the speed's own
+/// discovery had not named a shared force its start does not carry (the
+/// current acts at this speed too).
+pub(super) fn held_at(
+    p: &PointDiscovery,
+    start: &AugmentedModel,
+    est: &[Record],
+    settings: &DiscoverySettings,
+    pooled: &[(ModelTerm, CampaignEstimate)],
+) -> Result<PointDiscovery, IdentifyError> {
+    let is_shared = |e: Effect| pooled.iter().any(|(t, _)| t.effect == e);
+    let own: Vec<ModelTerm> = p
+        .report
+        .model
+        .terms
+        .iter()
+        .filter(|t| !is_shared(t.effect))
+        .cloned()
+        .collect();
+    let held: Vec<ModelTerm> = pooled.iter().map(|(t, _)| t.clone()).collect();
+    let model = refit_holding(start, est, settings, &own, &held).map_err(|e| {
+        IdentifyError::invalid(
+            e.field().to_string(),
+            format!("at grid speed {} m/s: {e}", p.grid_speed_mps),
+        )
+    })?;
+    let mut out = p.clone();
+    for (t, c) in pooled {
+        match out
+            .report
+            .findings
+            .iter_mut()
+            .find(|f| f.effect == t.effect)
+        {
+            Some(f) => {
+                f.coefficients = c.coefficients.clone();
+                f.evidence.push(c.text.clone());
+            }
+            None if !start.terms.iter().any(|s| s.effect == t.effect) => {
+                out.report.findings.push(Finding {
+                    effect: t.effect,
+                    label: t.effect.label(),
+                    dofs: t
+                        .effect
+                        .rows(&model.dofs, &model.d_ref)
+                        .into_iter()
+                        .map(|r| model.dofs[r])
+                        .collect(),
+                    coefficients: c.coefficients.clone(),
+                    shape: None,
+                    effect_text: c.text.clone(),
+                    evidence: vec![format!(
+                        "Not named by this speed's own discovery; a force fixed in NED acts at every speed, so it is held here at the campaign's estimate ({}).",
+                        c.text
+                    )],
+                });
+            }
+            None => {}
+        }
+    }
+    out.report.model = ModelReport::of(&model);
+    Ok(out)
+}
+
+/// When the examined model was identified without the current discovery
+/// pooled ([V_N, V_E] m/s), the way to a model that has it throughout: the
+/// identification's own current estimate, which also places each run at
+/// the grid point of its speed through the water u − u_c(ψ). Names the
+/// estimation runs (`est_ids`, no stated grid speed) that the current moves
+/// to another grid point. `None` when the model has a current or is not a
+/// horizontal (surge–sway–yaw) model.
+pub(super) fn reidentify_note(
+    doc: &ModelDocument,
+    runs: &[RunInput],
+    est_ids: &[String],
+    grid: &[f64],
+    v: [f64; 2],
+) -> Option<String> {
+    let lpv = doc.lpv.as_ref()?;
+    if lpv.current.is_some() || !ned_current::applies(&doc.dofs) {
+        return None;
+    }
+    let mut moved = Vec::new();
+    for r in runs
+        .iter()
+        .filter(|r| est_ids.contains(&r.run_id) && r.grid_speed_mps.is_none())
+        .filter(|r| r.family != Some(ExperimentFamily::Static))
+    {
+        let (Some(u), Some(psi)) = (
+            r.record.column(Dof::Surge.velocity_symbol()),
+            r.record.column(pose_column(Dof::Yaw)),
+        ) else {
+            continue;
+        };
+        let (mut ground, mut water, mut n) = (0.0, 0.0, 0usize);
+        for (u, psi) in u.iter().zip(psi) {
+            if u.is_finite() && psi.is_finite() {
+                ground += u;
+                water += u - surge_component(v, *psi);
+                n += 1;
+            }
+        }
+        if n == 0 {
+            continue;
+        }
+        let (ground, water) = (ground / n as f64, water / n as f64);
+        let (a, b) = (
+            nearest_grid_index(grid, ground),
+            nearest_grid_index(grid, water),
+        );
+        if a != b {
+            moved.push(format!(
+                "{} ({} m/s over ground, {} through the water: the {} m/s sub-model's, not the {} m/s one's)",
+                r.name,
+                sig3(ground),
+                sig3(water),
+                sig3(grid[b]),
+                sig3(grid[a])
+            ));
+        }
+    }
+    let why = if moved.is_empty() {
+        "it estimates the current together with M and D̄, once for the campaign, instead of fitting around damping that absorbed it".to_owned()
+    } else {
+        format!(
+            "it also places each run at the grid point of its speed through the water, which the hull's forces follow; this model holds runs at the grid point of their speed over ground: {}",
+            moved.join(", ")
+        )
+    };
+    Some(format!(
+        "The model was identified without a current. Identify the campaign again with the NED current estimated (`ned_current: true`, the default): {why}."
+    ))
+}
+
+/// A pull fixed in NED named on a horizontal model identified without a
+/// current: at one forward speed a current's force D̄·ν_c(ψ) turns with the
+/// heading as the pull does, so the text names the look-alike and how to
+/// test it.
+pub(super) fn pull_or_current_note(doc: &ModelDocument) -> Option<String> {
+    let lpv = doc.lpv.as_ref()?;
+    (lpv.current.is_none() && ned_current::applies(&doc.dofs)).then(|| {
+        "A force fixed in NED was named; a current looks the same at one forward speed (its force D̄·ν_c(ψ) turns with the heading too), and the model was identified without one. Unless the vessel was moored, towed or held in a steady wind, identify the campaign again with the NED current estimated (`ned_current: true`, the default) and compare the held-out fits.".to_owned()
+    })
+}
+
+fn capital_first(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
+}
+
+fn two(v: &[f64]) -> Option<Vector2<f64>> {
+    (v.len() == 2 && v.iter().all(|x| x.is_finite())).then(|| Vector2::new(v[0], v[1]))
+}
+
+fn covariance(c: &[Vec<f64>]) -> Option<Matrix2<f64>> {
+    if c.len() != 2 || c.iter().any(|r| r.len() != 2) {
+        return None;
+    }
+    let m = Matrix2::new(c[0][0], c[0][1], c[1][0], c[1][1]);
+    (m.iter().all(|v| v.is_finite()) && m[(0, 0)] > 0.0 && m[(1, 1)] > 0.0).then_some(m)
+}
+
+/// Size and direction (towards, degrees from north) ± std of a vector
+/// [N, E] with covariance `cov`, by the first-order propagation through
+/// |v| and atan2(E, N).
+fn polar(effect: Effect, v: &Vector2<f64>, cov: &Matrix2<f64>) -> String {
+    let size = v.norm();
+    let dir = v[1].atan2(v[0]).to_degrees().rem_euclid(360.0);
+    let (unit, digits) = match effect {
+        Effect::Current => ("m/s", 1000.0),
+        _ => ("N", 1.0),
+    };
+    if size <= 0.0 {
+        return format!("0 {unit}");
+    }
+    let js = Vector2::new(v[0] / size, v[1] / size);
+    let jd = Vector2::new(-v[1] / (size * size), v[0] / (size * size));
+    let s_size = (js.transpose() * cov * js)[(0, 0)].max(0.0).sqrt();
+    let s_dir = (jd.transpose() * cov * jd)[(0, 0)]
+        .max(0.0)
+        .sqrt()
+        .to_degrees();
+    let round = |x: f64| (x * digits).round() / digits;
+    format!(
+        "{} ± {} {unit} towards {:.0}° ± {:.0}° (north {}, east {} {unit})",
+        sig3(round(size)),
+        sig3(s_size),
+        dir,
+        s_dir.max(1.0),
+        sig3(round(v[0])),
+        sig3(round(v[1]))
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn term(x: [f64; 2], var: f64) -> ModelTerm {
+        ModelTerm {
+            effect: Effect::Current,
+            coefficients: x.to_vec(),
+            covariance: vec![vec![var, 0.0], vec![0.0, var]],
+            shape: None,
+            shape_std: None,
+        }
+    }
+
+    /// Two estimates of equal covariance pool to their mean with the
+    /// variance halved; estimates two std apart give χ² = 2 on 2 dof.
+    #[test]
+    fn two_equal_estimates_pool_to_their_mean() {
+        let (a, b) = (term([0.1, -0.2], 1e-4), term([0.1, -0.18], 1e-4));
+        let (t, e) = pool(&[(0.3, &a), (0.6, &b)], Effect::Current).expect("pooled");
+        assert!((t.coefficients[0] - 0.1).abs() < 1e-12);
+        assert!((t.coefficients[1] + 0.19).abs() < 1e-12);
+        // (0.01/0.01)² twice = 2 on 2 dof: agree, std 0.01/√2.
+        assert!((e.chi2 - 2.0).abs() < 1e-9, "{}", e.chi2);
+        assert_eq!(e.dof, 2);
+        assert!((e.coefficients[1].std.unwrap() - 0.01 / 2f64.sqrt()).abs() < 1e-12);
+        assert!(e.text.contains("agree"), "{}", e.text);
+        // |(0.1, −0.19)| = 0.2147, towards 360° − 62.2°.
+        assert!(
+            e.text.contains("0.215 ± 0.00707 m/s towards 298°"),
+            "{}",
+            e.text
+        );
+    }
+
+    /// The χ² 95 % points of 2 and 4 degrees of freedom (5.99, 9.49).
+    #[test]
+    fn the_chi2_points_are_close_to_the_tables() {
+        assert!((chi2_95(2) - 5.991).abs() < 0.1);
+        assert!((chi2_95(4) - 9.488).abs() < 0.05);
+    }
+
+    /// Estimates twenty std apart: the std is widened by √(χ²/dof).
+    #[test]
+    fn scattered_estimates_widen_the_std() {
+        let (a, b) = (term([0.0, 0.3], 1e-4), term([0.0, 0.1], 1e-4));
+        let (t, e) = pool(&[(0.3, &a), (0.6, &b)], Effect::Current).expect("pooled");
+        assert!((t.coefficients[1] - 0.2).abs() < 1e-12);
+        // χ² = 2·(0.1/0.01)² = 200 on 2 dof → std 0.00707·10.
+        assert!((e.chi2 - 200.0).abs() < 1e-6);
+        assert!((e.coefficients[1].std.unwrap() - 0.01 / 2f64.sqrt() * 10.0).abs() < 1e-9);
+        assert!(e.text.contains("widened 10×"), "{}", e.text);
+    }
+
+    /// One speed's estimate, or a term without covariance, is no pool.
+    #[test]
+    fn one_estimate_is_not_pooled() {
+        let a = term([0.1, 0.1], 1e-4);
+        let mut b = term([0.1, 0.1], 1e-4);
+        b.covariance = vec![];
+        assert!(pool(&[(0.3, &a)], Effect::Current).is_none());
+        assert!(pool(&[(0.3, &a), (0.6, &b)], Effect::Current).is_none());
+    }
+}
