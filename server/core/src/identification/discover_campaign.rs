@@ -402,7 +402,14 @@ pub fn discover_campaign(
 
     let mut effects = effects_across(&points);
     // Forces the campaign shares: one estimate, held at every grid speed.
-    let pooled = shared::pool_all(&points);
+    // A current and a pull fixed in NED both turn with the heading: the
+    // campaign holds one force fixed in NED, and the other is its look-alike.
+    let carried: Vec<Effect> = points
+        .iter()
+        .flat_map(|p| p.report.carried.iter().copied())
+        .collect();
+    let (pooled, look_alikes) =
+        shared::one_ned_force(shared::pool_all(&points), &effects, &carried);
     let mut shared_notes = Vec::new();
     for (term, estimate) in &pooled {
         match effects.iter_mut().find(|e| e.effect == term.effect) {
@@ -459,6 +466,18 @@ pub fn discover_campaign(
         for (e, v) in effects.iter_mut().zip(&gate.verdicts) {
             e.kept = Some(v.keep && gate.model.is_some());
             e.held_out_verdict = Some(v.reason.clone());
+        }
+        for e in effects
+            .iter_mut()
+            .filter(|e| look_alikes.contains(&e.effect))
+        {
+            e.kept = Some(false);
+            e.held_out_verdict = Some(format!(
+                "{} is held for the campaign instead, its look-alike: both are forces fixed in NED that turn with the heading",
+                pooled
+                    .first()
+                    .map_or_else(String::new, |(t, _)| t.effect.label())
+            ));
         }
         (gate.model, Some(gate.overall.text()))
     };

@@ -15,8 +15,8 @@ use super::super::document::ModelDocument;
 use super::super::error::IdentifyError;
 use super::super::ned_current::{self, surge_component};
 use super::super::roles::nearest_grid_index;
-use super::PointDiscovery;
 use super::speeds_text;
+use super::{EffectAcrossGrid, PointDiscovery};
 use crate::discrepancy::report::{Estimate, Finding, ModelReport};
 use crate::discrepancy::{
     AugmentedModel, DiscoverySettings, Effect, ModelTerm, Record, refit_holding,
@@ -62,6 +62,47 @@ pub(super) fn pool_all(points: &[PointDiscovery]) -> Vec<(ModelTerm, CampaignEst
         .into_iter()
         .filter_map(|e| pool(&terms, e))
         .collect()
+}
+
+/// Of the pooled forces fixed in NED, the one the campaign holds: a force
+/// the model carries (a current the identification found), else the first
+/// in the campaign's ranking `effects`. Returns it (or nothing) and the
+/// effects the grid speeds named that are its look-alikes, which the
+/// refitted models leave out.
+pub(super) fn one_ned_force(
+    pooled: Vec<(ModelTerm, CampaignEstimate)>,
+    effects: &[EffectAcrossGrid],
+    carried: &[Effect],
+) -> (Vec<(ModelTerm, CampaignEstimate)>, Vec<Effect>) {
+    let rank = |e: Effect| {
+        if carried.contains(&e) {
+            0
+        } else {
+            1 + effects
+                .iter()
+                .position(|x| x.effect == e)
+                .unwrap_or(effects.len())
+        }
+    };
+    let Some(best) = pooled
+        .iter()
+        .map(|(t, _)| t.effect)
+        .min_by_key(|e| rank(*e))
+    else {
+        return (pooled, vec![]);
+    };
+    let look_alikes = effects
+        .iter()
+        .map(|e| e.effect)
+        .filter(|e| e.fixed_in_ned() && *e != best)
+        .collect();
+    (
+        pooled
+            .into_iter()
+            .filter(|(t, _)| t.effect == best)
+            .collect(),
+        look_alikes,
+    )
 }
 
 /// The inverse-covariance pool of `effect`'s [N, E] coefficients over the
@@ -149,10 +190,11 @@ fn pool(terms: &[(f64, &ModelTerm)], effect: Effect) -> Option<(ModelTerm, Campa
 }
 
 /// Point `p` with the pooled terms held: its model refitted on its
-/// estimation runs with them at the campaign's values, its findings of
-/// them showing those values, and a finding added where the speed's own
-/// discovery had not named a shared force its start does not carry (the
-/// current acts at this speed too).
+/// estimation runs with them at the campaign's values and without their
+/// look-alikes (any other force fixed in NED), its findings of them showing
+/// those values, and a finding added where the speed's own discovery had
+/// not named a shared force its start does not carry (the current acts at
+/// this speed too).
 pub(super) fn held_at(
     p: &PointDiscovery,
     start: &AugmentedModel,
@@ -160,7 +202,8 @@ pub(super) fn held_at(
     settings: &DiscoverySettings,
     pooled: &[(ModelTerm, CampaignEstimate)],
 ) -> Result<PointDiscovery, IdentifyError> {
-    let is_shared = |e: Effect| pooled.iter().any(|(t, _)| t.effect == e);
+    // Every force fixed in NED but the held one is its look-alike.
+    let is_shared = |e: Effect| e.fixed_in_ned();
     let own: Vec<ModelTerm> = p
         .report
         .model
@@ -177,6 +220,9 @@ pub(super) fn held_at(
         )
     })?;
     let mut out = p.clone();
+    out.report
+        .findings
+        .retain(|f| !f.effect.fixed_in_ned() || pooled.iter().any(|(t, _)| t.effect == f.effect));
     for (t, c) in pooled {
         match out
             .report
