@@ -17,6 +17,7 @@ use super::super::ned_current::{self, surge_component};
 use super::super::roles::nearest_grid_index;
 use super::speeds_text;
 use super::{EffectAcrossGrid, PointDiscovery};
+use crate::discrepancy::locate::capital;
 use crate::discrepancy::report::{Estimate, Finding, ModelReport};
 use crate::discrepancy::{
     AugmentedModel, DiscoverySettings, Effect, ModelTerm, Record, refit_holding,
@@ -172,7 +173,7 @@ fn pool(terms: &[(f64, &ModelTerm)], effect: Effect) -> Option<(ModelTerm, Campa
     };
     let text = format!(
         "{} for the campaign: {}, pooled from the estimates at {} grid speeds ({} m/s); {agreement}. Every grid speed's model is refitted with it held there.",
-        capital_first(&effect.label()),
+        capital(&effect.label()),
         polar(effect, &mean, &cov),
         ests.len(),
         speeds_text(&speeds)
@@ -339,13 +340,6 @@ pub(super) fn pull_or_current_note(doc: &ModelDocument) -> Option<String> {
     (lpv.current.is_none() && ned_current::applies(&doc.dofs)).then(|| {
         "A force fixed in NED was named; a current looks the same at one forward speed (its force D̄·ν_c(ψ) turns with the heading too), and the model was identified without one. Unless the vessel was moored, towed or held in a steady wind, identify the campaign again with the NED current estimated (`ned_current: true`, the default) and compare the held-out fits.".to_owned()
     })
-}
-
-fn capital_first(s: &str) -> String {
-    let mut c = s.chars();
-    c.next()
-        .map(|f| f.to_uppercase().chain(c).collect())
-        .unwrap_or_default()
 }
 
 fn two(v: &[f64]) -> Option<Vector2<f64>> {
