@@ -199,9 +199,16 @@ export async function discoveryPage(view, id) {
         h('th', { title: 'The model with every finding, or else each grid speed\u2019s findings added one speed at a time, is kept only where the held-out runs are better with them than without and no worse anywhere' }, 'In the stored model'))),
       h('tbody', null, effects.map((e) => h('tr', { 'data-testid': 'effect-row' },
         h('td', null, h('b', null, e.label)),
-        h('td', null, e.grid_speeds_mps.map((s) => `${fmtKn(s)} kn`).join(', ')),
+        h('td', null, e.grid_speeds_mps.length
+          ? e.grid_speeds_mps.map((s) => `${fmtKn(s)} kn`).join(', ')
+          : (e.campaign_estimate ? 'the whole campaign' : '—')),
         h('td', { class: 'num mono', 'data-testid': 'effect-evidence' }, fmt((e.held_out_gains || []).reduce((a, b) => a + b, 0), 3)),
-        h('td', { class: 'mono small' }, e.magnitudes.map((m) => `${exact(m[0])}${m[1] != null ? ` ± ${exact(m[1])}` : ''}`).join('; ')),
+        h('td', { class: 'mono small', 'data-testid': 'effect-coefficients' },
+          e.magnitudes.map((m) => `${exact(m[0])}${m[1] != null ? ` ± ${exact(m[1])}` : ''}`).join('; '),
+          e.campaign_estimate
+            ? h('div', { title: e.campaign_estimate.text }, `campaign: ${e.campaign_estimate.coefficients
+              .map((c) => `${c.name} ${exact(c.value)}${c.std != null ? ` ± ${exact(c.std)}` : ''}`).join(', ')}`)
+            : null),
         h('td', { class: 'small', 'data-testid': 'effect-kept', 'data-kept': e.kept == null ? '' : String(e.kept) },
           e.kept == null ? '—' : h('span', { class: `badge ${e.kept ? 'good' : 'neutral'}` }, e.kept ? 'kept' : 'left out'),
           e.held_out_verdict ? h('div', { class: 'hint' }, e.held_out_verdict) : null))))))

@@ -69,11 +69,14 @@ fn cases(seed: u64) -> Vec<(&'static str, Effects)> {
 }
 
 /// Discovery on the λ model `base` of `runs`, printed as a table row.
+/// Discovery as the service runs it: with the model's own identification
+/// settings (`identified_with`).
 fn examine(
     report: SurfaceReport,
     base: Identified,
     profile: &VesselProfile,
     runs: &[RunInput],
+    identified_with: &LambdaCampaignSettings,
 ) -> Case {
     let forces: Vec<String> = Dof::HORIZONTAL
         .iter()
@@ -86,7 +89,10 @@ fn examine(
         runs,
         &base.estimation_run_ids,
         &base.validation_run_ids,
-        &DiscoverCampaignSettings::default(),
+        &DiscoverCampaignSettings {
+            identification: Some(identified_with.clone()),
+            ..DiscoverCampaignSettings::default()
+        },
         &mut NoProgress,
     )
     .expect("discovery runs on the 3-DOF model");
@@ -142,7 +148,7 @@ fn discovered() -> &'static [Case] {
                 };
                 let profile = supply_profile(&vessel, &trial);
                 let runs = inputs(&profile, &usv::fly_supply_campaign(&vessel, &trial, seed));
-                out.push(examine(report, base, &profile, &runs));
+                out.push(examine(report, base, &profile, &runs, settings));
             }
         }
         out
@@ -186,7 +192,7 @@ fn otter_discovered() -> &'static [Case] {
                 };
                 let profile = otter_profile(&vessel);
                 let runs = inputs(&profile, &fly_usv_campaign(&vessel, &trial, seed));
-                out.push(examine(report, base, &profile, &runs));
+                out.push(examine(report, base, &profile, &runs, &settings));
             }
         }
         out
@@ -225,7 +231,7 @@ fn otter_concealed_current() -> &'static [Case] {
                 };
                 let profile = otter_profile(&vessel);
                 let runs = inputs(&profile, &fly_usv_campaign(&vessel, &trial, seed));
-                examine(report, base, &profile, &runs)
+                examine(report, base, &profile, &runs, &settings)
             })
             .collect()
     })
@@ -314,30 +320,40 @@ fn the_identified_current_is_carried_not_named_again() {
     }
 }
 
-/// A current the baseline does not carry is found once for the campaign:
-/// the first-named effect is a force fixed in NED pointing the current's
-/// way (within 10°), pooled over the grid speeds; named as the current,
-/// its speed is within 20 % and the way to a model that has it throughout
-/// is named (the identification's own current, which places runs by their
-/// speed through the water); named as a pull fixed in NED, the text names
-/// the current as its look-alike. Every grid point of a stored model holds
-/// the one value, and the refitted models are stored where the held-out
-/// runs are better with them. (Named as a pull on 3 of 4 seeds: the Otter's
-/// sway damping is cross-flow drag, not linear, so at one speed the
-/// current's force is as near a constant NED force as a linear-damping
-/// current; telling them apart across speeds is not built yet.)
+/// The case's seed and the effect its discovery named first.
+fn first_named(
+    c: &Case,
+) -> (
+    u64,
+    &seatrial_core::identification::discover_campaign::EffectAcrossGrid,
+) {
+    let seed = c.report.seed;
+    let first = c
+        .found
+        .report
+        .effects
+        .first()
+        .unwrap_or_else(|| panic!("seed {seed}: nothing named"));
+    (seed, first)
+}
+
+/// A current the baseline does not carry is found once for the campaign.
+/// Discovery's per-speed hypotheses name a pull fixed in NED (at one speed
+/// a current's force turns with the heading as a pull does, and the
+/// baseline's damping absorbed part of it); the campaign is then identified
+/// again with the NED current estimated, and the held-out runs decide. The
+/// first-named effect points the current's way (within 10°) on every seed;
+/// it is the current, within 10 % of the true speed, on at least 3 of 4
+/// (measured: 3 of 4; on seed 4 the pull model's held-out fits are higher
+/// by 0.16 summed over 12). A stored current model carries the named
+/// value; a stored pull model holds the one pooled value at every examined
+/// grid point.
 #[test]
 fn a_concealed_current_is_found_once_for_the_campaign() {
     use seatrial_core::discrepancy::Effect;
-    let mut stored = 0;
+    let (mut stored, mut as_current) = (0, 0);
     for c in otter_concealed_current() {
-        let seed = c.report.seed;
-        let first = c
-            .found
-            .report
-            .effects
-            .first()
-            .unwrap_or_else(|| panic!("seed {seed}: nothing named"));
+        let (seed, first) = first_named(c);
         assert!(
             matches!(first.effect, Effect::Current | Effect::TetherPull),
             "seed {seed}: {:?}",
@@ -376,57 +392,121 @@ fn a_concealed_current_is_found_once_for_the_campaign() {
             ddir.abs() <= 10f64.to_radians(),
             "seed {seed}: direction off by {ddir} rad"
         );
-        if first.effect == Effect::Current {
-            let err = (n.hypot(e) - speed) / speed;
-            assert!(err.abs() <= 0.2, "seed {seed}: speed off by {err}");
-        }
-        // The re-identification the current calls for (with the runs it
-        // moves when the current was named; as the pull's look-alike else).
+        // The re-identification with the current was run, and the summary
+        // says what it showed.
         assert!(
             c.found
                 .report
                 .summary
                 .iter()
-                .any(|l| l.contains("identified without a current")
-                    || l.contains("a current looks the same at one forward speed")),
+                .any(|l| l.contains("Identified again with the NED current estimated")),
             "seed {seed}: {:?}",
             c.found.report.summary
         );
-        if let Some(aug) = c
-            .found
-            .augmented
-            .as_ref()
-            .filter(|_| first.campaign_estimate.is_some())
-        {
-            stored += 1;
-            let lpv = aug.document.lpv.as_ref().expect("LPV");
-            // Every grid point examined (one without held-out runs keeps
-            // the baseline's sub-model).
-            let examined: Vec<f64> = c
-                .found
-                .report
-                .points
-                .iter()
-                .map(|p| p.grid_speed_mps)
-                .collect();
-            for p in lpv
-                .points
-                .iter()
-                .filter(|p| examined.contains(&p.speed_mps))
-            {
-                let held = p
-                    .augmentation
-                    .as_ref()
-                    .and_then(|a| a.terms.iter().find(|t| t.effect == first.effect))
-                    .map(|t| &t.coefficients);
-                assert_eq!(
-                    held,
-                    Some(&vec![n, e]),
-                    "seed {seed} at {} m/s",
-                    p.speed_mps
-                );
+        if first.effect == Effect::Current {
+            as_current += 1;
+            let err = (n.hypot(e) - speed) / speed;
+            assert!(err.abs() <= 0.1, "seed {seed}: speed off by {err}");
+            // The pull it was mistaken for is left out as its look-alike.
+            for other in c.found.report.effects.iter().skip(1) {
+                assert_eq!(other.kept, Some(false), "seed {seed}: {}", other.label);
             }
         }
+        let Some(aug) = c.found.augmented.as_ref() else {
+            continue;
+        };
+        stored += 1;
+        let lpv = aug.document.lpv.as_ref().expect("LPV");
+        if first.effect == Effect::Current {
+            // The model identified again: its current is the one named.
+            let cur = lpv
+                .current
+                .as_ref()
+                .expect("the stored model has the current");
+            assert!((cur.ned_mps[0] - n).abs() < 1e-12 && (cur.ned_mps[1] - e).abs() < 1e-12);
+            assert_eq!(first.kept, Some(true));
+            continue;
+        }
+        // Every grid point examined holds the pooled pull (one without
+        // held-out runs keeps the baseline's sub-model).
+        if first.campaign_estimate.is_none() {
+            continue;
+        }
+        let examined: Vec<f64> = c
+            .found
+            .report
+            .points
+            .iter()
+            .map(|p| p.grid_speed_mps)
+            .collect();
+        for p in lpv
+            .points
+            .iter()
+            .filter(|p| examined.contains(&p.speed_mps))
+        {
+            let held = p
+                .augmentation
+                .as_ref()
+                .and_then(|a| a.terms.iter().find(|t| t.effect == first.effect))
+                .map(|t| &t.coefficients);
+            assert_eq!(
+                held,
+                Some(&vec![n, e]),
+                "seed {seed} at {} m/s",
+                p.speed_mps
+            );
+        }
     }
-    assert!(stored >= 2, "{stored} of {} stored", SEEDS.len());
+    assert!(
+        as_current >= 3,
+        "the current named first on {as_current} of {}",
+        SEEDS.len()
+    );
+    assert!(stored >= 3, "{stored} of {} stored", SEEDS.len());
+}
+
+/// The supply vessel in DP, its current (0.05–0.5 m/s) concealed from the
+/// baseline (identified with constant loads only, one grid point at
+/// 0 m/s): discovery's per-speed terms stand in for the current (a pull
+/// fixed in NED, or Coriolis and cross-flow terms), and identifying the
+/// campaign again with the NED current estimated explains the held-out
+/// runs better. The current is named first on every seed, its speed within
+/// 10 % and its direction within 5° (measured: −4 … +1 %, ≤ 2°), the
+/// stored model carries it, and every other finding is left out.
+#[test]
+fn a_concealed_current_on_a_dp_vessel_is_named_by_identifying_again() {
+    use seatrial_core::discrepancy::Effect;
+    for c in discovered()
+        .iter()
+        .filter(|c| c.report.label == "current, loads only")
+    {
+        let (seed, first) = first_named(c);
+        assert_eq!(
+            first.effect,
+            Effect::Current,
+            "seed {seed}: {:?}",
+            c.found.report.summary
+        );
+        let once = first.campaign_estimate.as_ref().expect("one estimate");
+        let (n, e) = (once.coefficients[0].value, once.coefficients[1].value);
+        let (speed, dir) = c.report.current_true.expect("flown in a current");
+        let err = (n.hypot(e) - speed) / speed;
+        let ddir = (e.atan2(n) - dir + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        println!(
+            "DP seed {seed}: current {speed:.3} m/s, named {:.3} m/s ({:+.1} %, {:+.1}°)",
+            n.hypot(e),
+            100.0 * err,
+            ddir.to_degrees()
+        );
+        assert!(err.abs() <= 0.1, "seed {seed}: speed off by {err}");
+        assert!(ddir.abs() <= 5f64.to_radians(), "seed {seed}: {ddir} rad");
+        assert_eq!(first.kept, Some(true));
+        for other in c.found.report.effects.iter().skip(1) {
+            assert_eq!(other.kept, Some(false), "seed {seed}: {}", other.label);
+        }
+        let aug = c.found.augmented.as_ref().expect("stored");
+        let cur = aug.document.lpv.as_ref().and_then(|l| l.current.as_ref());
+        assert_eq!(cur.map(|c| c.ned_mps), Some([n, e]));
+    }
 }

@@ -5,8 +5,10 @@
 //! calls and stores.
 
 use seatrial_core::estimation::{Progress, SubProgress};
-use seatrial_core::identification::document::{ModelDocument, ModelKind};
-use seatrial_core::identification::{DiscoverCampaignSettings, IdentifyError, discover_campaign};
+use seatrial_core::identification::document::{Method, ModelDocument, ModelKind};
+use seatrial_core::identification::{
+    DiscoverCampaignSettings, IdentifyError, LambdaCampaignSettings, discover_campaign,
+};
 use sqlx::SqliteConnection;
 
 use super::handler::{BoxFuture, Compute, JobContext, JobFailure, JobHandler, Persist, compute};
@@ -131,15 +133,25 @@ impl JobHandler for Discover {
             }
             let stored = run_inputs::describe(cx, &cid, chosen).await?;
             let settings = req.settings.clone();
+            // The examined model's own λ-filter settings: discovery may
+            // identify the campaign again with the NED current.
+            let identified_with = (model.summary.method == Method::LambdaKf.name())
+                .then(|| {
+                    serde_json::from_value::<LambdaCampaignSettings>(model.settings.clone()).ok()
+                })
+                .flatten();
             let profile = vessel.profile.clone();
             let base = model.summary.clone();
             Ok(compute(move |progress: &mut dyn Progress| {
-                let s: DiscoverCampaignSettings =
+                let mut s: DiscoverCampaignSettings =
                     parse_settings(&settings).map_err(|(f, m)| JobFailure::field(f, m))?;
+                if s.identification.is_none() {
+                    s.identification = identified_with;
+                }
                 progress.update(0.0, "reading runs")?;
                 let (inputs, _) = run_inputs::read(&profile, &stored)?;
                 let forces = generalized_force_columns(&profile);
-                let mut sub = SubProgress::new(progress, 0.05, 0.98);
+                let mut sub = SubProgress::new(progress, 0.05, 0.93);
                 let out = discover_campaign(
                     &doc, &profile, &forces, &inputs, &est_ids, &val_ids, &s, &mut sub,
                 )

@@ -49,7 +49,8 @@ pub struct SubProgress<'a> {
 }
 
 impl<'a> SubProgress<'a> {
-    /// A sub-range of `parent`.
+    /// The sub-range `[start, start + width]` of `parent` (a width, not
+    /// an end).
     pub fn new(parent: &'a mut dyn Progress, start: f64, width: f64) -> Self {
         SubProgress {
             parent,

@@ -15,6 +15,7 @@ use super::augmented::{augmented_at, pieces_by_speed};
 use super::dataset::{RunInput, level_attitude, segments};
 use super::document::{ModelDocument, ModelKind};
 use super::error::IdentifyError;
+use super::lambda_settings::LambdaCampaignSettings;
 use super::outcome::Identified;
 use super::roles::nearest_grid_index;
 use crate::discrepancy::lines::SpectralLine;
@@ -31,7 +32,7 @@ use crate::planning::campaign::ExperimentFamily;
 use crate::planning::dof::Dof;
 
 /// Settings of a discovery job.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct DiscoverCampaignSettings {
@@ -46,6 +47,29 @@ pub struct DiscoverCampaignSettings {
     /// Settings of the discovery itself (filter, criteria, library); the
     /// vessel is taken from the campaign when not given.
     pub discovery: DiscoverySettings,
+    /// When a force fixed in NED is named on a surface model identified
+    /// without a current, identify the campaign again with the NED current
+    /// estimated and keep whichever model is better on the held-out runs
+    /// (a current and a pull look alike at one speed; the current's force
+    /// follows the damping, which the identification fits with it).
+    pub reidentify_current: bool,
+    /// The λ-filter identification settings for that (the examined model's
+    /// own when not given; `ned_current` is set and the held-out runs are
+    /// discovery's).
+    pub identification: Option<LambdaCampaignSettings>,
+}
+
+impl Default for DiscoverCampaignSettings {
+    fn default() -> Self {
+        DiscoverCampaignSettings {
+            grid_speeds_mps: None,
+            estimation_run_ids: None,
+            validation_run_ids: None,
+            discovery: DiscoverySettings::default(),
+            reidentify_current: true,
+            identification: None,
+        }
+    }
 }
 
 /// Discovery at one grid speed.
@@ -425,11 +449,14 @@ pub fn discover_campaign(
         .chain(points.iter().flat_map(|p| &p.report.model.terms))
         .find(|t| t.effect == Effect::Current && t.coefficients.len() == 2)
         .filter(|_| effects.iter().any(|e| e.effect == Effect::Current));
+    // Advice to identify again with the current (superseded when that is
+    // done here).
+    let mut advice = Vec::new();
     if let Some(t) = found_current {
         let v = [t.coefficients[0], t.coefficients[1]];
-        shared_notes.extend(shared::reidentify_note(doc, runs, est_ids, &grid, v));
+        advice.extend(shared::reidentify_note(doc, runs, est_ids, &grid, v));
     } else if effects.iter().any(|e| e.effect == Effect::TetherPull) {
-        shared_notes.extend(shared::pull_or_current_note(doc));
+        advice.extend(shared::pull_or_current_note(doc));
     }
     let assembled = if pooled.is_empty() {
         None
@@ -457,12 +484,14 @@ pub fn discover_campaign(
         settings,
         k: dset.k_step,
     };
-    let (augmented, overall) = if effects.is_empty() {
-        (None, None)
+    let again = current_again::applies(doc, settings, &effects, &carried);
+    let gate_to = if again { 0.96 } else { 0.99 };
+    let (mut augmented, mut overall, before) = if effects.is_empty() {
+        (None, None, None)
     } else {
         // The start model through the same validation, on the same runs.
         let before = asm.validate(doc)?;
-        let gate = keep_better(&asm, &effects, &before, progress, (0.9, 0.99))?;
+        let gate = keep_better(&asm, &effects, &before, progress, (0.9, gate_to))?;
         for (e, v) in effects.iter_mut().zip(&gate.verdicts) {
             e.kept = Some(v.keep && gate.model.is_some());
             e.held_out_verdict = Some(v.reason.clone());
@@ -479,8 +508,27 @@ pub fn discover_campaign(
                     .map_or_else(String::new, |(t, _)| t.effect.label())
             ));
         }
-        (gate.model, Some(gate.overall.text()))
+        (gate.model, Some(gate.overall.text()), Some(before))
     };
+    // A force fixed in NED on a surface model without a current: the
+    // current, estimated with the damping, is tested against it.
+    if let (true, Some(before)) = (again, &before) {
+        match current_again::identify_again(&asm, profile, &grid, before, progress, (0.96, 0.99))? {
+            Ok(a) => {
+                let settled =
+                    current_again::settle(a, augmented.take(), &mut effects, before);
+                augmented = settled.model;
+                if settled.overall.is_some() {
+                    overall = settled.overall;
+                }
+                advice = vec![settled.note];
+            }
+            Err(why) => advice.push(format!(
+                "Identifying the campaign again with the NED current estimated gave no model to compare: {why}."
+            )),
+        }
+    }
+    shared_notes.extend(advice);
     let mut summary = summarize(&points, &effects, &skipped);
     summary.extend(shared_notes);
     summary.extend(overall);
@@ -621,6 +669,11 @@ fn summarize(
             .as_ref()
             .map(|c| format!(" {}", c.text))
             .unwrap_or_default();
+        if k == 0 {
+            // Estimated for the campaign, not named by a grid speed.
+            out.push(format!("{}:{once}{gate}", e.label));
+            continue;
+        }
         out.push(format!(
             "{}: named {scope}; {range}; held-out fit gained {:.3} (summed over speeds and channels).{once}{gate}",
             e.label,
@@ -713,6 +766,7 @@ fn summarize(
 }
 
 mod assemble;
+mod current_again;
 mod keep;
 mod shared;
 mod start;

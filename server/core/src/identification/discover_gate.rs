@@ -206,7 +206,7 @@ pub fn compare_against(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::estimation::NoProgress;
     use crate::identification::lambda_campaign::{
@@ -220,7 +220,7 @@ mod tests {
 
     /// A real held-out validation: a λ model of a simulated ROV at one
     /// speed, validated on its own held-out run.
-    fn held_out() -> Vec<RunValidation> {
+    pub(crate) fn held_out() -> Vec<RunValidation> {
         let truth = RovTruth::surveyor_like();
         let runs: Vec<_> = (0..3u64)
             .map(|r| {

@@ -397,7 +397,7 @@ fn identify(
         && let Some((moved, note)) =
             through_water::regrid(runs, &roles, &data, grid, surge, n, c.estimate.v)
     {
-        let mut sub = SubProgress::new(progress, 0.4, 1.0);
+        let mut sub = SubProgress::new(progress, 0.4, 0.6);
         return identify(
             profile,
             grid,
@@ -481,7 +481,7 @@ fn identify(
         quadratic = Some((d, d_std));
         exps = known(quadratic.as_ref().map(|(d, _)| d));
         fit_notes.clear();
-        let mut sub = SubProgress::new(progress, 0.6, 0.8);
+        let mut sub = SubProgress::new(progress, 0.6, 0.2);
         estimates = fit_points(
             &points_of(exps.clone()),
             &lambda_settings,

@@ -357,7 +357,7 @@ fn covariance(c: &[Vec<f64>]) -> Option<Matrix2<f64>> {
 /// Size and direction (towards, degrees from north) ± std of a vector
 /// [N, E] with covariance `cov`, by the first-order propagation through
 /// |v| and atan2(E, N).
-fn polar(effect: Effect, v: &Vector2<f64>, cov: &Matrix2<f64>) -> String {
+pub(super) fn polar(effect: Effect, v: &Vector2<f64>, cov: &Matrix2<f64>) -> String {
     let size = v.norm();
     let dir = v[1].atan2(v[0]).to_degrees().rem_euclid(360.0);
     let (unit, digits) = match effect {

@@ -1,0 +1,364 @@
+//! A current tested as the identification estimates it. At one forward
+//! speed a current's force D̄·ν_c(ψ) turns with the heading as a pull fixed
+//! in NED does, and a model identified without a current has absorbed part
+//! of it into its damping; so discovery's per-speed hypotheses, which hold
+//! D̄ at the absorbed values, cannot tell the two apart. The identification
+//! with the NED current (`ned_current`) estimates V_c together with M and
+//! D̄ at every grid speed, on relative velocities ν − ν_c. When a force
+//! fixed in NED was named on a surface model identified without a current,
+//! the campaign is identified again that way and the two explanations are
+//! judged on the held-out runs: the re-identified model must beat the
+//! baseline (the same gate as any augmentation) and the augmented model in
+//! the sum of its held-out fits.
+
+use nalgebra::{Matrix2, Vector2};
+
+use super::super::discover_gate::{HeldOutVerdict, compare_against, inertia_verdict};
+use super::super::document::{ModelDocument, NedCurrentDoc};
+use super::super::error::IdentifyError;
+use super::super::lambda_campaign::identify_lambda_campaign;
+use super::super::ned_current;
+use super::super::outcome::{Identified, RunValidation};
+use super::assemble::Assembly;
+use super::shared::{CampaignEstimate, polar};
+use super::{DiscoverCampaignSettings, EffectAcrossGrid};
+use crate::discrepancy::Effect;
+use crate::discrepancy::locate::capital;
+use crate::discrepancy::report::Estimate;
+use crate::estimation::{Progress, SubProgress};
+use crate::numbers::sig3;
+use crate::planning::VesselProfile;
+
+/// Whether to identify again with the current: asked for, a surface model
+/// without a current (in its document or as a carried term) that was not
+/// identified with one already (`ned_current` in the identification
+/// settings given), and something named that a current could stand behind
+/// (a force fixed in NED, or terms that absorb its force at one speed).
+pub(super) fn applies(
+    doc: &ModelDocument,
+    settings: &DiscoverCampaignSettings,
+    effects: &[EffectAcrossGrid],
+    carried: &[Effect],
+) -> bool {
+    settings.reidentify_current
+        && !settings
+            .identification
+            .as_ref()
+            .is_some_and(|s| s.ned_current)
+        && ned_current::applies(&doc.dofs)
+        && doc.lpv.as_ref().is_some_and(|l| l.current.is_none())
+        && !carried.contains(&Effect::Current)
+        && !effects.is_empty()
+}
+
+/// The model identified again with the NED current, validated on the
+/// held-out runs as discovery validates.
+pub(super) struct Again {
+    pub model: Identified,
+    pub current: NedCurrentDoc,
+    /// Against the baseline: the gate every augmentation passes.
+    pub vs_baseline: HeldOutVerdict,
+}
+
+/// Identifies the campaign's runs again with the NED current estimated
+/// (between progress `from` and `to`). `Ok(Err(why))` when it gave no
+/// current model (no heading logged, an identification error): discovery
+/// then goes on without it.
+pub(super) fn identify_again(
+    asm: &Assembly<'_>,
+    profile: &VesselProfile,
+    grid: &[f64],
+    before: &[RunValidation],
+    progress: &mut dyn Progress,
+    (from, to): (f64, f64),
+) -> Result<Result<Again, String>, IdentifyError> {
+    progress.update(
+        from,
+        "identifying the campaign again with the NED current estimated",
+    )?;
+    let mut s = asm.settings.identification.clone().unwrap_or_default();
+    s.ned_current = true;
+    s.validation_run_ids = Some(asm.val_ids.to_vec());
+    let runs: Vec<_> = asm
+        .runs
+        .iter()
+        .filter(|r| asm.est_ids.contains(&r.run_id) || asm.val_ids.contains(&r.run_id))
+        .cloned()
+        .collect();
+    let mut sub = SubProgress::new(progress, from, to - from);
+    let model = match identify_lambda_campaign(profile, grid, asm.forces, &runs, &s, &mut sub) {
+        Ok(m) => m,
+        Err(IdentifyError::Cancelled) => return Err(IdentifyError::Cancelled),
+        Err(e) => return Ok(Err(e.to_string())),
+    };
+    let Some(current) = model.document.lpv.as_ref().and_then(|l| l.current.clone()) else {
+        return Ok(Err(
+            "no current stands out of the noise (or the heading ψ is not logged on every run)"
+                .to_owned(),
+        ));
+    };
+    let validation = asm.validate(&model.document)?;
+    let vs_baseline = inertia_verdict(&model.document)
+        .unwrap_or_else(|| compare_against(before, &validation, "the baseline"));
+    Ok(Ok(Again {
+        model: Identified {
+            validation,
+            ..model
+        },
+        current,
+        vs_baseline,
+    }))
+}
+
+/// Σ (a − b) over the held-out fits both give (run, channel, each of the
+/// four fits), each fit clamped to [−1, 1] so that one divergent channel
+/// counts as a total loss and no more; and how many were compared.
+pub(super) fn advantage(a: &[RunValidation], b: &[RunValidation]) -> (f64, usize) {
+    let mut sum = 0.0;
+    let mut n = 0;
+    for ra in a {
+        let Some(rb) = b.iter().find(|r| r.run_id == ra.run_id) else {
+            continue;
+        };
+        for ca in &ra.report.channels {
+            let Some(cb) = rb.report.channels.iter().find(|c| c.output == ca.output) else {
+                continue;
+            };
+            let pairs = [
+                (ca.fit_one_step, cb.fit_one_step),
+                (ca.fit_k_step, cb.fit_k_step),
+                (ca.fit_restarted, cb.fit_restarted),
+                (ca.fit_simulation, cb.fit_simulation),
+            ];
+            for (x, y) in pairs {
+                if let (Some(x), Some(y)) =
+                    (x.filter(|v| v.is_finite()), y.filter(|v| v.is_finite()))
+                {
+                    sum += x.clamp(-1.0, 1.0) - y.clamp(-1.0, 1.0);
+                    n += 1;
+                }
+            }
+        }
+    }
+    (sum, n)
+}
+
+/// The outcome once both explanations are known.
+pub(super) struct Settled {
+    /// The model to store.
+    pub model: Option<Identified>,
+    /// The verdict on it, in a sentence (replaces the gate's).
+    pub overall: Option<String>,
+    /// What the re-identification showed, for the summary.
+    pub note: String,
+}
+
+/// Keeps the better of the gate's model (`gated`, `None` when the gate
+/// stored nothing) and the re-identified one, and marks the effects: the
+/// current, when its model wins, goes first with its one estimate; the
+/// forces fixed in NED are then its look-alikes, and any other finding is
+/// left for a discovery run on the new model.
+pub(super) fn settle(
+    again: Again,
+    gated: Option<Identified>,
+    effects: &mut Vec<EffectAcrossGrid>,
+    before: &[RunValidation],
+) -> Settled {
+    let Again {
+        model,
+        current,
+        vs_baseline,
+    } = again;
+    let Estimated { polar, estimate } = campaign_estimate(&current);
+    let found = format!(
+        "Identified again with the NED current estimated, the campaign's current is {}",
+        polar
+    );
+    if !vs_baseline.keep {
+        return Settled {
+            model: gated,
+            overall: None,
+            note: format!("{found}; that model is not kept: {}.", vs_baseline.reason),
+        };
+    }
+    let (gain, _) = advantage(&model.validation, before);
+    if let Some(g) = &gated {
+        let (edge, n) = advantage(&model.validation, &g.validation);
+        if edge <= 0.0 {
+            return Settled {
+                model: gated,
+                overall: None,
+                note: format!(
+                    "{found}; on the held-out runs that model is better than the baseline but not than the model with the force fixed in NED (its {n} fits sum {} lower), so the force stands.",
+                    sig3(-edge)
+                ),
+            };
+        }
+    }
+    let versus = match &gated {
+        Some(g) => {
+            let (edge, n) = advantage(&model.validation, &g.validation);
+            format!(
+                " and better than the model with the force fixed in NED (its {n} held-out fits sum {} higher)",
+                sig3(edge)
+            )
+        }
+        None => String::new(),
+    };
+    let reason = format!(
+        "identified again with the current, {}{versus}",
+        vs_baseline.reason
+    );
+    let why = if effects.iter().any(|e| e.effect.fixed_in_ned()) {
+        "A force fixed in NED was named; at one forward speed a current looks the same, and estimated with the damping it explains the held-out runs better.".to_owned()
+    } else {
+        let named: Vec<String> = effects.iter().map(|e| e.label.clone()).collect();
+        format!(
+            "The terms named ({}) stood in for it: estimated with the damping, the current explains the held-out runs better.",
+            named.join("; ")
+        )
+    };
+    // Not named by a grid speed: its evidence is the re-identified model's
+    // held-out gain over the baseline.
+    let mut entry = effects
+        .iter()
+        .position(|e| e.effect == Effect::Current)
+        .map(|i| effects.remove(i))
+        .unwrap_or_else(|| EffectAcrossGrid {
+            effect: Effect::Current,
+            label: Effect::Current.label(),
+            grid_speeds_mps: vec![],
+            magnitudes: vec![],
+            held_out_gains: vec![gain],
+            kept: None,
+            held_out_verdict: None,
+            campaign_estimate: None,
+        });
+    entry.kept = Some(true);
+    entry.held_out_verdict = Some(reason.clone());
+    entry.campaign_estimate = Some(estimate.clone());
+    for e in effects.iter_mut() {
+        e.kept = Some(false);
+        e.held_out_verdict = Some(if e.effect.fixed_in_ned() {
+            "the current, estimated with M and D̄ by identifying the campaign again, is its look-alike and explains the held-out runs better".to_owned()
+        } else {
+            "not in the stored model, which is the campaign identified again with the current; run discovery on it to test this again".to_owned()
+        });
+    }
+    effects.insert(0, entry);
+    Settled {
+        model: Some(model),
+        overall: Some(format!(
+            "The model identified again with the NED current was stored: {reason}."
+        )),
+        note: format!("{found}. {why}"),
+    }
+}
+
+/// The current as the campaign's one estimate, and its size and direction
+/// in words.
+struct Estimated {
+    polar: String,
+    estimate: CampaignEstimate,
+}
+
+/// The current as the campaign's one estimate: [V_N, V_E] ± std by the
+/// first-order propagation of speed and direction.
+fn campaign_estimate(c: &NedCurrentDoc) -> Estimated {
+    let (v, b) = (c.speed_mps, c.direction_deg.to_radians());
+    let (sv, sb) = (c.speed_std_mps, c.direction_std_deg.to_radians());
+    let (cb, sn) = (b.cos(), b.sin());
+    let var_n = cb * cb * sv * sv + v * v * sn * sn * sb * sb;
+    let var_e = sn * sn * sv * sv + v * v * cb * cb * sb * sb;
+    let cov_ne = cb * sn * (sv * sv - v * v * sb * sb);
+    let mean = Vector2::new(c.ned_mps[0], c.ned_mps[1]);
+    let cov = Matrix2::new(var_n, cov_ne, cov_ne, var_e);
+    let names = Effect::Current.coefficient_names();
+    let coefficients = (0..2)
+        .map(|j| Estimate {
+            name: names.get(j).cloned().unwrap_or_default(),
+            value: mean[j],
+            std: Some(cov[(j, j)].max(0.0).sqrt()).filter(|s| s.is_finite()),
+        })
+        .collect();
+    let polar = polar(Effect::Current, &mean, &cov);
+    let text = format!(
+        "{} for the campaign: {polar}, estimated once with M and D̄ at every grid speed by identifying the campaign again on the velocities through the water.",
+        capital(&Effect::Current.label())
+    );
+    Estimated {
+        polar,
+        estimate: CampaignEstimate {
+            coefficients,
+            grid_speeds_mps: vec![],
+            chi2: 0.0,
+            dof: 0,
+            text,
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identification::discover_gate::tests::held_out;
+
+    /// The sum counts each fit both give, clamped to [−1, 1]: one fit up
+    /// 0.1, a whole-run free run down to −5 (−1 after clamping), a k-step
+    /// fit missing on one side (not counted).
+    #[test]
+    fn the_advantage_sums_the_fits_both_give() {
+        let b = held_out();
+        let both = |v: &[RunValidation]| advantage(v, v).1;
+        let n0 = both(&b);
+        assert!(n0 >= 4, "{n0} fits");
+        let mut a = b.clone();
+        let c = &mut a[0].report.channels[0];
+        let (one, sim) = (
+            c.fit_one_step.expect("1-step"),
+            c.fit_simulation.expect("free run"),
+        );
+        assert!(c.fit_k_step.is_some());
+        c.fit_one_step = Some(one + 0.1);
+        c.fit_simulation = Some(-5.0);
+        c.fit_k_step = None;
+        let (sum, n) = advantage(&a, &b);
+        assert_eq!(n, n0 - 1);
+        let want =
+            (one + 0.1).clamp(-1.0, 1.0) - one.clamp(-1.0, 1.0) + (-1.0 - sim.clamp(-1.0, 1.0));
+        assert!((sum - want).abs() < 1e-12, "{sum} vs {want}");
+        assert_eq!(advantage(&a, &[]), (0.0, 0));
+    }
+
+    /// [V_N, V_E] ± std from speed and direction: a current towards east
+    /// with an exact direction has σ_N = 0 and σ_E = σ_V; towards north
+    /// with σ_β = 0.1 rad, σ_E = V·σ_β.
+    #[test]
+    fn the_current_estimate_propagates_speed_and_direction() {
+        let doc = |dir: f64, s_dir: f64| NedCurrentDoc {
+            speed_mps: 0.2,
+            speed_std_mps: 0.01,
+            direction_deg: dir,
+            direction_std_deg: s_dir,
+            ned_mps: [0.2 * dir.to_radians().cos(), 0.2 * dir.to_radians().sin()],
+            evidence: String::new(),
+        };
+        let east = campaign_estimate(&doc(90.0, 0.0)).estimate;
+        assert!(east.coefficients[0].std.unwrap() < 1e-12);
+        assert!((east.coefficients[1].std.unwrap() - 0.01).abs() < 1e-12);
+        assert!((east.coefficients[1].value - 0.2).abs() < 1e-12);
+        let north = campaign_estimate(&doc(0.0, 0.1f64.to_degrees()));
+        assert!((north.estimate.coefficients[0].std.unwrap() - 0.01).abs() < 1e-12);
+        assert!((north.estimate.coefficients[1].std.unwrap() - 0.02).abs() < 1e-12);
+        assert!(
+            north.polar.starts_with("0.2 ± 0.01 m/s towards 0°"),
+            "{}",
+            north.polar
+        );
+        assert!(
+            north.estimate.text.starts_with("Ocean current"),
+            "{}",
+            north.estimate.text
+        );
+    }
+}
