@@ -21,7 +21,7 @@ use super::super::ned_current;
 use super::super::outcome::{Identified, RunValidation};
 use super::assemble::Assembly;
 use super::shared::{CampaignEstimate, polar};
-use super::{DiscoverCampaignSettings, EffectAcrossGrid};
+use super::{CampaignDiscovery, DiscoverCampaignSettings, EffectAcrossGrid, PointDiscovery};
 use crate::discrepancy::Effect;
 use crate::discrepancy::locate::capital;
 use crate::discrepancy::report::Estimate;
@@ -110,6 +110,42 @@ pub(super) fn identify_again(
     }))
 }
 
+/// Discovery on the current model (never identifying again), between
+/// progress 0.975 and 0.99, when [`continue_from_it`] says so; `None`
+/// when it is not needed or fails (the comparison then goes without it).
+pub(super) fn continue_discovery(
+    asm: &Assembly<'_>,
+    profile: &VesselProfile,
+    again: &Again,
+    gated: Option<&Identified>,
+    progress: &mut dyn Progress,
+) -> Result<Option<CampaignDiscovery>, IdentifyError> {
+    if !continue_from_it(again, gated) {
+        return Ok(None);
+    }
+    let s = DiscoverCampaignSettings {
+        estimation_run_ids: Some(asm.est_ids.to_vec()),
+        validation_run_ids: Some(asm.val_ids.to_vec()),
+        reidentify_current: false,
+        ..asm.settings.clone()
+    };
+    let mut sub = SubProgress::new(progress, 0.975, 0.015);
+    match super::discover_campaign(
+        &again.model.document,
+        profile,
+        asm.forces,
+        asm.runs,
+        asm.est_ids,
+        asm.val_ids,
+        &s,
+        &mut sub,
+    ) {
+        Ok(c) => Ok(Some(c)),
+        Err(IdentifyError::Cancelled) => Err(IdentifyError::Cancelled),
+        Err(_) => Ok(None),
+    }
+}
+
 /// Σ (a − b) over the held-out fits both give (run, channel, each of the
 /// four fits), each fit clamped to [−1, 1] so that one divergent channel
 /// counts as a total loss and no more; and how many were compared.
@@ -151,6 +187,18 @@ pub(super) struct Settled {
     pub overall: Option<String>,
     /// What the re-identification showed, for the summary.
     pub note: String,
+    /// The grid speeds' reports of the discovery that continued from the
+    /// current model, when that model is the one stored.
+    pub points: Option<Vec<PointDiscovery>>,
+}
+
+/// Whether the current model loses to the gate's model on the held-out
+/// runs while beating the baseline: then discovery continues from it (the
+/// physics the force's model found beside the force may be missing from
+/// the current model too) before the two are compared again.
+fn continue_from_it(again: &Again, gated: Option<&Identified>) -> bool {
+    again.vs_baseline.keep
+        && gated.is_some_and(|g| advantage(&again.model.validation, &g.validation).0 <= 0.0)
 }
 
 /// Keeps the better of the gate's model (`gated`, `None` when the gate
@@ -160,6 +208,7 @@ pub(super) struct Settled {
 /// left for a discovery run on the new model.
 pub(super) fn settle(
     again: Again,
+    continued: Option<CampaignDiscovery>,
     gated: Option<Identified>,
     effects: &mut Vec<EffectAcrossGrid>,
     before: &[RunValidation],
@@ -179,22 +228,70 @@ pub(super) fn settle(
             model: gated,
             overall: None,
             note: format!("{found}; that model is not kept: {}.", vs_baseline.reason),
+            points: None,
         };
     }
-    let (gain, _) = advantage(&model.validation, before);
+    // The current model, or (when it loses to the force's model) the
+    // discovery that continued from it, with what it found there.
+    let mut model = model;
+    let mut vs_baseline = vs_baseline;
+    let mut on_top: Option<CampaignDiscovery> = None;
     if let Some(g) = &gated {
         let (edge, n) = advantage(&model.validation, &g.validation);
         if edge <= 0.0 {
-            return Settled {
-                model: gated,
-                overall: None,
-                note: format!(
-                    "{found}; on the held-out runs that model is better than the baseline but not than the model with the force fixed in NED (its {n} fits sum {} lower), so the force stands.",
-                    sig3(-edge)
-                ),
+            // What discovery on the current model did, in words, when it
+            // does not win either.
+            let mut on_it = "discovery did not run on it".to_owned();
+            let plus = continued.and_then(|mut c| {
+                let named: Vec<String> = c.report.effects.iter().map(|e| e.label.clone()).collect();
+                let Some(m) = c.augmented.take() else {
+                    on_it = if named.is_empty() {
+                        "discovery on it names nothing".to_owned()
+                    } else {
+                        format!(
+                            "discovery on it names {} and stores nothing",
+                            named.join("; ")
+                        )
+                    };
+                    return None;
+                };
+                let v = inertia_verdict(&m.document)
+                    .unwrap_or_else(|| compare_against(before, &m.validation, "the baseline"));
+                let (e2, _) = advantage(&m.validation, &g.validation);
+                on_it = format!(
+                    "with what discovery finds on it ({}) its fits sum {} {}",
+                    named.join("; "),
+                    sig3(e2.abs()),
+                    if e2 > 0.0 {
+                        "higher but it fails the gate against the baseline"
+                    } else {
+                        "lower"
+                    }
+                );
+                (v.keep && e2 > 0.0).then_some((m, v, c))
+            });
+            let Some((m, v, c)) = plus else {
+                return Settled {
+                    model: gated,
+                    overall: None,
+                    note: format!(
+                        "{found}; on the held-out runs that model is better than the baseline but not than the model with the force fixed in NED (its {n} fits sum {} lower; {on_it}), so the force stands.",
+                        sig3(-edge)
+                    ),
+                    points: None,
+                };
             };
+            model = m;
+            vs_baseline = v;
+            on_top = Some(c);
         }
     }
+    // The value the stored model holds (refitted when discovery went on).
+    let estimate = match on_top.as_ref().and_then(|_| held_current(&model.document)) {
+        Some(held) => held.estimate,
+        None => estimate,
+    };
+    let (gain, _) = advantage(&model.validation, before);
     let versus = match &gated {
         Some(g) => {
             let (edge, n) = advantage(&model.validation, &g.validation);
@@ -205,8 +302,24 @@ pub(super) fn settle(
         }
         None => String::new(),
     };
+    let with = match &on_top {
+        Some(c) => {
+            let kept: Vec<String> = c
+                .report
+                .effects
+                .iter()
+                .filter(|e| e.kept == Some(true))
+                .map(|e| e.label.clone())
+                .collect();
+            format!(
+                " and with what discovery found on that model ({})",
+                kept.join("; ")
+            )
+        }
+        None => String::new(),
+    };
     let reason = format!(
-        "identified again with the current, {}{versus}",
+        "identified again with the current{with}, {}{versus}",
         vs_baseline.reason
     );
     let why = if effects.iter().any(|e| e.effect.fixed_in_ned()) {
@@ -237,21 +350,33 @@ pub(super) fn settle(
     entry.kept = Some(true);
     entry.held_out_verdict = Some(reason.clone());
     entry.campaign_estimate = Some(estimate.clone());
-    for e in effects.iter_mut() {
+    let mut previous = std::mem::take(effects);
+    for e in previous.iter_mut() {
         e.kept = Some(false);
         e.held_out_verdict = Some(if e.effect.fixed_in_ned() {
             "the current, estimated with M and D̄ by identifying the campaign again, is its look-alike and explains the held-out runs better".to_owned()
+        } else if on_top.is_some() {
+            "named on the baseline; the stored model is the campaign identified again with the current and what discovery found on that model (listed with it)".to_owned()
         } else {
             "not in the stored model, which is the campaign identified again with the current; run discovery on it to test this again".to_owned()
         });
     }
-    effects.insert(0, entry);
+    let stored = if on_top.is_some() {
+        "The model identified again with the NED current, with what discovery found on it, was stored"
+    } else {
+        "The model identified again with the NED current was stored"
+    };
+    effects.push(entry);
+    let points = on_top.map(|c| {
+        effects.extend(c.report.effects);
+        c.report.points
+    });
+    effects.extend(previous);
     Settled {
         model: Some(model),
-        overall: Some(format!(
-            "The model identified again with the NED current was stored: {reason}."
-        )),
+        overall: Some(format!("{stored}: {reason}.")),
         note: format!("{found}. {why}"),
+        points,
     }
 }
 
@@ -271,8 +396,16 @@ fn campaign_estimate(c: &NedCurrentDoc) -> Estimated {
     let var_n = cb * cb * sv * sv + v * v * sn * sn * sb * sb;
     let var_e = sn * sn * sv * sv + v * v * cb * cb * sb * sb;
     let cov_ne = cb * sn * (sv * sv - v * v * sb * sb);
-    let mean = Vector2::new(c.ned_mps[0], c.ned_mps[1]);
-    let cov = Matrix2::new(var_n, cov_ne, cov_ne, var_e);
+    estimated(
+        Vector2::new(c.ned_mps[0], c.ned_mps[1]),
+        Matrix2::new(var_n, cov_ne, cov_ne, var_e),
+        "estimated once with M and D̄ at every grid speed by identifying the campaign again on the velocities through the water",
+    )
+}
+
+/// [V_N, V_E] with covariance `cov` as the campaign's estimate; `how` it
+/// was estimated ends the sentence.
+fn estimated(mean: Vector2<f64>, cov: Matrix2<f64>, how: &str) -> Estimated {
     let names = Effect::Current.coefficient_names();
     let coefficients = (0..2)
         .map(|j| Estimate {
@@ -283,7 +416,7 @@ fn campaign_estimate(c: &NedCurrentDoc) -> Estimated {
         .collect();
     let polar = polar(Effect::Current, &mean, &cov);
     let text = format!(
-        "{} for the campaign: {polar}, estimated once with M and D̄ at every grid speed by identifying the campaign again on the velocities through the water.",
+        "{} for the campaign: {polar}, {how}.",
         capital(&Effect::Current.label())
     );
     Estimated {
@@ -296,6 +429,32 @@ fn campaign_estimate(c: &NedCurrentDoc) -> Estimated {
             text,
         },
     }
+}
+
+/// The current a stored model holds: its `lpv.current`, or the one value
+/// every grid point's current term holds (with that term's covariance).
+fn held_current(doc: &ModelDocument) -> Option<Estimated> {
+    let lpv = doc.lpv.as_ref()?;
+    if let Some(c) = &lpv.current {
+        return Some(campaign_estimate(c));
+    }
+    let terms: Vec<_> = lpv
+        .points
+        .iter()
+        .filter_map(|p| p.augmentation.as_ref())
+        .filter_map(|a| a.terms.iter().find(|t| t.effect == Effect::Current))
+        .collect();
+    let first = terms.first()?;
+    let same = terms.iter().all(|t| t.coefficients == first.coefficients);
+    let (c, v) = (&first.coefficients, &first.covariance);
+    if !same || c.len() != 2 || v.len() != 2 || v.iter().any(|r| r.len() != 2) {
+        return None;
+    }
+    Some(estimated(
+        Vector2::new(c[0], c[1]),
+        Matrix2::new(v[0][0], v[0][1], v[1][0], v[1][1]),
+        "estimated with M and D̄ by identifying the campaign again, then refitted with what discovery found on that model and held at every grid speed",
+    ))
 }
 
 #[cfg(test)]
