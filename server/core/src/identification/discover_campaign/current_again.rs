@@ -202,10 +202,12 @@ fn continue_from_it(again: &Again, gated: Option<&Identified>) -> bool {
 }
 
 /// Keeps the better of the gate's model (`gated`, `None` when the gate
-/// stored nothing) and the re-identified one, and marks the effects: the
-/// current, when its model wins, goes first with its one estimate; the
-/// forces fixed in NED are then its look-alikes, and any other finding is
-/// left for a discovery run on the new model.
+/// stored nothing) and the re-identified one (or, when that loses, the
+/// model of the discovery `continued` from it), and marks the effects: the
+/// current, when its model wins, goes first with its one estimate (the
+/// value the stored model holds), then what the continued discovery
+/// found; the forces fixed in NED are its look-alikes, and any other
+/// finding on the baseline is left out with the reason.
 pub(super) fn settle(
     again: Again,
     continued: Option<CampaignDiscovery>,
