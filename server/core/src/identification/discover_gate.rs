@@ -78,19 +78,53 @@ impl Change {
 }
 
 fn changes(run: &str, b: &ChannelValidation, a: &ChannelValidation) -> Vec<Change> {
-    let c = |metric, before, after| Change {
-        run: run.to_string(),
-        channel: b.output.clone(),
-        metric,
-        before,
-        after,
-    };
-    vec![
-        c("1-step", b.fit_one_step, a.fit_one_step),
-        c("k-step", b.fit_k_step, a.fit_k_step),
-        c("10 s restarted free-run", b.fit_restarted, a.fit_restarted),
-        c("whole-run free-run", b.fit_simulation, a.fit_simulation),
+    fit_pairs(b, a)
+        .into_iter()
+        .map(|(metric, before, after)| Change {
+            run: run.to_string(),
+            channel: b.output.clone(),
+            metric,
+            before,
+            after,
+        })
+        .collect()
+}
+
+/// A channel's four held-out fits, before (`b`) and after (`a`): 1-step,
+/// k-step, 10 s restarted and whole-run free run.
+pub(crate) fn fit_pairs(
+    b: &ChannelValidation,
+    a: &ChannelValidation,
+) -> [(&'static str, Option<f64>, Option<f64>); 4] {
+    [
+        ("1-step", b.fit_one_step, a.fit_one_step),
+        ("k-step", b.fit_k_step, a.fit_k_step),
+        ("10 s restarted free-run", b.fit_restarted, a.fit_restarted),
+        ("whole-run free-run", b.fit_simulation, a.fit_simulation),
     ]
+}
+
+/// Each channel of `augmented`'s runs with the same run's channel of the
+/// same output in `baseline`: (run, before, after).
+pub(crate) fn paired<'a>(
+    baseline: &'a [RunValidation],
+    augmented: &'a [RunValidation],
+) -> impl Iterator<
+    Item = (
+        &'a RunValidation,
+        &'a ChannelValidation,
+        &'a ChannelValidation,
+    ),
+> {
+    augmented
+        .iter()
+        .filter_map(move |a| Some((a, baseline.iter().find(|b| b.run_id == a.run_id)?)))
+        .flat_map(|(a, b)| {
+            a.report.channels.iter().filter_map(move |ca| {
+                let cb = b.report.channels.iter().find(|c| c.output == ca.output)?;
+                Some((a, cb, ca))
+            })
+        })
 }
 
 /// Refuses an augmented model whose inertia is not physical: at some grid
@@ -135,22 +169,14 @@ pub fn compare_against(
 ) -> HeldOutVerdict {
     let mut all = Vec::new();
     let mut diverged = Vec::new();
-    for a in augmented {
-        let Some(b) = baseline.iter().find(|b| b.run_id == a.run_id) else {
-            continue;
-        };
-        for ca in &a.report.channels {
-            let Some(cb) = b.report.channels.iter().find(|c| c.output == ca.output) else {
-                continue;
-            };
-            if let (None, Some(d)) = (&cb.diverged.simulation, &ca.diverged.simulation) {
-                diverged.push(format!(
-                    "its free run on '{}' diverged at t = {:.1} s in {}",
-                    a.run_name, d.t_s, ca.output
-                ));
-            }
-            all.extend(changes(&a.run_name, cb, ca));
+    for (a, cb, ca) in paired(baseline, augmented) {
+        if let (None, Some(d)) = (&cb.diverged.simulation, &ca.diverged.simulation) {
+            diverged.push(format!(
+                "its free run on '{}' diverged at t = {:.1} s in {}",
+                a.run_name, d.t_s, ca.output
+            ));
         }
+        all.extend(changes(&a.run_name, cb, ca));
     }
     if all.is_empty() {
         return HeldOutVerdict {

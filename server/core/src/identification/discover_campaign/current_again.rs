@@ -13,7 +13,9 @@
 
 use nalgebra::{Matrix2, Vector2};
 
-use super::super::discover_gate::{HeldOutVerdict, compare_against, inertia_verdict};
+use super::super::discover_gate::{
+    HeldOutVerdict, compare_against, fit_pairs, inertia_verdict, paired,
+};
 use super::super::document::{ModelDocument, NedCurrentDoc};
 use super::super::error::IdentifyError;
 use super::super::lambda_campaign::identify_lambda_campaign;
@@ -152,27 +154,11 @@ pub(super) fn continue_discovery(
 pub(super) fn advantage(a: &[RunValidation], b: &[RunValidation]) -> (f64, usize) {
     let mut sum = 0.0;
     let mut n = 0;
-    for ra in a {
-        let Some(rb) = b.iter().find(|r| r.run_id == ra.run_id) else {
-            continue;
-        };
-        for ca in &ra.report.channels {
-            let Some(cb) = rb.report.channels.iter().find(|c| c.output == ca.output) else {
-                continue;
-            };
-            let pairs = [
-                (ca.fit_one_step, cb.fit_one_step),
-                (ca.fit_k_step, cb.fit_k_step),
-                (ca.fit_restarted, cb.fit_restarted),
-                (ca.fit_simulation, cb.fit_simulation),
-            ];
-            for (x, y) in pairs {
-                if let (Some(x), Some(y)) =
-                    (x.filter(|v| v.is_finite()), y.filter(|v| v.is_finite()))
-                {
-                    sum += x.clamp(-1.0, 1.0) - y.clamp(-1.0, 1.0);
-                    n += 1;
-                }
+    for (_, cb, ca) in paired(b, a) {
+        for (_, y, x) in fit_pairs(cb, ca) {
+            if let (Some(x), Some(y)) = (x.filter(|v| v.is_finite()), y.filter(|v| v.is_finite())) {
+                sum += x.clamp(-1.0, 1.0) - y.clamp(-1.0, 1.0);
+                n += 1;
             }
         }
     }
