@@ -31,6 +31,8 @@ struct Case {
     report: SurfaceReport,
     base: Identified,
     found: CampaignDiscovery,
+    profile: VesselProfile,
+    runs: Vec<RunInput>,
 }
 
 fn cases(seed: u64) -> Vec<(&'static str, Effects)> {
@@ -116,6 +118,8 @@ fn examine(
         report,
         base,
         found,
+        profile: profile.clone(),
+        runs: runs.to_vec(),
     }
 }
 
@@ -438,34 +442,9 @@ fn a_concealed_current_is_found_once_for_the_campaign() {
             }
             continue;
         }
-        // Every grid point examined holds the pooled pull (one without
-        // held-out runs keeps the baseline's sub-model).
-        if first.campaign_estimate.is_none() {
-            continue;
-        }
-        let examined: Vec<f64> = c
-            .found
-            .report
-            .points
-            .iter()
-            .map(|p| p.grid_speed_mps)
-            .collect();
-        for p in lpv
-            .points
-            .iter()
-            .filter(|p| examined.contains(&p.speed_mps))
-        {
-            let held = p
-                .augmentation
-                .as_ref()
-                .and_then(|a| a.terms.iter().find(|t| t.effect == first.effect))
-                .map(|t| &t.coefficients);
-            assert_eq!(
-                held,
-                Some(&vec![n, e]),
-                "seed {seed} at {} m/s",
-                p.speed_mps
-            );
+        // Every grid point holds the pooled pull.
+        if first.campaign_estimate.is_some() {
+            assert_holds_everywhere(aug, first.effect, [n, e], seed);
         }
     }
     assert!(
@@ -474,6 +453,92 @@ fn a_concealed_current_is_found_once_for_the_campaign() {
         SEEDS.len()
     );
     assert!(stored >= 3, "{stored} of {} stored", SEEDS.len());
+}
+
+/// Every grid point of the stored LPV model holds `effect` at `value`.
+fn assert_holds_everywhere(
+    aug: &Identified,
+    effect: seatrial_core::discrepancy::Effect,
+    value: [f64; 2],
+    seed: u64,
+) {
+    for p in &aug.document.lpv.as_ref().expect("LPV").points {
+        let held = p
+            .augmentation
+            .as_ref()
+            .and_then(|a| a.terms.iter().find(|t| t.effect == effect))
+            .map(|t| t.coefficients.clone());
+        assert_eq!(
+            held,
+            Some(value.to_vec()),
+            "seed {seed} at {} m/s",
+            p.speed_mps
+        );
+    }
+}
+
+/// A force fixed in NED acts at every forward speed. Where discovery does
+/// not examine a grid speed (here: not asked for; elsewhere: no held-out
+/// run there), the stored model holds the campaign's one estimate there
+/// too, that speed's M and D̄ refitted on its estimation runs with it; the
+/// report says which speeds were not examined and that the force is held
+/// at them. The Otter with its current concealed, discovery without the
+/// re-identification: the pull fixed in NED stands for the campaign.
+#[test]
+fn a_shared_force_is_held_at_the_grid_speeds_not_examined() {
+    let c = &otter_concealed_current()[0];
+    let lpv = c.base.document.lpv.as_ref().expect("LPV");
+    let grid: Vec<f64> = lpv.points.iter().map(|p| p.speed_mps).collect();
+    let asked = grid[..grid.len() - 1].to_vec();
+    let forces: Vec<String> = Dof::HORIZONTAL
+        .iter()
+        .map(|d| d.force_column().to_string())
+        .collect();
+    let found = discover_campaign(
+        &c.base.document,
+        &c.profile,
+        &forces,
+        &c.runs,
+        &c.base.estimation_run_ids,
+        &c.base.validation_run_ids,
+        &DiscoverCampaignSettings {
+            grid_speeds_mps: Some(asked.clone()),
+            reidentify_current: false,
+            ..DiscoverCampaignSettings::default()
+        },
+        &mut NoProgress,
+    )
+    .expect("discovery runs");
+    let rep = &found.report;
+    println!("{:#?}", rep.summary);
+    assert_eq!(rep.points.len(), asked.len(), "{:?}", rep.skipped);
+    assert_eq!(rep.skipped.len(), 1, "{:?}", rep.skipped);
+    assert!(rep.skipped[0].contains("not among settings.grid_speeds_mps"));
+    let first = rep.effects.first().expect("a force named");
+    assert!(first.effect.fixed_in_ned(), "{:?}", rep.summary);
+    let once = first.campaign_estimate.as_ref().expect("pooled");
+    let value = [once.coefficients[0].value, once.coefficients[1].value];
+    assert!(
+        rep.summary
+            .iter()
+            .any(|l| l.contains("is also held at the grid speeds not examined")),
+        "{:?}",
+        rep.summary
+    );
+    let aug = found.augmented.as_ref().expect("stored");
+    assert_holds_everywhere(aug, first.effect, value, c.report.seed);
+    // The speed not examined is refitted, not the baseline's sub-model.
+    let last = |doc: &seatrial_core::identification::ModelDocument| {
+        doc.lpv
+            .as_ref()
+            .expect("LPV")
+            .points
+            .last()
+            .expect("a point")
+            .d_bar
+            .clone()
+    };
+    assert_ne!(last(&aug.document), last(&c.base.document));
 }
 
 /// The supply vessel in DP, its current (0.05–0.5 m/s) concealed from the

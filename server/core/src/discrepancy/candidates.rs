@@ -159,9 +159,9 @@ impl Family {
             Family::CrossDamping => "cross-flow damping",
             Family::Coriolis => "Coriolis–centripetal coupling",
             Family::Restoring => "restoring force",
-            Family::ConstantLoad => "constant load (tether)",
+            Family::ConstantLoad => "constant load",
             Family::Current => "ocean current",
-            Family::Tether => "tether pull (fixed in NED)",
+            Family::Tether => "pull fixed in NED (tether, towline or mooring)",
             Family::Coupling => "missing coupling",
             Family::ActuatorLag => "actuator lag",
             Family::InputDelay => "input delay",
@@ -392,7 +392,9 @@ impl Effect {
                 )
             }
             Effect::Current => "ocean current (relative velocity ν − ν_c)".into(),
-            Effect::TetherPull => "tether pull fixed in NED (turns with heading)".into(),
+            Effect::TetherPull => {
+                "pull fixed in NED (tether, towline or mooring; turns with heading)".into()
+            }
             Effect::Coupling { dof, from } => {
                 format!("missing coupling from {} into {}", from.name(), dof.name())
             }

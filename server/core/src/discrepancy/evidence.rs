@@ -92,7 +92,7 @@ pub(crate) fn effect_text(t: &ModelTerm, h: f64) -> String {
             dof.force_unit()
         ),
         Effect::ConstantLoad { dof } => format!(
-            "A constant {} of {} {} acts in {} (tether pull, buoyancy or trim error).",
+            "A constant {} of {} {} acts in {} (a tether or mooring pull along the body axes, a buoyancy or trim error, or a thrust bias).",
             if dof.is_angular() { "moment" } else { "force" },
             pm(c(0), std_of(t, 0)),
             dof.force_unit(),
@@ -114,7 +114,7 @@ pub(crate) fn effect_text(t: &ModelTerm, h: f64) -> String {
             let (n, e) = (c(0), c(1));
             let to = e.atan2(n).to_degrees().rem_euclid(360.0);
             format!(
-                "A pull of {} N fixed in NED towards {:.0}° (north {}, east {} N) acts on the hull, as a tether leading to the ship does.",
+                "A pull of {} N fixed in NED towards {:.0}° (north {}, east {} N) acts on the hull, as a tether to the ship, a towline or a mooring line does.",
                 sig(n.hypot(e)),
                 to,
                 pm(n, std_of(t, 0)),

@@ -19,7 +19,8 @@ use super::lambda_settings::LambdaCampaignSettings;
 use super::outcome::Identified;
 use super::roles::nearest_grid_index;
 use crate::discrepancy::{
-    DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, Record, Verdict, discover_from,
+    AugmentedModel, DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, Record, Verdict,
+    discover_from,
 };
 use crate::estimation::Progress;
 use crate::estimation::lambda::MIN_T_OVER_H;
@@ -372,7 +373,10 @@ pub fn discover_campaign(
                 .is_none_or(|s| s.iter().any(|v| (v - grid[i]).abs() < 1e-6))
         })
         .collect();
-    let mut skipped = Vec::new();
+    let mut skipped: Vec<String> = (0..grid.len())
+        .filter(|i| !wanted.contains(i))
+        .map(|i| format!("{:.2} m/s: not among settings.grid_speeds_mps", grid[i]))
+        .collect();
     let todo: Vec<usize> = wanted
         .into_iter()
         .filter(|&i| {
@@ -471,6 +475,13 @@ pub fn discover_campaign(
         }
         Some(out)
     };
+    // The grid speeds not examined hold the shared force too.
+    let unexamined: Vec<(f64, AugmentedModel, &[Record])> = (0..grid.len())
+        .filter(|i| !todo.contains(i) && !pooled.is_empty())
+        .map(|i| Ok((grid[i], augmented_at(doc, &lpv.points[i])?, &est[i].0[..])))
+        .collect::<Result<_, IdentifyError>>()?;
+    let (held_only, notes) = shared::hold_unexamined(&unexamined, &dset, &pooled);
+    shared_notes.extend(notes);
     progress.update(0.9, "validating the baseline on the held-out runs")?;
     let asm = Assembly {
         doc,
@@ -481,6 +492,7 @@ pub fn discover_campaign(
         val_ids,
         settings,
         k: dset.k_step,
+        held_only: &held_only,
     };
     let again = current_again::applies(doc, settings, &effects, &carried);
     let gate_to = if again { 0.96 } else { 0.99 };

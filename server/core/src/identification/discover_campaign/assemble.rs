@@ -9,13 +9,16 @@ use nalgebra::DMatrix;
 use super::super::augmented::load_of;
 use super::super::dataset::RunInput;
 use super::super::document::ModelDocument;
-use super::super::document::{Method, ParameterRow, PointAugmentation, to_rows};
+use super::super::document::{
+    LoggedController, LpvDoc, Method, ParameterRow, PointAugmentation, to_rows,
+};
 use super::super::error::IdentifyError;
 use super::super::intersample::vehicle_from_logged;
 use super::super::outcome::{Identified, RunValidation};
 use super::super::predictor::validate_on_run;
 use super::{DiscoverCampaignSettings, PointDiscovery};
 use crate::discrepancy::ModelTerm;
+use crate::discrepancy::report::ModelReport;
 use crate::logs::schema::pose_column;
 use crate::planning::dof::Dof;
 
@@ -29,6 +32,9 @@ pub(super) struct Assembly<'a> {
     pub val_ids: &'a [String],
     pub settings: &'a DiscoverCampaignSettings,
     pub k: usize,
+    /// Grid speeds not examined, refitted with the campaign's shared
+    /// force held (`shared::held_alone`): they enter with any augmentation.
+    pub held_only: &'a [(f64, ModelReport)],
 }
 
 impl Assembly<'_> {
@@ -64,64 +70,31 @@ impl Assembly<'_> {
             .collect();
         let lpv = out.lpv.as_mut().expect("checked: LPV");
         let logged_controller = lpv.logged_controller.clone();
+        let mut applied = false;
         for (i, p) in self.points.iter().enumerate() {
-            let Some(pt) = lpv
-                .points
-                .iter_mut()
-                .find(|q| (q.speed_mps - p.grid_speed_mps).abs() < 1e-9)
-            else {
-                continue;
-            };
             if !kept.contains(&i) || p.report.findings.is_empty() {
                 continue;
             }
-            let model = &p.report.model;
-            let terms = &model.terms;
-            let m = DMatrix::from_fn(model.m.len(), model.m.len(), |i, j| model.m[i][j]);
-            let d = DMatrix::from_fn(model.d_bar.len(), model.d_bar.len(), |i, j| {
-                model.d_bar[i][j]
-            });
-            // Discovery fitted the model the logs see; the document keeps the
-            // vehicle's M and D̄ (the logged view is rebuilt when predicting).
-            let (m, d) = match &logged_controller {
-                Some(lc) => vehicle_from_logged(&m, &d, lc, &doc.dofs)
-                    .ok_or_else(super::super::intersample::malformed_controller)?,
-                None => (m, d),
-            };
-            let m_inv = m.clone().try_inverse().ok_or_else(|| {
-                IdentifyError::invalid(
-                    "document.lpv",
-                    format!("augmented M at {} m/s is singular", p.grid_speed_mps),
-                )
-            })?;
-            // A force fixed in NED is refitted with the constant loads it
-            // had been absorbed into.
-            let load: Vec<f64> = doc
-                .dofs
-                .iter()
-                .map(|d| model.restoring.constant[d.index()])
-                .collect();
-            if load != load_of(doc, pt).as_slice() {
-                pt.load = Some(load);
-            }
-            pt.augmentation = Some(PointAugmentation {
-                m_ref: model.m_ref.clone(),
-                d_ref: model.d_ref.clone(),
-                terms: terms.clone(),
-            });
-            pt.a = to_rows(&(-&m_inv * &d));
-            pt.b = to_rows(&m_inv);
-            pt.m = to_rows(&m);
-            pt.d_bar = to_rows(&d);
-            // Every term's estimates as refitted here (carried terms' earlier
-            // rows at this speed are replaced).
-            let speed = p.grid_speed_mps;
-            out.parameters.retain(|r| {
-                !(r.group.starts_with("discovered: ")
-                    && r.grid_speed_mps.is_some_and(|s| (s - speed).abs() < 1e-9))
-            });
-            for term in terms {
-                out.parameters.extend(term_rows(term, speed));
+            applied |= apply_at(
+                doc,
+                lpv,
+                logged_controller.as_ref(),
+                &mut out.parameters,
+                p.grid_speed_mps,
+                &p.report.model,
+            )?;
+        }
+        // The speeds not examined hold the campaign's shared force too.
+        if applied {
+            for (speed, model) in self.held_only {
+                apply_at(
+                    doc,
+                    lpv,
+                    logged_controller.as_ref(),
+                    &mut out.parameters,
+                    *speed,
+                    model,
+                )?;
             }
         }
         out.notes.insert(
@@ -137,6 +110,73 @@ impl Assembly<'_> {
             settings_used: serde_json::to_value(self.settings).unwrap_or_default(),
         })
     }
+}
+
+/// Grid point `speed` of `lpv` takes discovery's refitted `model`: its M,
+/// D̄, constant loads and terms, and the terms' parameter rows. `false`
+/// when the model has no such grid point.
+fn apply_at(
+    doc: &ModelDocument,
+    lpv: &mut LpvDoc,
+    logged_controller: Option<&LoggedController>,
+    parameters: &mut Vec<ParameterRow>,
+    speed: f64,
+    model: &ModelReport,
+) -> Result<bool, IdentifyError> {
+    let Some(pt) = lpv
+        .points
+        .iter_mut()
+        .find(|q| (q.speed_mps - speed).abs() < 1e-9)
+    else {
+        return Ok(false);
+    };
+    let terms = &model.terms;
+    let m = DMatrix::from_fn(model.m.len(), model.m.len(), |i, j| model.m[i][j]);
+    let d = DMatrix::from_fn(model.d_bar.len(), model.d_bar.len(), |i, j| {
+        model.d_bar[i][j]
+    });
+    // Discovery fitted the model the logs see; the document keeps the
+    // vehicle's M and D̄ (the logged view is rebuilt when predicting).
+    let (m, d) = match logged_controller {
+        Some(lc) => vehicle_from_logged(&m, &d, lc, &doc.dofs)
+            .ok_or_else(super::super::intersample::malformed_controller)?,
+        None => (m, d),
+    };
+    let m_inv = m.clone().try_inverse().ok_or_else(|| {
+        IdentifyError::invalid(
+            "document.lpv",
+            format!("augmented M at {speed} m/s is singular"),
+        )
+    })?;
+    // A force fixed in NED is refitted with the constant loads it had been
+    // absorbed into.
+    let load: Vec<f64> = doc
+        .dofs
+        .iter()
+        .map(|d| model.restoring.constant[d.index()])
+        .collect();
+    if load != load_of(doc, pt).as_slice() {
+        pt.load = Some(load);
+    }
+    pt.augmentation = Some(PointAugmentation {
+        m_ref: model.m_ref.clone(),
+        d_ref: model.d_ref.clone(),
+        terms: terms.clone(),
+    });
+    pt.a = to_rows(&(-&m_inv * &d));
+    pt.b = to_rows(&m_inv);
+    pt.m = to_rows(&m);
+    pt.d_bar = to_rows(&d);
+    // Every term's estimates as refitted here (carried terms' earlier rows
+    // at this speed are replaced).
+    parameters.retain(|r| {
+        !(r.group.starts_with("discovered: ")
+            && r.grid_speed_mps.is_some_and(|s| (s - speed).abs() < 1e-9))
+    });
+    for term in terms {
+        parameters.extend(term_rows(term, speed));
+    }
+    Ok(true)
 }
 
 /// The parameter-table rows of one discovered term at `speed`: its

@@ -172,7 +172,7 @@ fn pool(terms: &[(f64, &ModelTerm)], effect: Effect) -> Option<(ModelTerm, Campa
         )
     };
     let text = format!(
-        "{} for the campaign: {}, pooled from the estimates at {} grid speeds ({} m/s); {agreement}. Every grid speed's model is refitted with it held there.",
+        "{} for the campaign: {}, pooled from the estimates at {} grid speeds ({} m/s); {agreement}. Every examined grid speed's model is refitted with it held there.",
         capital(&effect.label()),
         polar(effect, &mean, &cov),
         ests.len(),
@@ -259,6 +259,61 @@ pub(super) fn held_at(
     }
     out.report.model = ModelReport::of(&model);
     Ok(out)
+}
+
+/// The grid speeds discovery did not examine (no held-out run there, or
+/// not asked for: (speed, its start model, its estimation records)) with
+/// the pooled terms held: each model refitted on its estimation runs with
+/// them at the campaign's values, its own terms (carried from the model
+/// examined) refitted beside them. Returns the refitted speeds and what the
+/// summary says of them; a speed without estimation runs, or whose refit
+/// fails, stays as it was, and the summary says so.
+pub(super) fn hold_unexamined(
+    unexamined: &[(f64, AugmentedModel, &[Record])],
+    settings: &DiscoverySettings,
+    pooled: &[(ModelTerm, CampaignEstimate)],
+) -> (Vec<(f64, ModelReport)>, Vec<String>) {
+    let Some((term, _)) = pooled.first() else {
+        return (vec![], vec![]);
+    };
+    let held: Vec<ModelTerm> = pooled.iter().map(|(t, _)| t.clone()).collect();
+    let (mut out, mut left) = (Vec::new(), Vec::new());
+    for (speed, start, est) in unexamined {
+        let own: Vec<ModelTerm> = start
+            .terms
+            .iter()
+            .filter(|t| !t.effect.fixed_in_ned())
+            .cloned()
+            .collect();
+        let fit = if est.is_empty() {
+            Err("no estimation run to refit on".to_owned())
+        } else {
+            refit_holding(start, est, settings, &own, &held)
+                .map(|m| ModelReport::of(&m))
+                .map_err(|e| e.to_string())
+        };
+        match fit {
+            Ok(model) => out.push((*speed, model)),
+            Err(why) => left.push(format!("{speed:.2} m/s ({why})")),
+        }
+    }
+    let label = term.effect.label();
+    let mut notes = Vec::new();
+    if !out.is_empty() {
+        let speeds: Vec<f64> = out.iter().map(|(s, _)| *s).collect();
+        notes.push(format!(
+            "{} is also held at the grid speeds not examined ({} m/s): their models are refitted on their estimation runs with it at the campaign's estimate.",
+            capital(&label),
+            speeds_text(&speeds)
+        ));
+    }
+    if !left.is_empty() {
+        notes.push(format!(
+            "At {} the model stays as it was, without the {label}.",
+            left.join(", ")
+        ));
+    }
+    (out, notes)
 }
 
 /// When the examined model was identified without the current discovery
@@ -438,6 +493,41 @@ mod tests {
         assert!((e.chi2 - 200.0).abs() < 1e-6);
         assert!((e.coefficients[1].std.unwrap() - 0.01 / 2f64.sqrt() * 10.0).abs() < 1e-9);
         assert!(e.text.contains("widened 10×"), "{}", e.text);
+    }
+
+    /// A speed not examined and without estimation runs keeps its model,
+    /// and the summary says so; nothing is held there.
+    #[test]
+    fn a_speed_without_estimation_runs_stays_as_it_was() {
+        use crate::discrepancy::{Baseline, Restoring};
+        use nalgebra::DMatrix;
+        let start = AugmentedModel::from_baseline(&Baseline {
+            dofs: Dof::HORIZONTAL.to_vec(),
+            m: DMatrix::identity(3, 3) * 100.0,
+            d_bar: DMatrix::identity(3, 3) * 50.0,
+            restoring: Restoring::default(),
+            coriolis: None,
+            quadratic: None,
+        });
+        let (a, b) = (term([0.1, -0.2], 1e-4), term([0.1, -0.18], 1e-4));
+        let pooled = vec![pool(&[(0.3, &a), (0.6, &b)], Effect::Current).expect("pooled")];
+        let (held, notes) =
+            hold_unexamined(&[(0.9, start, &[])], &DiscoverySettings::default(), &pooled);
+        assert!(held.is_empty());
+        assert_eq!(
+            notes,
+            vec![format!(
+                "At 0.90 m/s (no estimation run to refit on) the model stays as it was, without the {}.",
+                Effect::Current.label()
+            )]
+        );
+        // Nothing pooled: nothing to hold, nothing to say.
+        assert_eq!(
+            hold_unexamined(&[], &DiscoverySettings::default(), &[])
+                .1
+                .len(),
+            0
+        );
     }
 
     /// One speed's estimate, or a term without covariance, is no pool.
