@@ -172,7 +172,8 @@ fn the_otter_without_a_current_comes_within_five_hundredths() {
 /// The Otter in a current: the current within 5 % and 3° on every seed;
 /// the free runs, whose heading (and with it the current's push in the
 /// body frame) the model integrates over 180 s, within 0.05 of the true
-/// model's on 4 of 6 seeds and within 0.2 on all.
+/// model's on 4 of 6 seeds and within 0.1 on all (measured: 0.013–0.072;
+/// seed 4's 0.29 m/s current, near its slowest level, 0.072).
 #[test]
 fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
     let current: Vec<&SurfaceReport> = otter_reports()
@@ -206,7 +207,7 @@ fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
         );
         let gap = r.worst_gap().expect("every channel has a free run");
         assert!(
-            gap <= 0.2,
+            gap <= 0.1,
             "seed {}: {}\n{}",
             r.seed,
             r.line(),

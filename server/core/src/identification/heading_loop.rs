@@ -77,11 +77,16 @@ impl HeadingLoop {
             Some(ms) => (ms[lo].clone(), true),
             None => (self.lpv.points()[lo].m().clone(), false),
         };
+        let quadratic = self
+            .lpv
+            .quadratic_damping()
+            .map(|d| &d[lo] * w + &d[hi] * (1.0 - w));
         Relative {
             dofs: self.lpv.dofs().to_vec(),
             v: self.v,
             m,
             coriolis,
+            quadratic,
         }
         .drive(nu, psi, u0, &f)
     }

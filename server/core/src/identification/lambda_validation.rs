@@ -161,7 +161,7 @@ pub(crate) fn keep_current(
 
 /// Free-run NRMSE fit summed over runs and channels; a channel without a
 /// fit (diverged, constant output) counts −1, and none counts below −1.
-fn free_run_total(validation: &[RunValidation]) -> f64 {
+pub(crate) fn free_run_total(validation: &[RunValidation]) -> f64 {
     validation
         .iter()
         .flat_map(|r| &r.report.channels)

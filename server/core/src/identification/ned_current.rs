@@ -26,6 +26,7 @@ use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
 
 use super::dataset::Segment;
 use super::document::{NedCurrentDoc, ParameterRow};
+use super::lambda_quadratic::force_at;
 use super::roles::Roles;
 use crate::estimation::lambda::{Exogenous, Experiment, LambdaEstimate};
 use crate::logs::schema::pose_column;
@@ -275,6 +276,9 @@ pub(crate) struct Relative {
     pub m: DMatrix<f64>,
     /// The model carries the second-order C(δ)δ.
     pub coriolis: bool,
+    /// The model's D_q (surge: X_|u|u), when it applies D_q|δ|δ of ν
+    /// itself: [`Relative::drive`] moves it onto ν_r.
+    pub quadratic: Option<DVector<f64>>,
 }
 
 impl Relative {
@@ -299,7 +303,8 @@ impl Relative {
     /// −F e(ψ) (the damping of −ν_c), + M ν̇_c (ν̇_c = r·[v_c, −u_c, 0]
     /// for a current constant in NED), and, when the model carries C(δ)δ
     /// of ν, + C(δ)δ − C(δ_r)δ_r so that it acts on the relative velocity
-    /// δ_r = ν − ν_c − u₀ instead: for a current constant in NED,
+    /// δ_r = ν − ν_c − u₀ instead (and likewise D_q|δ|δ, when
+    /// `quadratic`): for a current constant in NED,
     /// M_RB ν̇ + C_RB(ν)ν = M_RB ν̇_r + C_RB(ν_r)ν_r (Fossen 2011,
     /// Property 8.1), and the added mass's C_A acts on ν_r, so the whole
     /// model reads M ν̇_r + C(ν_r)ν_r + D̄ ν_r + b = τ.
@@ -325,6 +330,10 @@ impl Relative {
             for i in 0..out.len() {
                 out[i] += c[i] - c_r[i];
             }
+        }
+        if let Some(d_q) = &self.quadratic {
+            let nu_r = nu - &nu_c;
+            out += force_at(d_q, nu, Some(surge), u0) - force_at(d_q, &nu_r, Some(surge), u0);
         }
         out
     }
@@ -541,6 +550,35 @@ mod tests {
             let got = f[(i, 0)] * e[(0, 0)] + f[(i, 1)] * e[(0, 1)];
             assert!((got - want).abs() < 1e-12, "{i}: {got} vs {want}");
         }
+    }
+
+    /// With D_q the model applies to ν, `drive` adds D_q(f(ν) − f(ν_r)):
+    /// the drag then acts on the velocity through the water. A current of
+    /// 0.2 m/s towards north seen at ψ = 90° is v_c = −0.2 m/s; at
+    /// ν = (0.5, 0.1, 0) and u₀ = 0.5: sway 20·(0.1² − 0.3²) = −1.6 N, surge
+    /// 0 (u_c = 0). At ψ = 0: u_r = 0.3, surge 10·(0 − (0.3 − 0.5)²) = −0.4 N.
+    #[test]
+    fn the_quadratic_drag_is_moved_onto_the_relative_velocity() {
+        let r = Relative {
+            dofs: Dof::HORIZONTAL.to_vec(),
+            v: Vector2::new(0.2, 0.0),
+            m: DMatrix::identity(3, 3),
+            coriolis: false,
+            quadratic: Some(DVector::from_vec(vec![10.0, 20.0, 0.0])),
+        };
+        let nu = DVector::from_vec(vec![0.5, 0.1, 0.0]);
+        let f = DMatrix::zeros(3, 2);
+        let east = r.drive(&nu, std::f64::consts::FRAC_PI_2, 0.5, &f);
+        let north = r.drive(&nu, 0.0, 0.5, &f);
+        for (got, want) in [
+            (east[0], 0.0),
+            (east[1], -1.6),
+            (north[0], -0.4),
+            (north[1], 0.0),
+        ] {
+            assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+        }
+        assert_eq!(east[2], 0.0);
     }
 
     #[test]
