@@ -453,8 +453,12 @@ fn identify(
                 .map(|(e, seg)| {
                     let r = relative.as_ref().filter(|_| current_forces(u0).is_some())?;
                     let psi = ned_current::heading(seg, n);
-                    (psi.len() >= e.nu.nrows())
-                        .then(|| DMatrix::from_fn(e.nu.nrows(), n, |k, i| r.nu_c(psi[k])[i]))
+                    let rows: Vec<_> = psi
+                        .get(..e.nu.nrows())?
+                        .iter()
+                        .map(|&p| r.nu_c(p).transpose())
+                        .collect();
+                    (!rows.is_empty()).then(|| DMatrix::from_rows(&rows))
                 })
                 .collect()
         })

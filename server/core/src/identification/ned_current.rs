@@ -323,8 +323,8 @@ impl Relative {
         nu_c_dot[surge] = nu[yaw] * nu_c[sway];
         nu_c_dot[sway] = -nu[yaw] * nu_c[surge];
         out += &self.m * nu_c_dot;
+        let nu_r = nu - &nu_c;
         if self.coriolis {
-            let nu_r = nu - &nu_c;
             let c = second_order_force_about(&self.dofs, &self.m, nu.as_slice(), surge, u0);
             let c_r = second_order_force_about(&self.dofs, &self.m, nu_r.as_slice(), surge, u0);
             for i in 0..out.len() {
@@ -332,7 +332,6 @@ impl Relative {
             }
         }
         if let Some(d_q) = &self.quadratic {
-            let nu_r = nu - &nu_c;
             out += force_at(d_q, nu, Some(surge), u0) - force_at(d_q, &nu_r, Some(surge), u0);
         }
         out

@@ -20,7 +20,7 @@ use super::{EffectAcrossGrid, PointDiscovery};
 use crate::discrepancy::locate::capital;
 use crate::discrepancy::report::{Estimate, Finding, ModelReport};
 use crate::discrepancy::{
-    AugmentedModel, DiscoverySettings, Effect, ModelTerm, Record, refit_holding,
+    AugmentedModel, DiscoveryError, DiscoverySettings, Effect, ModelTerm, Record, refit_holding,
 };
 use crate::logs::schema::pose_column;
 use crate::numbers::sig3;
@@ -190,6 +190,25 @@ fn pool(terms: &[(f64, &ModelTerm)], effect: Effect) -> Option<(ModelTerm, Campa
     ))
 }
 
+/// `start` refitted on `est` with the pooled terms held at the campaign's
+/// values and `terms` fitted beside them, less any force fixed in NED (the
+/// held one's look-alikes).
+fn refit_with_pooled(
+    start: &AugmentedModel,
+    terms: &[ModelTerm],
+    est: &[Record],
+    settings: &DiscoverySettings,
+    pooled: &[(ModelTerm, CampaignEstimate)],
+) -> Result<AugmentedModel, DiscoveryError> {
+    let own: Vec<ModelTerm> = terms
+        .iter()
+        .filter(|t| !t.effect.fixed_in_ned())
+        .cloned()
+        .collect();
+    let held: Vec<ModelTerm> = pooled.iter().map(|(t, _)| t.clone()).collect();
+    refit_holding(start, est, settings, &own, &held)
+}
+
 /// Point `p` with the pooled terms held: its model refitted on its
 /// estimation runs with them at the campaign's values and without their
 /// look-alikes (any other force fixed in NED), its findings of them showing
@@ -204,22 +223,13 @@ pub(super) fn held_at(
     pooled: &[(ModelTerm, CampaignEstimate)],
 ) -> Result<PointDiscovery, IdentifyError> {
     // Every force fixed in NED but the held one is its look-alike.
-    let is_shared = |e: Effect| e.fixed_in_ned();
-    let own: Vec<ModelTerm> = p
-        .report
-        .model
-        .terms
-        .iter()
-        .filter(|t| !is_shared(t.effect))
-        .cloned()
-        .collect();
-    let held: Vec<ModelTerm> = pooled.iter().map(|(t, _)| t.clone()).collect();
-    let model = refit_holding(start, est, settings, &own, &held).map_err(|e| {
-        IdentifyError::invalid(
-            e.field().to_string(),
-            format!("at grid speed {} m/s: {e}", p.grid_speed_mps),
-        )
-    })?;
+    let model =
+        refit_with_pooled(start, &p.report.model.terms, est, settings, pooled).map_err(|e| {
+            IdentifyError::invalid(
+                e.field().to_string(),
+                format!("at grid speed {} m/s: {e}", p.grid_speed_mps),
+            )
+        })?;
     let mut out = p.clone();
     out.report
         .findings
@@ -276,19 +286,12 @@ pub(super) fn hold_unexamined(
     let Some((term, _)) = pooled.first() else {
         return (vec![], vec![]);
     };
-    let held: Vec<ModelTerm> = pooled.iter().map(|(t, _)| t.clone()).collect();
     let (mut out, mut left) = (Vec::new(), Vec::new());
     for (speed, start, est) in unexamined {
-        let own: Vec<ModelTerm> = start
-            .terms
-            .iter()
-            .filter(|t| !t.effect.fixed_in_ned())
-            .cloned()
-            .collect();
         let fit = if est.is_empty() {
             Err("no estimation run to refit on".to_owned())
         } else {
-            refit_holding(start, est, settings, &own, &held)
+            refit_with_pooled(start, &start.terms, est, settings, pooled)
                 .map(|m| ModelReport::of(&m))
                 .map_err(|e| e.to_string())
         };
