@@ -424,119 +424,6 @@ impl Effect {
             _ => self.dof().and_then(idx).into_iter().collect(),
         }
     }
-
-    /// φ_p for coefficient `p` in equation row `row` at (ν, η), the force
-    /// it adds to the left-hand side per unit coefficient. Not used for
-    /// [`Effect::Coupling`] (which enters M and D̄) nor actuator effects.
-    pub fn regressor(
-        &self,
-        p: usize,
-        row: usize,
-        ctx: &TermContext<'_>,
-        nu: &[f64],
-        eta: &[f64; 6],
-    ) -> f64 {
-        let row_dof = ctx.dofs[row];
-        let v = |d: Dof| ctx.dofs.iter().position(|&x| x == d).map_or(0.0, |j| nu[j]);
-        match *self {
-            Effect::QuadraticDamping { dof } if dof == row_dof => {
-                let x = v(dof);
-                x.abs() * x
-            }
-            Effect::CubicDamping { dof } if dof == row_dof => v(dof).powi(3),
-            Effect::CrossDamping { dof, from } if dof == row_dof => v(from).abs() * v(dof),
-            Effect::CoriolisFromM => coriolis_force6(ctx.dofs, ctx.m_ref, nu)[row_dof.index()],
-            Effect::CoriolisProduct { dof, a, b } if dof == row_dof => v(a) * v(b),
-            Effect::Restoring { dof, shape } if dof == row_dof => {
-                let (sp, cp) = eta[3].sin_cos();
-                let (st, ct) = eta[4].sin_cos();
-                let _ = cp;
-                match shape {
-                    RestoringShape::SinTheta => st,
-                    RestoringShape::CosThetaSinPhi => ct * sp,
-                }
-            }
-            Effect::ConstantLoad { dof } if dof == row_dof => 1.0,
-            Effect::Current => {
-                let (Some(iu), Some(iv)) = (ctx.index(Dof::Surge), ctx.index(Dof::Sway)) else {
-                    return 0.0;
-                };
-                let (du, dv) = (ctx.d_ref[(row, iu)], ctx.d_ref[(row, iv)]);
-                let (mu, mv) = (ctx.m_ref[(row, iu)], ctx.m_ref[(row, iv)]);
-                let r = v(Dof::Yaw);
-                let (s, c) = eta[5].sin_cos();
-                // The hull feels ν_r = ν − ν_c, ν_c = R(ψ)ᵀ[V_N V_E]ᵀ =
-                // [V_N c + V_E s, −V_N s + V_E c]: M ν̇_r + D̄ ν_r = τ moves
-                // −D̄ ν_c and −M ν̇_c to the right, where the current turning
-                // in the body frame gives ν̇_c = r·[v_c, −u_c].
-                if p == 0 {
-                    -(du * c - dv * s) + r * (mu * s + mv * c)
-                } else {
-                    -(du * s + dv * c) - r * (mu * c - mv * s)
-                }
-            }
-            Effect::TetherPull => {
-                // Columns of R(Θ) = R_z(ψ)R_y(θ)R_x(φ) are the body axes in
-                // NED: the pull's body components are their dot products
-                // with [F_N F_E 0], moved to the left-hand side.
-                let (sp, cp) = eta[3].sin_cos();
-                let (st, ct) = eta[4].sin_cos();
-                let (ss, cs) = eta[5].sin_cos();
-                let axis = match row_dof {
-                    Dof::Surge => [cs * ct, ss * ct],
-                    Dof::Sway => [cs * st * sp - ss * cp, ss * st * sp + cs * cp],
-                    _ => return 0.0,
-                };
-                -axis[p.min(1)]
-            }
-            _ => 0.0,
-        }
-    }
-}
-
-impl Effect {
-    /// Adds the term's force Σ_p θ_p φ_p (left-hand side) to `out`, every
-    /// row at once: the same as summing [`Self::regressor`] row by row, with
-    /// C(ν)ν and the current's rotation computed once per state (the
-    /// simulators call this four times per RK4 step).
-    pub fn add_force(
-        &self,
-        theta: &[f64],
-        ctx: &TermContext<'_>,
-        nu: &[f64],
-        eta: &[f64; 6],
-        out: &mut [f64],
-    ) {
-        match *self {
-            Effect::CoriolisFromM => {
-                let c = coriolis_force6(ctx.dofs, ctx.m_ref, nu);
-                for (o, d) in out.iter_mut().zip(ctx.dofs) {
-                    *o += theta[0] * c[d.index()];
-                }
-            }
-            Effect::Current => {
-                let (Some(iu), Some(iv)) = (ctx.index(Dof::Surge), ctx.index(Dof::Sway)) else {
-                    return;
-                };
-                let r = ctx.index(Dof::Yaw).map_or(0.0, |j| nu[j]);
-                let (s, c) = eta[5].sin_cos();
-                for (row, o) in out.iter_mut().enumerate().take(ctx.dofs.len()) {
-                    let (du, dv) = (ctx.d_ref[(row, iu)], ctx.d_ref[(row, iv)]);
-                    let (mu, mv) = (ctx.m_ref[(row, iu)], ctx.m_ref[(row, iv)]);
-                    let north = -(du * c - dv * s) + r * (mu * s + mv * c);
-                    let east = -(du * s + dv * c) - r * (mu * c - mv * s);
-                    *o += theta[0] * north + theta[1] * east;
-                }
-            }
-            _ => {
-                for (row, o) in out.iter_mut().enumerate().take(ctx.dofs.len()) {
-                    for (p, th) in theta.iter().enumerate() {
-                        *o += th * self.regressor(p, row, ctx, nu, eta);
-                    }
-                }
-            }
-        }
-    }
 }
 
 fn load_word(dof: Dof) -> &'static str {
@@ -563,7 +450,6 @@ impl TermContext<'_> {
 }
 
 pub use crate::models::coriolis::coriolis_force;
-use crate::models::coriolis::coriolis_force6;
 
 /// Which candidate families to try.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -700,6 +586,8 @@ pub fn library(
     }
     out
 }
+
+mod force;
 
 #[cfg(test)]
 mod tests;

@@ -1,8 +1,6 @@
 //! The entry point: locate, name, model, show, ask, be honest.
 
-use serde::{Deserialize, Serialize};
-
-use super::candidates::{Effect, LibrarySettings, library};
+use super::candidates::{Effect, library};
 use super::data::{Baseline, Record};
 use super::drift::current_drift;
 use super::error::DiscoveryError;
@@ -13,140 +11,20 @@ use super::locate::{
     Predictions, capital, channel_fits, force_residual, locate, predict, residual,
 };
 use super::lookalike::{Selection, look_alikes};
-use super::model::{AugmentedModel, ModelTerm};
+use super::model::AugmentedModel;
 use super::narrate::{hypothesis, plot_series, summary, unexplained};
 use super::report::*;
 use super::residual::whiteness;
 use super::select::{Criteria, Scored, step};
 use crate::estimation::Progress;
 use crate::numbers::sig3;
-use crate::planning::VesselProfile;
 
-/// Settings of [`discover`]. Defaults suit a 10 Hz ROV log.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
-#[serde(default)]
-pub struct DiscoverySettings {
-    /// T of the state-variable filter λ(s) = 1/(1+sT) (s).
-    pub svf_time_constant_s: f64,
-    /// k of the k-step predictions (thesis: 10).
-    pub k_step: usize,
-    /// Bartlett window of the HAC covariance (s).
-    pub hac_window_s: f64,
-    /// Least significance z of a term.
-    pub min_z: f64,
-    /// Largest ΔBIC of a term (negative: evidence for it).
-    pub max_delta_bic: f64,
-    /// Least held-out free-run fit gain (summed over channels) to accept a term.
-    pub min_cv_gain: f64,
-    /// Least size of a term's force against the command in its DOF (RMS
-    /// over RMS, λ-filtered, on the estimation runs): below it a term is
-    /// too small to matter, however significant.
-    pub min_force_share: f64,
-    /// A look-alike whose held-out gain reaches this share of the winner's is
-    /// reported as ambiguous.
-    pub ambiguity_ratio: f64,
-    /// Most terms added.
-    pub max_terms: usize,
-    /// Candidates cross-validated per step.
-    pub cv_candidates: usize,
-    /// Longest actuator lag searched (s).
-    pub max_lag_s: f64,
-    /// Longest input delay searched (s).
-    pub max_delay_s: f64,
-    /// Segment length of the location report (s).
-    pub segment_s: f64,
-    /// Window of the test whether a fitted current is constant (s).
-    pub drift_window_s: f64,
-    /// Points per plot series.
-    pub plot_points: usize,
-    /// Candidate families.
-    pub library: LibrarySettings,
-    /// The vessel, for deciding-experiment proposals within its limits.
-    pub vessel: Option<VesselProfile>,
-}
+mod refit;
+mod settings;
 
-impl Default for DiscoverySettings {
-    fn default() -> Self {
-        DiscoverySettings {
-            svf_time_constant_s: 0.5,
-            k_step: 10,
-            hac_window_s: 3.0,
-            min_z: 4.0,
-            max_delta_bic: -10.0,
-            min_cv_gain: 0.01,
-            min_force_share: 0.02,
-            ambiguity_ratio: 0.8,
-            max_terms: 4,
-            cv_candidates: 5,
-            max_lag_s: 3.0,
-            max_delay_s: 1.0,
-            segment_s: 30.0,
-            drift_window_s: 15.0,
-            plot_points: 400,
-            library: LibrarySettings::default(),
-            vessel: None,
-        }
-    }
-}
-
-impl DiscoverySettings {
-    fn validate(&self) -> Result<(), DiscoveryError> {
-        let pos = |name: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(DiscoveryError::invalid(
-                    format!("settings.{name}"),
-                    "must be finite and > 0",
-                ))
-            }
-        };
-        pos("svf_time_constant_s", self.svf_time_constant_s)?;
-        pos("hac_window_s", self.hac_window_s)?;
-        pos("min_z", self.min_z)?;
-        pos("max_lag_s", self.max_lag_s)?;
-        pos("max_delay_s", self.max_delay_s)?;
-        pos("segment_s", self.segment_s)?;
-        pos("drift_window_s", self.drift_window_s)?;
-        pos("ambiguity_ratio", self.ambiguity_ratio)?;
-        if !(self.min_force_share.is_finite() && (0.0..1.0).contains(&self.min_force_share)) {
-            return Err(DiscoveryError::invalid(
-                "settings.min_force_share",
-                "must be in [0, 1)",
-            ));
-        }
-        if !(self.min_cv_gain.is_finite() && self.max_delta_bic.is_finite()) {
-            return Err(DiscoveryError::invalid(
-                "settings.min_cv_gain",
-                "must be finite",
-            ));
-        }
-        if self.k_step == 0 || self.k_step > 1000 {
-            return Err(DiscoveryError::invalid(
-                "settings.k_step",
-                "must be in 1..=1000",
-            ));
-        }
-        if self.max_terms > 20 {
-            return Err(DiscoveryError::invalid(
-                "settings.max_terms",
-                "must be at most 20",
-            ));
-        }
-        if self.plot_points < 2 {
-            return Err(DiscoveryError::invalid(
-                "settings.plot_points",
-                "must be at least 2",
-            ));
-        }
-        if let Some(v) = &self.vessel {
-            v.validate()
-                .map_err(|e| DiscoveryError::invalid("settings.vessel", e.to_string()))?;
-        }
-        Ok(())
-    }
-}
+pub(crate) use refit::fit_chosen;
+pub use refit::{FIT_NOISE, fit_gain, refit_holding};
+pub use settings::DiscoverySettings;
 
 fn check(p: &mut dyn Progress, f: f64, stage: &str) -> Result<(), DiscoveryError> {
     p.update(f, stage).map_err(DiscoveryError::from)
@@ -637,165 +515,4 @@ fn prepare<'a>(
             "no samples left after the filter transient",
         )
     })
-}
-
-/// The model of the terms `chosen` fitted on every run of `prep`: three
-/// fits — the touched rows' couplings held, free, or every row refitted (a
-/// baseline that absorbed the effect through its couplings in other rows
-/// gives it back) — of which the one that harms the estimation runs' fits
-/// least, then gains most, is kept; a fit whose M is not positive definite
-/// is not a vessel and is taken only when no fit is. `base_model` when
-/// nothing can be fitted.
-pub(crate) fn fit_chosen(
-    prep: &Prepared<'_>,
-    base_model: &AugmentedModel,
-    est: &[Record],
-    chosen: &[Spec],
-    shape_std: &[Option<f64>],
-    k: usize,
-) -> AugmentedModel {
-    let n = prep.baseline.n();
-    let runs: Vec<usize> = (0..est.len()).collect();
-    let all_rows: Vec<usize> = (0..n).collect();
-    let fit_variant = |v: usize, hac: bool| match v {
-        0 => prep.fit_for_model(chosen, &runs, hac),
-        1 => prep.fit(chosen, &[], &runs, hac),
-        _ => prep.fit(chosen, &all_rows, &runs, hac),
-    };
-    let fitted: Vec<&Record> = est.iter().collect();
-    let base_on_fitted: Vec<Predictions> =
-        fitted.iter().map(|r| predict(base_model, r, k)).collect();
-    let mut best: Option<(usize, (bool, f64, f64))> = None;
-    for v in 0..3 {
-        let Some(f) = fit_variant(v, false) else {
-            continue;
-        };
-        let candidate = prep.model(chosen, &f, &[]);
-        let (harm, gain) = change_score(&base_on_fitted, &candidate, &fitted, k);
-        let score = (candidate.inertia_positive(), harm, gain);
-        if best.is_none_or(|(_, b)| score > b) {
-            best = Some((v, score));
-        }
-    }
-    best.and_then(|(v, _)| fit_variant(v, true))
-        .map_or_else(|| base_model.clone(), |f| prep.model(chosen, &f, shape_std))
-}
-
-/// The terms of `start` and `terms` refitted on `estimation_runs` with the
-/// coefficients of `held` fixed: a force the campaign shares (a current, a
-/// pull fixed in NED), estimated once for it, enters each grid speed's
-/// model at that value, and M, D̄ and the speed's other terms are fitted
-/// around it as [`discover_from`] fits its chosen terms. A run too short or
-/// malformed is left out (as `discover_from` sets it aside).
-///
-/// # Errors
-/// [`DiscoveryError::Invalid`] for a malformed start model or settings, or
-/// when no run is usable.
-pub fn refit_holding(
-    start: &AugmentedModel,
-    estimation_runs: &[Record],
-    settings: &DiscoverySettings,
-    terms: &[ModelTerm],
-    held: &[ModelTerm],
-) -> Result<AugmentedModel, DiscoveryError> {
-    let baseline = &start.baseline();
-    baseline.validate()?;
-    settings.validate()?;
-    let n = baseline.n();
-    let h = estimation_runs
-        .iter()
-        .map(|r| r.h)
-        .find(|h| h.is_finite() && *h > 0.0)
-        .ok_or_else(|| DiscoveryError::invalid("estimation_runs", "at least one run is needed"))?;
-    let skip = transient(settings, h);
-    let min_len = skip + settings.k_step + 64;
-    let est: Vec<Record> = estimation_runs
-        .iter()
-        .enumerate()
-        .filter(|(i, r)| {
-            r.validate(n, min_len, &format!("estimation_runs[{i}]"))
-                .is_ok()
-                && (r.h - h).abs() <= 1e-9 * h
-        })
-        .map(|(_, r)| r.clone())
-        .collect();
-    if est.is_empty() {
-        return Err(DiscoveryError::invalid(
-            "estimation_runs",
-            "no run long enough to refit on",
-        ));
-    }
-    let hac_lags = ((settings.hac_window_s / h).ceil() as usize).max(1);
-    let prep = prepare(baseline, &est, settings, skip, hac_lags)?.holding(held.to_vec());
-    // The start's terms, then the others; a held effect once.
-    let mut all: Vec<&ModelTerm> = Vec::new();
-    for t in start.terms.iter().chain(terms).chain(held) {
-        if !all.iter().any(|a| a.effect == t.effect) {
-            all.push(t);
-        }
-    }
-    let chosen: Vec<Spec> = all
-        .iter()
-        .map(|t| Spec {
-            effect: t.effect,
-            shape: t.shape,
-        })
-        .collect();
-    let shape_std: Vec<Option<f64>> = all.iter().map(|t| t.shape_std).collect();
-    Ok(fit_chosen(
-        &prep,
-        start,
-        &est,
-        &chosen,
-        &shape_std,
-        settings.k_step,
-    ))
-}
-
-/// A change of an NRMSE fit (1 − NRMSE) below this is noise.
-pub const FIT_NOISE: f64 = 0.005;
-
-/// The change of one fit from `before` to `after`: positive when better;
-/// −∞ when a fit the baseline had is lost. Fits below 0 (worse than the
-/// record's mean) count as 0: two predictions that both miss are not ranked
-/// by how badly.
-pub fn fit_gain(before: Option<f64>, after: Option<f64>) -> f64 {
-    match (before, after) {
-        (Some(b), Some(a)) => a.max(0.0) - b.max(0.0),
-        (Some(_), None) => f64::NEG_INFINITY,
-        (None, _) => 0.0,
-    }
-}
-
-/// How a model changes the channels' fits (1-step, k-step, free run; fits
-/// below 0 count as 0) from the base model's predictions `before` on `runs`:
-/// (the worst loss beyond
-/// noise, 0 if none; the summed change). The kept model is the one of its
-/// two fits (couplings free or held, see `Prepared::fit_for_model`) that
-/// harms the untouched channels least, then gains most — judged on the
-/// estimation runs, so the held-out runs stay an independent test.
-fn change_score(
-    before: &[Predictions],
-    model: &AugmentedModel,
-    runs: &[&Record],
-    k: usize,
-) -> (f64, f64) {
-    let after: Vec<Predictions> = runs.iter().map(|r| predict(model, r, k)).collect();
-    let (mut worst, mut total) = (0.0_f64, 0.0);
-    for i in 0..model.dofs.len() {
-        let (b, a) = (channel_fits(runs, before, i), channel_fits(runs, &after, i));
-        for (x, y) in [
-            (b.one_step, a.one_step),
-            (b.k_step, a.k_step),
-            (b.free_run, a.free_run),
-        ] {
-            // A lost fit counts as the largest possible loss of a fit ≤ 1.
-            let d = fit_gain(x, y).max(-1.0);
-            if d < -FIT_NOISE {
-                worst = worst.min(d);
-            }
-            total += d;
-        }
-    }
-    (worst, total)
 }

@@ -1,0 +1,319 @@
+//! One fit's weighted normal equations: the rows' baseline blocks, the
+//! terms' filtered regressors and the constant loads assembled over the
+//! runs, solved with Jacobi scaling, with HAC covariances.
+
+use super::*;
+
+impl Prepared<'_> {
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn fit_with(
+        &self,
+        m_ref: &DMatrix<f64>,
+        d_ref: &DMatrix<f64>,
+        specs: &[Spec],
+        extra: &[usize],
+        runs: &[usize],
+        hac: bool,
+        hold: bool,
+    ) -> Option<FitOut> {
+        let rows = self.rows_of(specs, extra);
+        if rows.is_empty() {
+            return None;
+        }
+        let dofs = &self.baseline.dofs;
+        let shapes: Vec<(Effect, f64)> = specs
+            .iter()
+            .filter_map(|s| s.shape.map(|v| (s.effect, v)))
+            .collect();
+        // Parameter layout: base entries of each row, then the specs' θ.
+        let freed: Vec<(Vec<usize>, Vec<usize>)> =
+            rows.iter().map(|&r| self.freed(r, &rows, hold)).collect();
+        let mut base_index = Vec::with_capacity(rows.len());
+        let mut p = 0;
+        for (mf, df) in &freed {
+            base_index.push(p);
+            p += mf.len() + df.len();
+        }
+        let mut theta_index = Vec::with_capacity(specs.len());
+        for s in specs {
+            theta_index.push(p);
+            if self.held_values(s.effect).is_none() {
+                p += s.effect.n_linear();
+            }
+        }
+        // The constant loads of the rows, after the terms' θ, when a force
+        // fixed in NED is fitted (not when M, D̄ are held: a short window's
+        // heading barely turns, and the force would be the load).
+        let free_loads = !self.frozen && specs.iter().any(|s| s.effect.fixed_in_ned());
+        let load_index: Vec<Option<usize>> = rows
+            .iter()
+            .map(|_| {
+                free_loads.then(|| {
+                    p += 1;
+                    p - 1
+                })
+            })
+            .collect();
+        let ctx = TermContext { dofs, m_ref, d_ref };
+        let mut hmat = DMatrix::<f64>::zeros(p, p);
+        let mut bvec = vec![0.0; p];
+        let mut blocks: Vec<Block> = Vec::new();
+        let mut block_rows: Vec<usize> = Vec::new();
+        let mut n_tot = 0;
+        for &run in runs {
+            let rec = &self.records[run];
+            let pr = &self.runs[run];
+            let len = rec.len();
+            if len <= self.skip + 1 {
+                continue;
+            }
+            for (ri, &r) in rows.iter().enumerate() {
+                let w = self.weights[r];
+                let dof = dofs[r];
+                // Target [λτ_a] − [λg]: the applied force depends on the
+                // actuator hypotheses of this DOF.
+                let lam_tau_a = shapes.iter().any(|(e, _)| e.acts_on(dof)).then(|| {
+                    let (x, lag) = actuate(rec.tau.column(r).as_slice(), dof, &shapes);
+                    match lag {
+                        Some(t) => self.svf.foh(&lag_zoh(&x, t, rec.h)),
+                        None => self.svf.zoh(&x),
+                    }
+                });
+                let (mf, df) = &freed[ri];
+                let mut bb = self.base_block(run, r, w, mf, df, lam_tau_a);
+                // Held terms' forces go to the known side.
+                let held: Vec<&ModelTerm> = specs
+                    .iter()
+                    .filter_map(|s| self.held_values(s.effect))
+                    .filter(|t| t.effect.rows(dofs, &self.baseline.d_bar).contains(&r))
+                    .collect();
+                if !held.is_empty() {
+                    let mut y = bb.y.as_ref().clone();
+                    for t in &held {
+                        for (pi, c) in t.coefficients.iter().enumerate() {
+                            let f = self.filtered_regressor(t.effect, pi, r, run, &ctx);
+                            for (yk, fk) in y.iter_mut().zip(&f[self.skip..]) {
+                                *yk -= c * w * fk;
+                            }
+                        }
+                    }
+                    bb.by = blocks::products(&y, &bb.cols);
+                    bb.y = Rc::new(y);
+                }
+                let nb = bb.cols.len();
+                let y = Rc::clone(&bb.y);
+                let mut idx: Vec<usize> = (base_index[ri]..base_index[ri] + nb).collect();
+                let mut cols: Vec<Rc<Vec<f64>>> = bb.cols.clone();
+                for (si, s) in specs.iter().enumerate() {
+                    let nl = s.effect.n_linear();
+                    if nl == 0
+                        || self.held_values(s.effect).is_some()
+                        || !s.effect.rows(dofs, &self.baseline.d_bar).contains(&r)
+                    {
+                        continue;
+                    }
+                    if let Effect::Coupling { from, .. } = s.effect {
+                        let j = dofs.iter().position(|&d| d == from)?;
+                        idx.push(theta_index[si]);
+                        cols.push(Rc::new(weighted(&pr.dlam_nu[j][self.skip..], w)));
+                        idx.push(theta_index[si] + 1);
+                        cols.push(Rc::new(weighted(&pr.lam_nu[j][self.skip..], w)));
+                        continue;
+                    }
+                    for pi in 0..nl {
+                        let f = self.filtered_regressor(s.effect, pi, r, run, &ctx);
+                        idx.push(theta_index[si] + pi);
+                        cols.push(Rc::new(weighted(&f[self.skip..], w)));
+                    }
+                }
+                if let Some(li) = load_index[ri] {
+                    idx.push(li);
+                    cols.push(Rc::new(weighted(&pr.lam_one[self.skip..], w)));
+                }
+                // The baseline block's products come from the cache; the
+                // terms' columns are multiplied with every column.
+                let mut prods = vec![0.0; idx.len() + 1];
+                for a in 0..idx.len() {
+                    if a < nb {
+                        bvec[idx[a]] += bb.by[a];
+                    }
+                    let from = a.max(nb);
+                    let ys: Vec<&[f64]> = std::iter::once(y.as_slice())
+                        .chain(cols[from..].iter().map(|c| c.as_slice()))
+                        .collect();
+                    let out = &mut prods[..ys.len()];
+                    out.fill(0.0);
+                    crate::kernels::dots(&cols[a], &ys, out);
+                    if a >= nb {
+                        bvec[idx[a]] += out[0];
+                    }
+                    for b in a..idx.len() {
+                        let v = if b < nb {
+                            bb.gram[a * nb + b]
+                        } else {
+                            out[1 + b - from]
+                        };
+                        hmat[(idx[a], idx[b])] += v;
+                        if a != b {
+                            hmat[(idx[b], idx[a])] += v;
+                        }
+                    }
+                }
+                n_tot += y.len();
+                blocks.push((idx, cols, y));
+                block_rows.push(r);
+            }
+        }
+        if n_tot <= p {
+            return None;
+        }
+        let (theta_all, h_inv) = solve_scaled(&hmat, &bvec)?;
+        let mut sse = 0.0;
+        let mut resid = Vec::with_capacity(blocks.len());
+        for (idx, cols, y) in &blocks {
+            // Σ_i θ_i c_i[k] column by column (the same order per sample).
+            let mut fitted = vec![0.0; y.len()];
+            for (&i, c) in idx.iter().zip(cols) {
+                let t = theta_all[i];
+                for (f, v) in fitted.iter_mut().zip(c.iter()) {
+                    *f += t * v;
+                }
+            }
+            let e: Vec<f64> = y.iter().zip(&fitted).map(|(y, f)| y - f).collect();
+            sse += dot(&e, &e);
+            resid.push(e);
+        }
+        // Sandwich H⁻¹ S H⁻¹ on the θ block only: with C = H⁻¹[θ, :] the
+        // block is C S Cᵀ = Σ_l w_l Σ_k h_k h_{k−l}ᵀ over the projected
+        // scores h_k = C φ_k e_k, which costs t² per lag instead of p².
+        let t0 = theta_index.first().copied().unwrap_or(p);
+        let cov = hac.then(|| {
+            let t = p - t0;
+            let mut s = DMatrix::<f64>::zeros(t, t);
+            for ((idx, cols, _), e) in blocks.iter().zip(&resid) {
+                let len = e.len();
+                let mut h = vec![vec![0.0; len]; t];
+                for (a, &ia) in idx.iter().enumerate() {
+                    for (ti, hv) in h.iter_mut().enumerate() {
+                        let c = h_inv[(t0 + ti, ia)];
+                        if c != 0.0 {
+                            for k in 0..len {
+                                hv[k] += c * cols[a][k] * e[k];
+                            }
+                        }
+                    }
+                }
+                for l in 0..=self.hac_lags.min(len.saturating_sub(1)) {
+                    let wl = 1.0 - l as f64 / (self.hac_lags as f64 + 1.0);
+                    for a in 0..t {
+                        for b in 0..t {
+                            let acc = dot(&h[a][l..], &h[b][..len - l]);
+                            let v = if l == 0 { acc } else { wl * acc };
+                            s[(a, b)] += v;
+                            if l > 0 {
+                                s[(b, a)] += v;
+                            }
+                        }
+                    }
+                }
+            }
+            s
+        });
+        let base = rows
+            .iter()
+            .enumerate()
+            .map(|(ri, &r)| {
+                // Every free entry of the row: fitted, or held at the baseline.
+                let (mf, df) = &self.structure[r];
+                let (fm, fd) = &freed[ri];
+                let i0 = base_index[ri];
+                let value = |free: &[usize], j: usize, at: usize, held: f64| {
+                    free.iter()
+                        .position(|&x| x == j)
+                        .map_or(held, |k| theta_all[at + k])
+                };
+                (
+                    mf.iter()
+                        .map(|&j| value(fm, j, i0, self.baseline.m[(r, j)]))
+                        .collect(),
+                    df.iter()
+                        .map(|&j| value(fd, j, i0 + fm.len(), self.baseline.d_bar[(r, j)]))
+                        .collect(),
+                )
+            })
+            .collect();
+        let theta = specs
+            .iter()
+            .zip(&theta_index)
+            .map(|(s, &i)| match self.held_values(s.effect) {
+                Some(t) => t.coefficients.clone(),
+                None => theta_all[i..i + s.effect.n_linear()].to_vec(),
+            })
+            .collect();
+        let held = specs
+            .iter()
+            .map(|s| self.held_values(s.effect).is_some())
+            .collect();
+        let loads = load_index
+            .iter()
+            .map(|li| li.map(|i| theta_all[i]))
+            .collect();
+        Some(FitOut {
+            rows,
+            base,
+            theta,
+            theta_index,
+            sse,
+            n: n_tot,
+            cov,
+            resid,
+            block_rows,
+            d_ref: d_ref.clone(),
+            m_ref: m_ref.clone(),
+            loads,
+            held,
+        })
+    }
+}
+
+/// Smallest Cholesky pivot of the Jacobi-scaled normal matrix accepted as
+/// non-singular (condition ≈ 10¹⁰).
+const PIVOT_FLOOR: f64 = 1e-10;
+
+/// Solves H θ = b with Jacobi scaling (columns span forces of 10⁴ N and
+/// velocities of 10⁻² m/s); returns θ and H⁻¹.
+fn solve_scaled(h: &DMatrix<f64>, b: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>)> {
+    let p = h.nrows();
+    let s: Vec<f64> = (0..p)
+        .map(|i| {
+            let d = h[(i, i)];
+            if d > 0.0 { 1.0 / d.sqrt() } else { 1.0 }
+        })
+        .collect();
+    let mut hs = DMatrix::from_fn(p, p, |i, j| h[(i, j)] * s[i] * s[j]);
+    let bs = nalgebra::DVector::from_fn(p, |i, _| b[i] * s[i]);
+    // A pivot below 1e-10 of the unit diagonal is a column the others
+    // determine to rounding (a term collinear with D̄): whether Cholesky
+    // then succeeds is chance, and its inverse is noise. The pseudo-inverse
+    // gives the minimum-norm fit instead.
+    let factor = hs
+        .clone()
+        .cholesky()
+        .filter(|c| (0..p).all(|i| c.l_dirty()[(i, i)].powi(2) > PIVOT_FLOOR));
+    let inv = match factor {
+        Some(c) => c.inverse(),
+        None => {
+            for i in 0..p {
+                hs[(i, i)] += 1e-10;
+            }
+            hs.clone().pseudo_inverse(1e-12).ok()?
+        }
+    };
+    let z = &inv * bs;
+    let theta: Vec<f64> = (0..p).map(|i| z[i] * s[i]).collect();
+    if theta.iter().any(|x| !x.is_finite()) {
+        return None;
+    }
+    let h_inv = DMatrix::from_fn(p, p, |i, j| inv[(i, j)] * s[i] * s[j]);
+    Some((theta, h_inv))
+}
