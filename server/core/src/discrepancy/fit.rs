@@ -297,24 +297,35 @@ impl<'a> Prepared<'a> {
         hac: bool,
         hold: bool,
     ) -> Option<FitOut> {
-        let current = specs.iter().any(|s| s.effect == Effect::Current);
+        let current = specs.iter().position(|s| s.effect == Effect::Current);
         let coriolis = specs.iter().any(|s| s.effect == Effect::CoriolisFromM);
         let (mut m, mut d) = (self.baseline.m.clone(), self.baseline.d_bar.clone());
-        if !current && !coriolis {
-            return self.fit_with(&m, &d, specs, extra, runs, hac, hold);
+        if current.is_none() && !coriolis {
+            return self.fit_with(&m, &d, specs, extra, runs, hac, hold, None);
         }
+        // The current's estimate of a fit, where the next one linearizes
+        // the quadratic drag on ν_r (see `through_water`).
+        let estimate = |f: &FitOut| {
+            current
+                .and_then(|si| f.theta.get(si))
+                .filter(|t| t.len() == 2 && t.iter().all(|x| x.is_finite()))
+                .map(|t| [t[0], t[1]])
+        };
+        let current = current.is_some();
         // The current acts through D̄ and M on ν − ν_c, and C(ν) is built from M:
         // their regressors need the D̄ and M being fitted. A baseline
         // identified with the effect present has them biased (it absorbed
         // the effect's linear part), so iterate to the fixed point.
-        let mut f = self.fit_with(&m, &d, specs, extra, runs, false, hold)?;
+        let start = current.then_some([0.0; 2]);
+        let mut f = self.fit_with(&m, &d, specs, extra, runs, false, hold, start)?;
         for pass in 0..3 {
             let (m_new, d_new) = self.refitted(specs, &f, &m, &d);
             m = m_new;
             if current {
                 d = d_new;
             }
-            f = self.fit_with(&m, &d, specs, extra, runs, hac && pass == 2, hold)?;
+            let at = estimate(&f).or(start);
+            f = self.fit_with(&m, &d, specs, extra, runs, hac && pass == 2, hold, at)?;
         }
         Some(f)
     }
@@ -351,7 +362,9 @@ impl<'a> Prepared<'a> {
     }
 
     /// The augmented model of a fit: the baseline with the fitted rows
-    /// replaced, coupling entries set, and the terms attached.
+    /// replaced, coupling entries set, the terms attached, and the
+    /// baseline's C(δ)δ and D_q|δ|δ carried (the fit put them on the known
+    /// side).
     pub fn model(&self, specs: &[Spec], f: &FitOut, shape_std: &[Option<f64>]) -> AugmentedModel {
         let b = self.baseline;
         let (m, d) = self.refitted(specs, f, &b.m, &b.d_bar);
@@ -396,6 +409,7 @@ impl<'a> Prepared<'a> {
             terms,
         )
         .with_coriolis(b.coriolis.clone())
+        .with_quadratic(b.quadratic.clone())
     }
 
     /// (M_rr, D̄_rr) of row `r` (the `ri`-th of `f`) after the fit, where
@@ -466,8 +480,10 @@ mod equations;
 mod kstep;
 mod profile;
 mod regressors;
+mod through_water;
 
 pub(crate) use profile::{long_run_inflation, profile};
+pub(crate) use through_water::body_current;
 
 #[cfg(test)]
 mod tests;

@@ -273,8 +273,7 @@ impl AugmentedModel {
             }
         }
         if let Some(d) = &self.quadratic {
-            let surge = self.dofs.iter().position(|d| *d == Dof::Surge);
-            let q = d.force(&nu[..n], surge);
+            let q = self.quadratic_force(d, &nu[..n], eta[5]);
             for i in 0..n {
                 f[i] -= q[i];
             }
@@ -286,6 +285,35 @@ impl AugmentedModel {
                 .map(|(j, fj)| self.m_inv[(i, j)] * fj)
                 .sum();
         }
+    }
+
+    /// The current (V_N, V_E) of a current term, if the model carries one.
+    pub fn current(&self) -> Option<[f64; 2]> {
+        self.terms
+            .iter()
+            .find(|t| t.effect == Effect::Current && t.coefficients.len() == 2)
+            .map(|t| [t.coefficients[0], t.coefficients[1]])
+    }
+
+    /// D_q|δ_r|δ_r at `nu` and heading `psi`: on the velocity through the
+    /// water ν_r = ν − ν_c(ψ) when the model carries a current (the hull's
+    /// drag follows it, as the fit's `through_water`), else on ν.
+    fn quadratic_force(&self, d: &QuadraticDamping, nu: &[f64], psi: f64) -> Vec<f64> {
+        let surge = self.dofs.iter().position(|d| *d == Dof::Surge);
+        let Some(current) = self.current() else {
+            return d.force(nu, surge);
+        };
+        let (uc, vc) = super::fit::body_current(current, psi);
+        let rel: Vec<f64> = nu
+            .iter()
+            .zip(&self.dofs)
+            .map(|(v, dof)| match dof {
+                Dof::Surge => v - uc,
+                Dof::Sway => v - vc,
+                _ => *v,
+            })
+            .collect();
+        d.force(&rel, surge)
     }
 
     /// Whether ½(M + Mᵀ) is positive definite: the kinetic energy ½νᵀMν

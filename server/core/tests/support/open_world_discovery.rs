@@ -17,7 +17,12 @@ use seatrial_core::identification::LambdaCampaignSettings;
 /// identification's default) and quadratic damping the tether case of
 /// seed 1 was not closed (v: 0.00 of the gap), so the proof states which
 /// baseline it holds for.
+/// `DISCOVERY_BASELINE=default` (the examples) starts from the
+/// identification's defaults instead.
 fn discovery_baseline_settings() -> LambdaCampaignSettings {
+    if std::env::var("DISCOVERY_BASELINE").is_ok_and(|v| v == "default") {
+        return LambdaCampaignSettings::default();
+    }
     LambdaCampaignSettings {
         symmetric_inertia: false,
         quadratic_damping: false,

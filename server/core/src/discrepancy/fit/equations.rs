@@ -15,6 +15,7 @@ impl Prepared<'_> {
         runs: &[usize],
         hac: bool,
         hold: bool,
+        current_at: Option<[f64; 2]>,
     ) -> Option<FitOut> {
         let rows = self.rows_of(specs, extra);
         if rows.is_empty() {
@@ -55,6 +56,18 @@ impl Prepared<'_> {
             })
             .collect();
         let ctx = TermContext { dofs, m_ref, d_ref };
+        // Where the current's D_q|δ_r|δ_r is linearized (a held current: at
+        // its value, exactly).
+        let water: Option<([f64; 2], bool)> = specs
+            .iter()
+            .find(|s| s.effect == Effect::Current)
+            .and_then(|s| match self.held_values(s.effect) {
+                Some(t) if t.coefficients.len() == 2 => {
+                    Some(([t.coefficients[0], t.coefficients[1]], true))
+                }
+                Some(_) => None,
+                None => current_at.map(|at| (at, false)),
+            });
         let mut hmat = DMatrix::<f64>::zeros(p, p);
         let mut bvec = vec![0.0; p];
         let mut blocks: Vec<Block> = Vec::new();
@@ -87,7 +100,9 @@ impl Prepared<'_> {
                     .filter_map(|s| self.held_values(s.effect))
                     .filter(|t| t.effect.rows(dofs, &self.baseline.d_bar).contains(&r))
                     .collect();
-                if !held.is_empty() {
+                // The baseline's D_q on the velocity through the water.
+                let water = water.and_then(|(at, held)| self.through_water(r, run, at, held));
+                if !held.is_empty() || water.is_some() {
                     let mut y = bb.y.as_ref().clone();
                     for t in &held {
                         for (pi, c) in t.coefficients.iter().enumerate() {
@@ -95,6 +110,11 @@ impl Prepared<'_> {
                             for (yk, fk) in y.iter_mut().zip(&f[self.skip..]) {
                                 *yk -= c * w * fk;
                             }
+                        }
+                    }
+                    if let Some(tw) = &water {
+                        for (yk, fk) in y.iter_mut().zip(&tw.shift[self.skip..]) {
+                            *yk -= w * fk;
                         }
                     }
                     bb.by = blocks::products(&y, &bb.cols);
@@ -123,7 +143,18 @@ impl Prepared<'_> {
                     for pi in 0..nl {
                         let f = self.filtered_regressor(s.effect, pi, r, run, &ctx);
                         idx.push(theta_index[si] + pi);
-                        cols.push(Rc::new(weighted(&f[self.skip..], w)));
+                        let jac = water
+                            .as_ref()
+                            .filter(|_| s.effect == Effect::Current)
+                            .and_then(|tw| tw.jacobian.as_ref());
+                        cols.push(Rc::new(match jac {
+                            Some(j) => {
+                                let sum: Vec<f64> =
+                                    f.iter().zip(&j[pi]).map(|(a, b)| a + b).collect();
+                                weighted(&sum[self.skip..], w)
+                            }
+                            None => weighted(&f[self.skip..], w),
+                        }));
                     }
                 }
                 if let Some(li) = load_index[ri] {

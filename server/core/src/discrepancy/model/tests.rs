@@ -134,3 +134,59 @@ fn a_stiff_dof_follows_its_exponential() {
         }
     }
 }
+
+/// Unforced, a hull in a current drifts with it: started at ν = ν_c(ψ)
+/// (over ground) it stays there, its velocity through the water zero, so
+/// neither D̄ nor D_q|δ_r|δ_r acts. Drag on ν over ground would slow it.
+#[test]
+fn an_unforced_hull_drifts_with_the_current_its_quadratic_drag_on_the_relative_velocity() {
+    use crate::discrepancy::fit::body_current;
+    use nalgebra::DVector;
+    let dofs = vec![Dof::Surge, Dof::Sway, Dof::Yaw];
+    let m = DMatrix::from_diagonal(&DVector::from_vec(vec![60.0, 90.0, 25.0]));
+    let d = DMatrix::from_diagonal(&DVector::from_vec(vec![20.0, 30.0, 15.0]));
+    let current = [0.2, 0.1];
+    let (psi, n, h) = (1.0, 200, 0.1);
+    let (uc, vc) = body_current(current, psi);
+    assert!((uc - (0.2 * psi.cos() + 0.1 * psi.sin())).abs() < 1e-15);
+    assert!((vc - (-0.2 * psi.sin() + 0.1 * psi.cos())).abs() < 1e-15);
+    let mut eta = DMatrix::zeros(n, 6);
+    eta.column_mut(5).fill(psi);
+    let rec = Record {
+        name: "drift".into(),
+        h,
+        tau: DMatrix::zeros(n, 3),
+        nu: DMatrix::from_fn(n, 3, |_, j| [uc, vc, 0.0][j]),
+        eta,
+    };
+    let model = AugmentedModel::new(
+        dofs,
+        m.clone(),
+        d.clone(),
+        Restoring::default(),
+        m,
+        d,
+        vec![ModelTerm {
+            effect: Effect::Current,
+            coefficients: current.to_vec(),
+            covariance: vec![],
+            shape: None,
+            shape_std: None,
+        }],
+    )
+    .with_quadratic(Some(QuadraticDamping {
+        d_q: DVector::from_vec(vec![40.0, 300.0, 20.0]),
+        u0: 0.0,
+    }));
+    assert_eq!(model.current(), Some(current));
+    let sim = model.simulate(&rec);
+    for k in 0..n {
+        for (j, want) in [uc, vc, 0.0].into_iter().enumerate() {
+            assert!(
+                (sim[(k, j)] - want).abs() < 1e-9,
+                "sample {k}, DOF {j}: {} for {want}",
+                sim[(k, j)]
+            );
+        }
+    }
+}
