@@ -483,7 +483,6 @@ mod regressors;
 mod through_water;
 
 pub(crate) use profile::{long_run_inflation, profile};
-pub(crate) use through_water::body_current;
 
 #[cfg(test)]
 mod tests;

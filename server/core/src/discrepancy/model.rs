@@ -303,7 +303,7 @@ impl AugmentedModel {
         let Some(current) = self.current() else {
             return d.force(nu, surge);
         };
-        let (uc, vc) = super::fit::body_current(current, psi);
+        let (uc, vc) = crate::models::current::body_current(current, psi);
         let rel: Vec<f64> = nu
             .iter()
             .zip(&self.dofs)

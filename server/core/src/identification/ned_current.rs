@@ -31,6 +31,7 @@ use super::roles::Roles;
 use crate::estimation::lambda::{Exogenous, Experiment, LambdaEstimate};
 use crate::logs::schema::pose_column;
 use crate::models::coriolis::second_order_force_about;
+use crate::models::current::body_current;
 use crate::numbers::sig3;
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
@@ -261,8 +262,7 @@ pub(crate) fn force(d_bar: &DMatrix<f64>, dofs: &[Dof], v: &Vector2<f64>) -> DMa
 /// u_c(ψ) = V_N cos ψ + V_E sin ψ (m/s), V = [V_N, V_E]: the forward speed
 /// through the water is u − u_c(ψ).
 pub(crate) fn surge_component(v: [f64; 2], psi: f64) -> f64 {
-    let (s, c) = psi.sin_cos();
-    v[0] * c + v[1] * s
+    body_current(v, psi).0
 }
 
 /// What a known current adds to the forces that drive a horizontal
@@ -284,11 +284,7 @@ pub(crate) struct Relative {
 impl Relative {
     /// ν_c(ψ) in the model's DOF order.
     pub fn nu_c(&self, psi: f64) -> DVector<f64> {
-        let (s, c) = psi.sin_cos();
-        let (u_c, v_c) = (
-            surge_component([self.v[0], self.v[1]], psi),
-            -self.v[0] * s + self.v[1] * c,
-        );
+        let (u_c, v_c) = body_current([self.v[0], self.v[1]], psi);
         DVector::from_iterator(
             self.dofs.len(),
             self.dofs.iter().map(|d| match d {

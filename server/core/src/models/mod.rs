@@ -20,6 +20,7 @@
 //! - `predict` (private): k-step and free-run loops shared by the predictors.
 
 pub mod coriolis;
+pub mod current;
 pub mod error;
 pub mod lpv;
 pub mod lpv_schedule;

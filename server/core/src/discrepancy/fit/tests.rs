@@ -1,6 +1,6 @@
 use super::*;
 use crate::discrepancy::candidates::TermContext;
-use crate::discrepancy::fit::body_current;
+use crate::models::current::body_current;
 
 /// A 1-DOF surge record with M ν̇ + D ν + θ|ν|ν = τ written from
 /// `nu(t)` and its derivative, and the prepared fits on it.

@@ -10,16 +10,8 @@
 //! Only surge and sway feel ν_c; D_q is diagonal, so only their rows move.
 
 use super::*;
+use crate::models::current::body_current;
 use crate::models::quadratic_damping::surge_remainder;
-
-/// ν_c(ψ) = R(ψ)ᵀ[V_N V_E]ᵀ in the body frame: (u_c, v_c).
-pub(crate) fn body_current(current: [f64; 2], psi: f64) -> (f64, f64) {
-    let (s, c) = psi.sin_cos();
-    (
-        current[0] * c + current[1] * s,
-        -current[0] * s + current[1] * c,
-    )
-}
 
 /// How the baseline's D_q|δ|δ moves one row's equation on one run.
 pub(super) struct ThroughWater {
@@ -83,8 +75,10 @@ impl Prepared<'_> {
                 dq -= a * at[0] + e * at[1];
             }
             shift.push(dq);
-            jn.push(a);
-            je.push(e);
+            if !held {
+                jn.push(a);
+                je.push(e);
+            }
         }
         Some(ThroughWater {
             shift: self.svf.foh(&shift),

@@ -140,7 +140,7 @@ fn a_stiff_dof_follows_its_exponential() {
 /// neither D̄ nor D_q|δ_r|δ_r acts. Drag on ν over ground would slow it.
 #[test]
 fn an_unforced_hull_drifts_with_the_current_its_quadratic_drag_on_the_relative_velocity() {
-    use crate::discrepancy::fit::body_current;
+    use crate::models::current::body_current;
     use nalgebra::DVector;
     let dofs = vec![Dof::Surge, Dof::Sway, Dof::Yaw];
     let m = DMatrix::from_diagonal(&DVector::from_vec(vec![60.0, 90.0, 25.0]));
