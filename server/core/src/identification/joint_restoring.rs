@@ -20,8 +20,9 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::document::{ParameterRow, RestoringDoc};
 use crate::estimation::lambda::{Exogenous, LambdaEstimate};
-use crate::estimation::restoring::RestoringParams;
+use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
 
@@ -209,6 +210,47 @@ impl PooledRestoring {
             weight_minus_buoyancy_n: self.weight_minus_buoyancy.value,
             zg_weight_minus_zb_buoyancy_nm: self.metacentric.value,
             tether_pitch_moment_nm: 0.0,
+        }
+    }
+
+    /// The model document's g(η): the pooled values and the evidence from
+    /// the `joint` fits per grid point and the station-keeping `holds`.
+    pub fn doc(
+        &self,
+        joint: &[(f64, LambdaEstimate)],
+        holds: Option<&RestoringEstimate>,
+    ) -> RestoringDoc {
+        let row = |symbol: &str, p: &Pooled, unit: &str| ParameterRow {
+            group: "g(η)".into(),
+            symbol: symbol.into(),
+            grid_speed_mps: None,
+            value: p.value,
+            std: Some(p.std),
+            unit: unit.into(),
+        };
+        let (wb, bg) = (&self.weight_minus_buoyancy, &self.metacentric);
+        let mut evidence = vec![format!(
+            "estimated with M, D̄ and the constant loads from every run where the attitude moves, at {} grid speeds; W − B from surge (sin θ) and sway (cos θ·sin φ): {} estimates, χ²/dof {:.2}; z_G·W − z_B·B from roll and pitch: {} estimates, χ²/dof {:.2}",
+            joint.len(),
+            wb.count,
+            wb.birge_ratio_sq,
+            bg.count,
+            bg.birge_ratio_sq
+        )];
+        if let Some(h) = holds {
+            evidence.push(format!(
+                "sharpened by {} steady segments of station-keeping attitude holds (W − B {:.1} ± {:.1} N, z_G·W − z_B·B {:.2} ± {:.2} N·m on their own)",
+                h.segments.len(),
+                h.params.weight_minus_buoyancy_n,
+                h.std.weight_minus_buoyancy_n,
+                h.params.zg_weight_minus_zb_buoyancy_nm,
+                h.std.zg_weight_minus_zb_buoyancy_nm
+            ));
+        }
+        RestoringDoc {
+            parameters: vec![row("W−B", wb, "N"), row("z_G·W − z_B·B", bg, "N·m")],
+            evidence,
+            params: self.params(),
         }
     }
 }

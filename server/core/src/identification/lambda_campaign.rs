@@ -6,63 +6,38 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::attitude_fusion::attitude_noise_std;
-use super::dataset::Segment;
-use super::dataset::{RunInput, segments};
-use super::document::{
-    LpvDoc, LpvPoint, Method, ModelDocument, ModelKind, ParameterRow, RestoringDoc, SpeedExtension,
-    to_rows,
-};
+use super::dataset::{RunInput, Segment};
+use super::document::{LpvDoc, Method, ModelDocument, ModelKind, RestoringDoc, SpeedExtension};
 use super::error::IdentifyError;
-use super::intersample::{correct_estimates, inertia_offset, logged_equivalent, logged_gains};
-use super::joint_restoring::{
-    COS_THETA_SIN_PHI, Functions, PooledRestoring, SIN_THETA, load, specification,
-};
+use super::intersample::{correct_estimates, inertia_offset, logged_gains};
+use super::joint_restoring::{Functions, PooledRestoring, specification};
 use super::lambda_consistency::{inflate_inertia_std, symmetry_note};
-use super::lambda_coriolis::{fit_points, pooled_inertia};
+use super::lambda_coriolis::fit_points;
 use super::lambda_data::{experiment, per_point, regression_columns, static_holds};
-use super::lambda_extension::{Sides, choose_extension, speed_coverage_notes};
+use super::lambda_extension::Sides;
 use super::lambda_information::default_t_lambda;
-use super::lambda_physical::{enforce, unresolved_mode};
+use super::lambda_known::KnownSide;
+use super::lambda_noise::{attitude_shape_noise, restoring_noise};
 use super::lambda_quadratic;
 use super::lambda_structure::choose_structure;
+use super::lambda_submodels::{Assembly, SubModelInputs, SubModels, assemble, sub_models};
 use super::lambda_unforced;
 use super::lambda_validation::{HeldOut, choose_second_order, free_run_total, keep_current};
 use super::ned_current;
 use super::outcome::Identified;
 use super::roles::assign_roles;
 use super::through_water;
-use crate::estimation::lambda::{
-    Experiment, LambdaEstimate, LambdaSettings, MIN_T_OVER_H, Prior, RegressorNoise,
-};
-use crate::estimation::restoring::{RestoringEstimate, RestoringParams};
+use crate::estimation::lambda::{Experiment, LambdaSettings, MIN_T_OVER_H, Prior};
+use crate::estimation::restoring::RestoringParams;
 use crate::estimation::{Progress, SubProgress};
 use crate::logs::schema::pose_column;
-use crate::models::{LinearVesselModel, LpvModel, Scheduling};
+use crate::models::{LpvModel, Scheduling};
 use crate::numbers::sig3;
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
 use crate::validation::ValidationSettings;
 
 pub use super::lambda_settings::{LambdaCampaignSettings, SchedulingChoice, StructureChoice};
-
-/// Unit of an entry (i, j) of M (`per_s` false) or D̄ (true).
-fn unit(dofs: &[Dof], i: usize, j: usize, per_s: bool) -> String {
-    let base = match (dofs[i].is_angular(), dofs[j].is_angular()) {
-        (false, false) => "kg",
-        (true, true) => "kg·m²",
-        _ => "kg·m",
-    };
-    if per_s {
-        format!("{base}/s")
-    } else {
-        base.to_string()
-    }
-}
-
-/// Unit of a force (N) or moment (N·m) in DOF `d`.
-fn force_unit(d: Dof) -> &'static str {
-    if d.is_angular() { "N·m" } else { "N" }
-}
 
 fn lambda_error(e: crate::estimation::lambda::LambdaError) -> IdentifyError {
     match e {
@@ -110,38 +85,7 @@ fn identify(
 ) -> Result<Identified, IdentifyError> {
     let dofs = profile.dofs.clone();
     let n = dofs.len();
-    if inputs.len() != n {
-        return Err(IdentifyError::invalid(
-            "inputs",
-            format!("{} input columns for {n} DOFs", inputs.len()),
-        ));
-    }
-    if grid.is_empty() {
-        return Err(IdentifyError::invalid(
-            "campaign.grid",
-            "the campaign has no grid speeds",
-        ));
-    }
-    if !(settings.coupling_threshold > 0.0 && settings.coupling_threshold < 1.0) {
-        return Err(IdentifyError::invalid(
-            "settings.coupling_threshold",
-            format!("must be in (0, 1), got {}", settings.coupling_threshold),
-        ));
-    }
-    if let Some(rate) = settings.controller_rate_hz
-        && !(rate.is_finite() && rate > 0.0)
-    {
-        return Err(IdentifyError::invalid(
-            "settings.controller_rate_hz",
-            format!("must be a positive rate in Hz, got {rate}"),
-        ));
-    }
-    if settings.k == 0 {
-        return Err(IdentifyError::invalid(
-            "settings.k",
-            "the horizon k must be ≥ 1",
-        ));
-    }
+    settings.check(inputs.len(), n, grid)?;
     let roles = assign_roles(runs, settings.validation_run_ids.as_deref())?;
     let outputs: Vec<String> = dofs
         .iter()
@@ -363,7 +307,7 @@ fn identify(
                     Some(est) => pooled.with_static(&est.params, &est.std),
                     None => pooled,
                 };
-                restoring = Some((pooled.params(), restoring_doc(&pooled, &joint, holds.as_ref())));
+                restoring = Some((pooled.params(), pooled.doc(&joint, holds.as_ref())));
             }
             None => notes.push(
                 "g(η) could not be estimated (no attitude motion in roll or pitch): γ = τ, the constant loads absorb W − B"
@@ -423,65 +367,16 @@ fn identify(
             .and_then(|c| c.forces.iter().find(|(s, _)| *s == speed))
             .map(|(_, f)| f.clone())
     };
-    let plain_exps = build(g, loads)?;
-    let plain_exps: Vec<Vec<Experiment>> = plain_exps
-        .into_iter()
-        .zip(&data.segments)
-        .zip(grid)
-        .map(|((point, segs), &u0)| match current_forces(u0) {
-            Some(f) => point
-                .into_iter()
-                .zip(segs)
-                .map(|(e, s)| match &relative {
-                    Some(r) => r.apply(e, s, u0, &f),
-                    None => e,
-                })
-                .collect(),
-            None => point,
-        })
-        .collect();
-    // ν_c(ψ) per sample, where the current is known: the drag acts on the
-    // velocity through the water.
-    let nu_c: Vec<Vec<Option<DMatrix<f64>>>> = plain_exps
-        .iter()
-        .zip(&data.segments)
-        .zip(grid)
-        .map(|((point, segs), &u0)| {
-            point
-                .iter()
-                .zip(segs)
-                .map(|(e, seg)| {
-                    let r = relative.as_ref().filter(|_| current_forces(u0).is_some())?;
-                    let psi = ned_current::heading(seg, n);
-                    let rows: Vec<_> = psi
-                        .get(..e.nu.nrows())?
-                        .iter()
-                        .map(|&p| r.nu_c(p).transpose())
-                        .collect();
-                    (!rows.is_empty()).then(|| DMatrix::from_rows(&rows))
-                })
-                .collect()
-        })
-        .collect();
-    let known = |d_q: Option<&DVector<f64>>| -> Vec<Vec<Experiment>> {
-        plain_exps
-            .iter()
-            .zip(&nu_c)
-            .zip(grid.iter())
-            .map(|((point, nu_c), &u0)| {
-                point
-                    .iter()
-                    .cloned()
-                    .zip(nu_c)
-                    .map(|(e, c)| match d_q {
-                        Some(d) => lambda_quadratic::subtract(e, d, surge, u0, c.as_ref()),
-                        None => e,
-                    })
-                    .collect()
-            })
-            .collect()
-    };
-    let mut exps = known(quadratic.as_ref().map(|(d, _)| d));
+    let known = KnownSide::new(
+        build(g, loads)?,
+        &data.segments,
+        grid,
+        n,
+        surge,
+        relative.as_ref(),
+        &current_forces,
+    );
+    let mut exps = known.with_drag(quadratic.as_ref().map(|(d, _)| d));
     let from = if joint.is_empty() { 0.1 } else { 0.4 };
     let mut fit_notes = Vec::new();
     let mut estimates = {
@@ -507,7 +402,7 @@ fn identify(
         d[s] = x;
         d_std[s] = sd;
         quadratic = Some((d, d_std));
-        exps = known(quadratic.as_ref().map(|(d, _)| d));
+        exps = known.with_drag(quadratic.as_ref().map(|(d, _)| d));
         fit_notes.clear();
         let mut sub = SubProgress::new(progress, 0.6, 0.2);
         estimates = fit_points(
@@ -547,83 +442,16 @@ fn identify(
     inflate_inertia_std(&mut estimates, &dofs, &mut notes);
 
     // 3. Sub-models, physical structure enforced, parameters.
-    let mut models = Vec::new();
-    let mut vehicle = Vec::new();
-    let mut lpv_points = Vec::new();
-    let mut parameters = Vec::new();
-    let mut findings = Vec::new();
-    for (speed, est) in &estimates {
-        let idx = grid.iter().position(|g| g == speed).unwrap_or(0);
-        let (load, load_std) = joint_load(est, n);
-        let physical = enforce(&dofs, est, &load, &exps[idx], *speed, coriolis_from_m)?;
-        findings.extend(physical.findings);
-        let model = physical.model;
-        findings.extend(unresolved_mode(&dofs, model.a(), est.h, *speed));
-        for i in 0..n {
-            for j in 0..n {
-                for (group, value, std, per_s) in [
-                    ("M", model.m()[(i, j)], est.std_m[(i, j)], false),
-                    ("D̄", model.d_bar()[(i, j)], est.std_d_bar[(i, j)], true),
-                ] {
-                    if value != 0.0 || std > 0.0 {
-                        parameters.push(ParameterRow {
-                            group: group.into(),
-                            symbol: format!("{group}[{},{}]", dofs[i].name(), dofs[j].name()),
-                            grid_speed_mps: Some(*speed),
-                            value,
-                            std: Some(std),
-                            unit: unit(&dofs, i, j, per_s),
-                        });
-                    }
-                }
-            }
-            if settings.constant_loads {
-                parameters.push(ParameterRow {
-                    group: "b".into(),
-                    symbol: format!("b[{}]", dofs[i].name()),
-                    grid_speed_mps: Some(*speed),
-                    value: load[i],
-                    std: Some(load_std[i]),
-                    unit: force_unit(dofs[i]).into(),
-                });
-            }
-        }
-        lpv_points.push(LpvPoint {
-            speed_mps: *speed,
-            m: to_rows(model.m()),
-            m_std: to_rows(&est.std_m),
-            d_bar: to_rows(model.d_bar()),
-            d_bar_std: to_rows(&est.std_d_bar),
-            a: to_rows(model.a()),
-            a_std: to_rows(&est.std_a),
-            b: to_rows(model.b()),
-            b_std: to_rows(&est.std_b),
-            load: settings
-                .constant_loads
-                .then(|| load.iter().copied().collect()),
-            load_std: settings
-                .constant_loads
-                .then(|| load_std.iter().copied().collect()),
-            n_samples: est.n_samples,
-            run_ids: data.run_ids[idx].clone(),
-            current_force: current_forces(*speed).map(|f| to_rows(&f)),
-            augmentation: None,
-        });
-        vehicle.push(model.clone());
-        // Validation predicts the logs: with the controller's unlogged
-        // commands added back when it ran faster than the log.
-        let for_logs = match &logged_controller {
-            Some(lc) => logged_equivalent(model.m(), model.d_bar(), lc, &dofs)
-                .and_then(|(m, d)| {
-                    LinearVesselModel::new(dofs.clone(), m, d)
-                        .and_then(|x| x.with_load(model.load().clone()))
-                        .ok()
-                })
-                .unwrap_or(model),
-            None => model,
-        };
-        models.push(for_logs);
-    }
+    let at = SubModelInputs {
+        dofs: &dofs,
+        grid,
+        exps: &exps,
+        run_ids: &data.run_ids,
+        coriolis_from_m,
+        constant_loads: settings.constant_loads,
+    };
+    let subs = sub_models(&at, &estimates, &current_forces, logged_controller.as_ref())?;
+    let mut parameters = subs.parameters.clone();
     if let Some((_, doc)) = &restoring {
         parameters.extend(doc.parameters.iter().cloned());
     }
@@ -634,60 +462,26 @@ fn identify(
         SchedulingChoice::Nearest => Scheduling::Nearest,
         SchedulingChoice::Interpolate => Scheduling::Interpolate,
     };
-    let speeds: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
-    let vehicle_m: Vec<_> = vehicle.iter().map(|v| v.m().clone()).collect();
-    let m_std: Vec<_> = estimates.iter().map(|(_, e)| e.std_m.clone()).collect();
-    let vehicle_m = match pooled_inertia(&vehicle_m, &m_std) {
-        Some(m) => vec![m; vehicle_m.len()],
-        None => vehicle_m,
+    let how = Assembly {
+        scheduling,
+        second_order,
+        quadratic: quadratic.as_ref(),
+        coriolis_from_m,
+        restoring: g,
+        sides: Sides {
+            below: settings.extend_below_grid,
+            above: settings.extend_above_grid,
+        },
     };
-    let lpv = LpvModel::new(speeds.clone(), models)
-        .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
-        .with_scheduling(scheduling);
-    let lpv = if second_order {
-        lpv.with_second_order_coriolis(vehicle_m)
-            .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
-    } else {
-        lpv
-    };
-    let lpv = match &quadratic {
-        Some((d_q, _)) => lpv
-            .with_quadratic_damping(vec![d_q.clone(); speeds.len()])
-            .map_err(|e| IdentifyError::invalid("model", e.to_string()))?,
-        None => lpv,
-    };
-    if let Some((d_q, std)) = &quadratic {
-        for i in (0..dofs.len()).filter(|&i| std[i] > 0.0) {
-            parameters.push(ParameterRow {
-                group: "D_q".into(),
-                symbol: format!("D_q[{}]", dofs[i].name()),
-                grid_speed_mps: None,
-                value: d_q[i],
-                std: Some(std[i]),
-                unit: lambda_quadratic::unit(dofs[i]).into(),
-            });
-        }
+    let (lpv, extension) = assemble(&dofs, &subs, &estimates, &how, &mut parameters)?;
+    if let Some((_, note)) = &extension {
+        notes.push(note.clone());
     }
-    // Beyond the grid: extended as far as the vehicle's model stays physical.
-    let extension = ((settings.extend_below_grid || settings.extend_above_grid)
-        && scheduling == Scheduling::Interpolate)
-        .then(|| LpvModel::new(speeds, vehicle).ok())
-        .flatten()
-        .and_then(|v| {
-            let sides = Sides {
-                below: settings.extend_below_grid,
-                above: settings.extend_above_grid,
-            };
-            choose_extension(&v, coriolis_from_m, g, sides)
-        });
-    let lpv = match &extension {
-        Some((ext, note)) => {
-            notes.push(note.clone());
-            lpv.with_extension(*ext)
-                .map_err(|e| IdentifyError::invalid("model", e.to_string()))?
-        }
-        None => lpv,
-    };
+    let SubModels {
+        points: mut lpv_points,
+        findings,
+        ..
+    } = subs;
 
     // 4. Validation on the held-out runs.
     progress.update(0.85, "validating on held-out runs")?;
@@ -762,16 +556,8 @@ fn identify(
             )),
         }
     }
-    if let Some(j) = dofs.iter().position(|d| *d == Dof::Surge) {
-        for r in &roles.validation {
-            if let Ok(segs) = segments(r, &cols, &outputs, 50)
-                && let Some(longest) = segs.iter().max_by_key(|s| s.y.nrows())
-            {
-                let u: Vec<f64> = longest.y.column(j).iter().copied().collect();
-                let grid: Vec<f64> = estimates.iter().map(|(s, _)| *s).collect();
-                notes.extend(speed_coverage_notes(&r.name, &u, &grid, lpv.extension()));
-            }
-        }
+    if let Some(j) = surge {
+        notes.extend(held_out.speed_coverage(j, &lpv));
     }
     progress.update(1.0, "done")?;
 
@@ -805,110 +591,11 @@ fn identify(
     };
     let mut used = settings.clone();
     used.t_lambda_s = Some(t_lambda);
-    let estimation_run_ids = {
-        let mut ids: Vec<String> = Vec::new();
-        for id in data.run_ids.iter().flatten() {
-            if !ids.contains(id) {
-                ids.push(id.clone());
-            }
-        }
-        ids
-    };
     Ok(Identified {
         document,
         validation,
-        estimation_run_ids,
+        estimation_run_ids: data.distinct_run_ids(),
         validation_run_ids: roles.validation.iter().map(|r| r.run_id.clone()).collect(),
         settings_used: serde_json::to_value(&used).unwrap_or_default(),
     })
-}
-
-/// The errors of the restoring shapes [1, sin θ, cos θ sin φ] among the
-/// exogenous columns `names` (after 2n columns of ν and γ): e_θ and e_φ of
-/// std `sd` = [σ_φ, σ_θ], held over each step.
-fn attitude_shape_noise(n: usize, names: &[String], sd: [f64; 2]) -> RegressorNoise {
-    let p = 2 * n + names.len();
-    let mut cov = DMatrix::zeros(p, p);
-    for (j, name) in names.iter().enumerate() {
-        let var = match name.as_str() {
-            COS_THETA_SIN_PHI => sd[0] * sd[0],
-            SIN_THETA => sd[1] * sd[1],
-            _ => 0.0,
-        };
-        cov[(2 * n + j, 2 * n + j)] = var;
-    }
-    RegressorNoise::held_over_step(cov)
-}
-
-/// The errors of γ = τ − g(η) (six DOFs, in [`Dof::ALL`] order) from the
-/// attitude noise `sd` = [σ_φ, σ_θ] through g's slopes at level attitude:
-/// ∂g/∂φ = (0, −(W−B), 0, z_G W − z_B B, 0, 0), ∂g/∂θ = (W−B, 0, 0, 0,
-/// z_G W − z_B B, 0); held over each step. q exogenous columns follow.
-fn restoring_noise(n: usize, q: usize, g: &RestoringParams, sd: [f64; 2]) -> RegressorNoise {
-    let p = 2 * n + q;
-    let mut cov = DMatrix::zeros(p, p);
-    if n == 6 {
-        let (wb, bg) = (g.weight_minus_buoyancy_n, g.zg_weight_minus_zb_buoyancy_nm);
-        let slopes = [
-            (
-                DVector::from_column_slice(&[0.0, -wb, 0.0, bg, 0.0, 0.0]),
-                sd[0],
-            ),
-            (
-                DVector::from_column_slice(&[wb, 0.0, 0.0, 0.0, bg, 0.0]),
-                sd[1],
-            ),
-        ];
-        for (j, s) in slopes {
-            let block = &j * j.transpose() * (s * s);
-            let mut view = cov.view_mut((n, n), (n, n));
-            view += block;
-        }
-    }
-    RegressorNoise::held_over_step(cov)
-}
-
-/// The constant load b and its std of an estimate (zero without loads).
-fn joint_load(est: &LambdaEstimate, n: usize) -> (DVector<f64>, DVector<f64>) {
-    load(est).unwrap_or_else(|| (DVector::zeros(n), DVector::zeros(n)))
-}
-
-/// The restoring document of the pooled estimate.
-fn restoring_doc(
-    pooled: &PooledRestoring,
-    joint: &[(f64, LambdaEstimate)],
-    holds: Option<&RestoringEstimate>,
-) -> RestoringDoc {
-    let row = |symbol: &str, p: &super::joint_restoring::Pooled, unit: &str| ParameterRow {
-        group: "g(η)".into(),
-        symbol: symbol.into(),
-        grid_speed_mps: None,
-        value: p.value,
-        std: Some(p.std),
-        unit: unit.into(),
-    };
-    let (wb, bg) = (&pooled.weight_minus_buoyancy, &pooled.metacentric);
-    let mut evidence = vec![format!(
-        "estimated with M, D̄ and the constant loads from every run where the attitude moves, at {} grid speeds; W − B from surge (sin θ) and sway (cos θ·sin φ): {} estimates, χ²/dof {:.2}; z_G·W − z_B·B from roll and pitch: {} estimates, χ²/dof {:.2}",
-        joint.len(),
-        wb.count,
-        wb.birge_ratio_sq,
-        bg.count,
-        bg.birge_ratio_sq
-    )];
-    if let Some(h) = holds {
-        evidence.push(format!(
-            "sharpened by {} steady segments of station-keeping attitude holds (W − B {:.1} ± {:.1} N, z_G·W − z_B·B {:.2} ± {:.2} N·m on their own)",
-            h.segments.len(),
-            h.params.weight_minus_buoyancy_n,
-            h.std.weight_minus_buoyancy_n,
-            h.params.zg_weight_minus_zb_buoyancy_nm,
-            h.std.zg_weight_minus_zb_buoyancy_nm
-        ));
-    }
-    RestoringDoc {
-        parameters: vec![row("W−B", wb, "N"), row("z_G·W − z_B·B", bg, "N·m")],
-        evidence,
-        params: pooled.params(),
-    }
 }

@@ -36,6 +36,19 @@ pub(crate) struct PointData {
     pub run_ids: Vec<Vec<String>>,
 }
 
+impl PointData {
+    /// The runs behind any grid point, each once, in grid order.
+    pub fn distinct_run_ids(&self) -> Vec<String> {
+        let mut ids: Vec<String> = Vec::new();
+        for id in self.run_ids.iter().flatten() {
+            if !ids.contains(id) {
+                ids.push(id.clone());
+            }
+        }
+        ids
+    }
+}
+
 fn segs(
     run: &RunInput,
     cols: &[String],

@@ -4,6 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::error::IdentifyError;
+
 /// The coupling structure to identify.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "openapi", derive(utoipa::ToSchema))]
@@ -169,5 +171,50 @@ impl Default for LambdaCampaignSettings {
             quadratic_damping: true,
             ned_current: true,
         }
+    }
+}
+
+impl LambdaCampaignSettings {
+    /// Settings a campaign of `n_inputs` input columns for `n` DOFs on
+    /// `grid` can run with; the error names the offending field.
+    pub(crate) fn check(
+        &self,
+        n_inputs: usize,
+        n: usize,
+        grid: &[f64],
+    ) -> Result<(), IdentifyError> {
+        if n_inputs != n {
+            return Err(IdentifyError::invalid(
+                "inputs",
+                format!("{n_inputs} input columns for {n} DOFs"),
+            ));
+        }
+        if grid.is_empty() {
+            return Err(IdentifyError::invalid(
+                "campaign.grid",
+                "the campaign has no grid speeds",
+            ));
+        }
+        if !(self.coupling_threshold > 0.0 && self.coupling_threshold < 1.0) {
+            return Err(IdentifyError::invalid(
+                "settings.coupling_threshold",
+                format!("must be in (0, 1), got {}", self.coupling_threshold),
+            ));
+        }
+        if let Some(rate) = self.controller_rate_hz
+            && !(rate.is_finite() && rate > 0.0)
+        {
+            return Err(IdentifyError::invalid(
+                "settings.controller_rate_hz",
+                format!("must be a positive rate in Hz, got {rate}"),
+            ));
+        }
+        if self.k == 0 {
+            return Err(IdentifyError::invalid(
+                "settings.k",
+                "the horizon k must be ≥ 1",
+            ));
+        }
+        Ok(())
     }
 }

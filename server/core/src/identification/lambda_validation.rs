@@ -5,6 +5,7 @@ use super::dataset::{RunInput, segments};
 use super::error::IdentifyError;
 use super::heading_loop::HeadingLoop;
 use super::lambda_data::experiment;
+use super::lambda_extension::speed_coverage_notes;
 use super::outcome::RunValidation;
 use crate::estimation::restoring::RestoringParams;
 use crate::models::LpvModel;
@@ -35,6 +36,23 @@ pub(crate) struct HeldOut<'a> {
 }
 
 impl HeldOut<'_> {
+    /// Notes on where each held-out run's surge speed (output column
+    /// `surge`, its longest valid block) leaves `lpv`'s grid speeds and
+    /// extension.
+    pub fn speed_coverage(&self, surge: usize, lpv: &LpvModel) -> Vec<String> {
+        let grid = lpv.grid_speeds();
+        let mut notes = Vec::new();
+        for r in self.runs {
+            if let Ok(segs) = segments(r, self.cols, self.outputs, 50)
+                && let Some(longest) = segs.iter().max_by_key(|s| s.y.nrows())
+            {
+                let u: Vec<f64> = longest.y.column(surge).iter().copied().collect();
+                notes.extend(speed_coverage_notes(&r.name, &u, grid, lpv.extension()));
+            }
+        }
+        notes
+    }
+
     /// Each held-out run's longest valid block validated with `lpv`: with
     /// g(η) of the simulated attitude in the loop when g(η) is estimated,
     /// on γ = τ − g(η) otherwise.
