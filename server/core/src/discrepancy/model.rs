@@ -19,7 +19,9 @@ use crate::models::quadratic_damping::QuadraticDamping;
 use crate::planning::Dof;
 use crate::simulation::exponential::EtdRk4;
 use crate::simulation::integrate::rk4_step;
-use crate::validation::{Predictor, ValidationRecord};
+
+mod predict;
+pub(crate) use predict::{State, free_run, k_step};
 
 /// One term of the augmented model with its estimates.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -506,50 +508,6 @@ impl AugmentedModel {
     }
 }
 
-/// A free run over `rec` (N × n ν): from the measured state at 0, one
-/// `step(k, x)` per sample interval.
-pub(crate) fn free_run(
-    rec: &Record,
-    n: usize,
-    measured: impl Fn(&Record, usize) -> State,
-    mut step: impl FnMut(usize, &State) -> State,
-) -> DMatrix<f64> {
-    let len = rec.len();
-    let mut out = DMatrix::zeros(len, n);
-    if len == 0 {
-        return out;
-    }
-    let mut x = measured(rec, 0);
-    out.row_mut(0).copy_from_slice(&x.nu);
-    for k in 0..len - 1 {
-        x = step(k, &x);
-        out.row_mut(k + 1).copy_from_slice(&x.nu);
-    }
-    out
-}
-
-/// k-step predictions over `rec` (rows t < k NaN): from the measured state
-/// at t − k, k calls of `step`.
-pub(crate) fn k_step(
-    rec: &Record,
-    n: usize,
-    k: usize,
-    measured: impl Fn(&Record, usize) -> State,
-    mut step: impl FnMut(usize, &State) -> State,
-) -> DMatrix<f64> {
-    let len = rec.len();
-    let k = k.max(1);
-    let mut out = DMatrix::from_element(len, n, f64::NAN);
-    for t in k..len {
-        let mut x = measured(rec, t - k);
-        for s in t - k..t {
-            x = step(s, &x);
-        }
-        out.row_mut(t).copy_from_slice(&x.nu);
-    }
-    out
-}
-
 /// The actuator chain of one record as one model sees it.
 pub(crate) struct Drive {
     input: AppliedInput,
@@ -568,78 +526,6 @@ impl Drive {
         self.etd.borrow_mut().push((sub, e.clone()));
         e
     }
-}
-
-/// A model's state between samples: ν, and (φ, θ) when the attitude is in
-/// the loop.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct State {
-    pub nu: Vec<f64>,
-    pub attitude: Option<[f64; 2]>,
-}
-
-impl State {
-    fn is_finite(&self) -> bool {
-        self.nu
-            .iter()
-            .chain(self.attitude.iter().flatten())
-            .all(|v| v.is_finite())
-    }
-
-    /// Σ wᵢ·xᵢ of states of the same shape (the LPV blend of predictions).
-    pub(crate) fn blend(parts: &[(f64, State)]) -> State {
-        let (w0, first) = &parts[0];
-        let mut out = State {
-            nu: first.nu.iter().map(|v| w0 * v).collect(),
-            attitude: first.attitude.map(|a| a.map(|v| w0 * v)),
-        };
-        for (w, x) in &parts[1..] {
-            out.nu.iter_mut().zip(&x.nu).for_each(|(o, v)| *o += w * v);
-            if let (Some(o), Some(a)) = (out.attitude.as_mut(), x.attitude) {
-                o[0] += w * a[0];
-                o[1] += w * a[1];
-            }
-        }
-        out
-    }
-}
-
-/// The augmented model as a [`Predictor`]: a record's `u` holds [τ | η]
-/// (n + 6 columns), `y` holds ν.
-impl Predictor for AugmentedModel {
-    fn output_names(&self) -> Vec<String> {
-        self.dofs
-            .iter()
-            .map(|d| d.velocity_symbol().to_string())
-            .collect()
-    }
-
-    fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {
-        match to_record(self.dofs.len(), rec) {
-            Some(r) => AugmentedModel::predict_k_step(self, &r, k),
-            None => DMatrix::from_element(rec.y.nrows(), self.dofs.len(), f64::NAN),
-        }
-    }
-
-    fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
-        match to_record(self.dofs.len(), rec) {
-            Some(r) => AugmentedModel::simulate(self, &r),
-            None => DMatrix::from_element(rec.y.nrows(), self.dofs.len(), f64::NAN),
-        }
-    }
-}
-
-fn to_record(n: usize, rec: &ValidationRecord<'_>) -> Option<Record> {
-    if rec.u.ncols() != n + 6 || rec.y.ncols() != n || rec.u.nrows() != rec.y.nrows() {
-        return None;
-    }
-    Some(Record {
-        name: String::new(),
-        h: rec.h,
-        tau: rec.u.columns(0, n).into_owned(),
-        nu: rec.y.clone(),
-        eta: rec.u.columns(n, 6).into_owned(),
-    })
 }
 
 #[cfg(test)]

@@ -1,3 +1,4 @@
+use super::job::empty_object;
 use super::*;
 
 async fn db() -> (tempfile::TempDir, Db) {

@@ -1,10 +1,12 @@
 use super::*;
 use crate::estimation::NoProgress;
+use crate::identification::augmented::pieces_by_speed;
 use crate::identification::document::Method;
 use crate::identification::lambda_campaign::{LambdaCampaignSettings, identify_lambda_campaign};
 use crate::identification::outcome::RunValidation;
 use crate::identification::predictor::validate_on_run;
 use crate::identification::tests::{force_columns, simulate, to_run};
+use crate::planning::dof::Dof;
 use crate::planning::examples::surveyor_rov;
 use crate::simulation::rov::{LinearDamping, RovTruth};
 
