@@ -8,6 +8,7 @@ use super::error::DiscoveryError;
 use crate::models::LinearVesselModel;
 use crate::models::quadratic_damping::QuadraticDamping;
 use crate::planning::Dof;
+use crate::validation::ValidationRecord;
 
 /// Restoring forces and moments g(η) of the baseline (thesis eq. 1.6):
 /// W−B, z_G·W − z_B·B and the tether pitch moment τ_θ, plus the model's
@@ -195,6 +196,21 @@ pub struct Record {
 }
 
 impl Record {
+    /// A validation record of n DOFs as a discovery record: `u` holds
+    /// [τ | η] (n + 6 columns), `y` holds ν; `None` for another shape.
+    pub(crate) fn from_validation(n: usize, rec: &ValidationRecord<'_>) -> Option<Record> {
+        if rec.u.ncols() != n + 6 || rec.y.ncols() != n || rec.u.nrows() != rec.y.nrows() {
+            return None;
+        }
+        Some(Record {
+            name: String::new(),
+            h: rec.h,
+            tau: rec.u.columns(0, n).into_owned(),
+            nu: rec.y.clone_owned(),
+            eta: rec.u.columns(n, 6).into_owned(),
+        })
+    }
+
     /// Number of samples N.
     pub fn len(&self) -> usize {
         self.nu.nrows()

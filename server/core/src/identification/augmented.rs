@@ -242,20 +242,6 @@ impl AugmentedLpv {
             .collect();
         State::blend(&parts)
     }
-
-    fn record(&self, rec: &ValidationRecord<'_>) -> Option<Record> {
-        let n = self.n();
-        if rec.u.ncols() != n + 6 || rec.y.ncols() != n || rec.u.nrows() != rec.y.nrows() {
-            return None;
-        }
-        Some(Record {
-            name: String::new(),
-            h: rec.h,
-            tau: rec.u.columns(0, n).into_owned(),
-            nu: rec.y.clone_owned(),
-            eta: rec.u.columns(n, 6).into_owned(),
-        })
-    }
 }
 
 /// The augmented model at speed `s` beyond the grid: the baseline LPV's
@@ -313,7 +299,7 @@ impl Predictor for AugmentedLpv {
     }
 
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {
-        let Some(r) = self.record(rec) else {
+        let Some(r) = Record::from_validation(self.n(), rec) else {
             return DMatrix::from_element(rec.y.nrows(), self.n(), f64::NAN);
         };
         let drives: Vec<Drive> = self.models.iter().map(|m| m.drive(&r)).collect();
@@ -328,7 +314,7 @@ impl Predictor for AugmentedLpv {
     }
 
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
-        let Some(r) = self.record(rec) else {
+        let Some(r) = Record::from_validation(self.n(), rec) else {
             return DMatrix::from_element(rec.y.nrows(), self.n(), f64::NAN);
         };
         let drives: Vec<Drive> = self.models.iter().map(|m| m.drive(&r)).collect();

@@ -97,29 +97,16 @@ impl Predictor for AugmentedModel {
     }
 
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {
-        match to_record(self.dofs.len(), rec) {
+        match Record::from_validation(self.dofs.len(), rec) {
             Some(r) => AugmentedModel::predict_k_step(self, &r, k),
             None => DMatrix::from_element(rec.y.nrows(), self.dofs.len(), f64::NAN),
         }
     }
 
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
-        match to_record(self.dofs.len(), rec) {
+        match Record::from_validation(self.dofs.len(), rec) {
             Some(r) => AugmentedModel::simulate(self, &r),
             None => DMatrix::from_element(rec.y.nrows(), self.dofs.len(), f64::NAN),
         }
     }
-}
-
-fn to_record(n: usize, rec: &ValidationRecord<'_>) -> Option<Record> {
-    if rec.u.ncols() != n + 6 || rec.y.ncols() != n || rec.u.nrows() != rec.y.nrows() {
-        return None;
-    }
-    Some(Record {
-        name: String::new(),
-        h: rec.h,
-        tau: rec.u.columns(0, n).into_owned(),
-        nu: rec.y.clone(),
-        eta: rec.u.columns(n, 6).into_owned(),
-    })
 }
