@@ -12,6 +12,7 @@ use super::lambda_coriolis::document_inertia;
 use super::ned_current::surge_component;
 use crate::discrepancy::model::{Drive, State, free_run, k_step};
 use crate::discrepancy::{AugmentedModel, Baseline, Effect, Record, Restoring};
+use crate::models::predict::no_prediction;
 use crate::models::quadratic_damping::QuadraticDamping;
 use crate::models::{LpvModel, Scheduling};
 use crate::planning::dof::Dof;
@@ -300,7 +301,7 @@ impl Predictor for AugmentedLpv {
 
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {
         let Some(r) = Record::from_validation(self.n(), rec) else {
-            return DMatrix::from_element(rec.y.nrows(), self.n(), f64::NAN);
+            return no_prediction(rec, self.n());
         };
         let drives: Vec<Drive> = self.models.iter().map(|m| m.drive(&r)).collect();
         let first = &self.models[0];
@@ -315,7 +316,7 @@ impl Predictor for AugmentedLpv {
 
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
         let Some(r) = Record::from_validation(self.n(), rec) else {
-            return DMatrix::from_element(rec.y.nrows(), self.n(), f64::NAN);
+            return no_prediction(rec, self.n());
         };
         let drives: Vec<Drive> = self.models.iter().map(|m| m.drive(&r)).collect();
         let first = &self.models[0];

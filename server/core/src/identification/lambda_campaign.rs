@@ -450,8 +450,8 @@ fn identify(
         coriolis_from_m,
         constant_loads: settings.constant_loads,
     };
-    let subs = sub_models(&at, &estimates, &current_forces, logged_controller.as_ref())?;
-    let mut parameters = subs.parameters.clone();
+    let mut subs = sub_models(&at, &estimates, &current_forces, logged_controller.as_ref())?;
+    let mut parameters = std::mem::take(&mut subs.parameters);
     if let Some((_, doc)) = &restoring {
         parameters.extend(doc.parameters.iter().cloned());
     }

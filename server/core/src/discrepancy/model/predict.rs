@@ -6,6 +6,7 @@ use nalgebra::DMatrix;
 
 use super::AugmentedModel;
 use crate::discrepancy::data::Record;
+use crate::models::predict::no_prediction;
 use crate::validation::{Predictor, ValidationRecord};
 
 /// A free run over `rec` (N × n ν): from the measured state at 0, one
@@ -99,14 +100,14 @@ impl Predictor for AugmentedModel {
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {
         match Record::from_validation(self.dofs.len(), rec) {
             Some(r) => AugmentedModel::predict_k_step(self, &r, k),
-            None => DMatrix::from_element(rec.y.nrows(), self.dofs.len(), f64::NAN),
+            None => no_prediction(rec, self.dofs.len()),
         }
     }
 
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
         match Record::from_validation(self.dofs.len(), rec) {
             Some(r) => AugmentedModel::simulate(self, &r),
-            None => DMatrix::from_element(rec.y.nrows(), self.dofs.len(), f64::NAN),
+            None => no_prediction(rec, self.dofs.len()),
         }
     }
 }

@@ -7,6 +7,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 
 use super::continuous::{ContinuousModel, D2cError, d2c};
 use super::settings::Weighting;
+use crate::models::predict::no_prediction;
 use crate::validation::{Predictor, ValidationRecord};
 
 /// Residual covariances of the state-space least squares: process ρ_w and
@@ -212,7 +213,7 @@ impl Predictor for N4sidModel {
     /// record ([`N4sidModel::estimate_initial_state`]).
     fn simulate(&self, rec: &ValidationRecord<'_>) -> DMatrix<f64> {
         if !self.fits_record(rec) {
-            return DMatrix::from_element(rec.y.nrows(), self.outputs(), f64::NAN);
+            return no_prediction(rec, self.outputs());
         }
         let x0 = self.estimate_initial_state(rec.u, rec.y);
         self.simulate_from(rec.u, &x0)
