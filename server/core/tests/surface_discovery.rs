@@ -131,7 +131,7 @@ fn discovered() -> &'static [Case] {
         // baseline then misses the current, and discovery must not make it
         // worse.
         let loads_only = LambdaCampaignSettings {
-            ned_current: false,
+            ned_current: Some(false),
             ..LambdaCampaignSettings::default()
         };
         let mut out = Vec::new();
@@ -212,7 +212,7 @@ fn otter_concealed_current() -> &'static [Case] {
     static CASES: std::sync::OnceLock<Vec<Case>> = std::sync::OnceLock::new();
     CASES.get_or_init(|| {
         let settings = LambdaCampaignSettings {
-            ned_current: false,
+            ned_current: Some(false),
             ..LambdaCampaignSettings::default()
         };
         SEEDS

@@ -14,9 +14,16 @@
 //! One step of length h holds τ (ZOH, as the identification does) and
 //! averages g(η) over the step (trapezoid, the identification's γ): a Heun
 //! predictor–corrector on the attitude.
+//!
+//! In a current fixed in NED ([`AttitudeLoop::with_current`]) the heading
+//! is integrated too, ψ̇ = (q sin φ + r cos φ)/cos θ, and the current's
+//! force of the simulated heading is averaged over the step like g(η)
+//! ([`HeadingLoop::drive`]: the damping of −ν_c(ψ), M ν̇_c and D_q on
+//! ν_r); the sub-models are then scheduled on the speed through the water.
 
 use nalgebra::{DMatrix, DVector};
 
+use super::heading_loop::HeadingLoop;
 use crate::estimation::restoring::RestoringParams;
 use crate::models::predict::no_prediction;
 use crate::models::{DiscreteLpv, LpvModel};
@@ -29,16 +36,41 @@ use crate::validation::{Predictor, ValidationRecord};
 pub struct AttitudeLoop {
     lpv: LpvModel,
     restoring: RestoringParams,
+    /// The current's force and scheduling, when the model carries one.
+    current: Option<HeadingLoop>,
 }
 
 /// (φ, θ) in rad.
 type Attitude = (f64, f64);
 
+/// (φ, θ, ψ) in rad.
+type Euler = (f64, f64, f64);
+
 impl AttitudeLoop {
     /// `None` unless the model covers the six DOFs in [`Dof::ALL`] order
     /// (φ̇ and θ̇ need p, q and r).
     pub fn new(lpv: LpvModel, restoring: RestoringParams) -> Option<Self> {
-        (lpv.dofs() == Dof::ALL).then_some(AttitudeLoop { lpv, restoring })
+        (lpv.dofs() == Dof::ALL).then_some(AttitudeLoop {
+            lpv,
+            restoring,
+            current: None,
+        })
+    }
+
+    /// The model in a current fixed in NED, V = [V_N, V_E] (m/s), with F
+    /// (6 × 2) per grid point ([`super::ned_current`]); `None` as for
+    /// [`AttitudeLoop::new`] or when the forces do not fit the grid.
+    pub fn with_current(
+        lpv: LpvModel,
+        restoring: RestoringParams,
+        forces: Vec<DMatrix<f64>>,
+        v: nalgebra::Vector2<f64>,
+    ) -> Option<Self> {
+        let current = Some(HeadingLoop::new(lpv.clone(), forces, v)?);
+        Some(AttitudeLoop {
+            current,
+            ..Self::new(lpv, restoring)?
+        })
     }
 
     /// Names of the record's input columns: the six force columns, then η.
@@ -56,40 +88,61 @@ impl AttitudeLoop {
         DVector::from_column_slice(&self.restoring.g(&[0.0, 0.0, 0.0, phi, theta, 0.0]))
     }
 
+    /// The forces besides τ at ν and the attitude: −g(η), and the current's
+    /// force of the heading when there is one.
+    fn load(&self, nu: &DVector<f64>, (phi, theta, psi): Euler) -> DVector<f64> {
+        let g = -self.g((phi, theta));
+        match &self.current {
+            Some(c) => g + c.drive(nu, psi),
+            None => g,
+        }
+    }
+
+    /// The speed the sub-models are scheduled on: through the water in a
+    /// current, else u.
+    fn speed(&self, nu: &DVector<f64>, psi: f64) -> f64 {
+        match &self.current {
+            Some(c) => c.speed(nu, psi),
+            None => nu[0],
+        }
+    }
+
     /// ν(k+1) and the attitude at k+1 from ν(k), the attitude at k and τ(k).
     fn step(
         &self,
         lpv: &DiscreteLpv,
         h: f64,
         nu: &DVector<f64>,
-        att: Attitude,
+        att: Euler,
         tau: &DVector<f64>,
-    ) -> (DVector<f64>, Attitude) {
+    ) -> (DVector<f64>, Euler) {
         let scheduling = self.lpv.scheduling();
-        let g0 = self.g(att);
-        let rate0 = attitude_rate(att, nu);
-        let nu_p = lpv.step(nu, &(tau - &g0), scheduling);
-        let att_p = (att.0 + h * rate0.0, att.1 + h * rate0.1);
-        let rate_p = attitude_rate(att_p, &nu_p);
-        let att_mid = (
-            att.0 + 0.5 * h * (rate0.0 + rate_p.0),
-            att.1 + 0.5 * h * (rate0.1 + rate_p.1),
-        );
-        let g1 = self.g(att_mid);
-        let next = lpv.step(nu, &(tau - (&g0 + &g1) * 0.5), scheduling);
-        let rate1 = attitude_rate(att_mid, &next);
-        (
-            next,
+        let speed = Some(self.speed(nu, att.2));
+        let advance = |a: Euler, r0: Euler, r1: Euler| {
             (
-                att.0 + 0.5 * h * (rate0.0 + rate1.0),
-                att.1 + 0.5 * h * (rate0.1 + rate1.1),
-            ),
-        )
+                a.0 + 0.5 * h * (r0.0 + r1.0),
+                a.1 + 0.5 * h * (r0.1 + r1.1),
+                a.2 + 0.5 * h * (r0.2 + r1.2),
+            )
+        };
+        let f0 = self.load(nu, att);
+        let rate0 = euler_rate(att, nu);
+        let nu_p = lpv.step_at(nu, &(tau + &f0), scheduling, speed);
+        let att_p = (
+            att.0 + h * rate0.0,
+            att.1 + h * rate0.1,
+            att.2 + h * rate0.2,
+        );
+        let att_end = advance(att, rate0, euler_rate(att_p, &nu_p));
+        let f1 = self.load(&nu_p, att_end);
+        let next = lpv.step_at(nu, &(tau + (&f0 + &f1) * 0.5), scheduling, speed);
+        let rate1 = euler_rate(att_end, &next);
+        (next, advance(att, rate0, rate1))
     }
 
     /// The record's τ (first six columns) and measured attitude, or `None`
     /// when it does not fit the model.
-    fn parts(&self, rec: &ValidationRecord<'_>) -> Option<(DMatrix<f64>, Vec<Attitude>)> {
+    fn parts(&self, rec: &ValidationRecord<'_>) -> Option<(DMatrix<f64>, Vec<Euler>)> {
         let n = rec.y.nrows();
         if rec.y.ncols() != 6 || rec.u.shape() != (n, 12) || rec.h.is_nan() || rec.h <= 0.0 {
             return None;
@@ -98,14 +151,19 @@ impl AttitudeLoop {
             return None;
         }
         let tau = rec.u.columns(0, 6).into_owned();
-        let att = (0..n).map(|k| (rec.u[(k, 9)], rec.u[(k, 10)])).collect();
+        let att = (0..n)
+            .map(|k| (rec.u[(k, 9)], rec.u[(k, 10)], rec.u[(k, 11)]))
+            .collect();
         Some((tau, att))
     }
 }
 
-/// (φ̇, θ̇) from ν = [u v w p q r] (Fossen 2011, eq. 2.29).
-fn attitude_rate((phi, theta): Attitude, nu: &DVector<f64>) -> Attitude {
-    euler_rates(phi, theta, nu[3], nu[4], nu[5])
+/// (φ̇, θ̇, ψ̇) from ν = [u v w p q r] (Fossen 2011, eq. 2.29):
+/// ψ̇ = (q sin φ + r cos φ)/cos θ.
+fn euler_rate((phi, theta, _): Euler, nu: &DVector<f64>) -> Euler {
+    let (dphi, dtheta) = euler_rates(phi, theta, nu[3], nu[4], nu[5]);
+    let (s, c) = phi.sin_cos();
+    (dphi, dtheta, (nu[4] * s + nu[5] * c) / theta.cos())
 }
 
 /// (φ̇, θ̇) at attitude (φ, θ) and body rates (p, q, r) (Fossen 2011,
@@ -202,8 +260,7 @@ mod tests {
             for i in 0..6 {
                 d[i] = (-D[i] * s[i] - g[i]) / M[i];
             }
-            let nu = DVector::from_column_slice(&s[..6]);
-            let (dphi, dtheta) = attitude_rate((phi, theta), &nu);
+            let (dphi, dtheta) = euler_rates(phi, theta, s[3], s[4], s[5]);
             d[6] = dphi;
             d[7] = dtheta;
             d
@@ -282,6 +339,95 @@ mod tests {
             y: &y,
         });
         assert!((open - &sim).abs().max() < 1e-12);
+    }
+
+    /// A vehicle turning at a steady yaw rate in a current fixed in NED,
+    /// V = (0.3, 0.1) m/s, level: M ν̇ = τ − D(ν − ν_c(ψ)) + M ν̇_c with
+    /// ν_c(ψ) = [V_N cψ + V_E sψ, −V_N sψ + V_E cψ, 0, 0, 0, 0] and
+    /// ψ̇ = r, integrated by RK4 at 1 ms. The model's own heading turns the
+    /// current's force: surge and sway follow the current round the turn.
+    #[test]
+    fn a_vehicle_turning_in_a_current_drifts_with_it() {
+        let v = nalgebra::Vector2::new(0.3, 0.1);
+        let tau_n = 0.9;
+        let (h, n) = (0.1, 800);
+        let nu_c = |psi: f64| {
+            let (s, c) = psi.sin_cos();
+            [v[0] * c + v[1] * s, -v[0] * s + v[1] * c]
+        };
+        let f = |x: &[f64; 7]| -> [f64; 7] {
+            let (psi, r) = (x[6], x[5]);
+            let [uc, vc] = nu_c(psi);
+            let mut d = [0.0; 7];
+            for i in 0..6 {
+                let rel = x[i]
+                    - match i {
+                        0 => uc,
+                        1 => vc,
+                        _ => 0.0,
+                    };
+                d[i] = -D[i] * rel / M[i];
+            }
+            d[0] += r * vc;
+            d[1] -= r * uc;
+            d[5] += tau_n / M[5];
+            d[6] = r;
+            d
+        };
+        let mut x = [0.0; 7];
+        let mut truth = Vec::new();
+        for _ in 0..n {
+            truth.push(x);
+            for _ in 0..100 {
+                let add = |a: &[f64; 7], b: &[f64; 7], c: f64| -> [f64; 7] {
+                    std::array::from_fn(|i| a[i] + c * b[i])
+                };
+                let k1 = f(&x);
+                let k2 = f(&add(&x, &k1, 5e-4));
+                let k3 = f(&add(&x, &k2, 5e-4));
+                let k4 = f(&add(&x, &k3, 1e-3));
+                x = std::array::from_fn(|i| {
+                    x[i] + 1e-3 / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+                });
+            }
+        }
+        let base = model();
+        let d_bar = DMatrix::from_diagonal(&DVector::from_column_slice(&D));
+        let forces = vec![crate::identification::ned_current::force(
+            &d_bar,
+            &Dof::ALL,
+            &v,
+        )];
+        let drifting =
+            AttitudeLoop::with_current(base.lpv.clone(), base.restoring, forces, v).unwrap();
+        let y = DMatrix::from_fn(n, 6, |k, j| truth[k][j]);
+        let u = DMatrix::from_fn(n, 12, |k, j| match j {
+            5 => tau_n,
+            11 => truth[k][6],
+            _ => 0.0,
+        });
+        let rec = ValidationRecord { h, u: &u, y: &y };
+        let sim = drifting.simulate(&rec);
+        // The turn covers more than a revolution, and the drift follows it.
+        assert!(truth[n - 1][6] > 7.0, "ψ = {}", truth[n - 1][6]);
+        for k in 0..n {
+            for j in [0, 1, 5] {
+                assert!(
+                    (sim[(k, j)] - truth[k][j]).abs() < 0.005,
+                    "t = {} s, channel {j}: {} against {}",
+                    k as f64 * h,
+                    sim[(k, j)],
+                    truth[k][j]
+                );
+            }
+        }
+        // Without the current the same vehicle only turns.
+        let still = base.simulate(&rec);
+        let off = (0..n).map(|k| still[(k, 0)].abs()).fold(0.0, f64::max);
+        assert!(off < 1e-9, "{off}");
+        let swing = (0..n).map(|k| truth[k][0]).fold(f64::MIN, f64::max)
+            - (0..n).map(|k| truth[k][0]).fold(f64::MAX, f64::min);
+        assert!(swing > 0.4, "the current swings surge by {swing} m/s");
     }
 
     #[test]

@@ -104,6 +104,23 @@ pub(crate) fn fit_pairs(
     ]
 }
 
+/// Σ (a − b) over the held-out fits both give (run, channel, each of the
+/// four fits), each fit clamped to [−1, 1] so that one divergent channel
+/// counts as a total loss and no more; and how many were compared.
+pub(crate) fn advantage(a: &[RunValidation], b: &[RunValidation]) -> (f64, usize) {
+    let mut sum = 0.0;
+    let mut n = 0;
+    for (_, cb, ca) in paired(b, a) {
+        for (_, y, x) in fit_pairs(cb, ca) {
+            if let (Some(x), Some(y)) = (x.filter(|v| v.is_finite()), y.filter(|v| v.is_finite())) {
+                sum += x.clamp(-1.0, 1.0) - y.clamp(-1.0, 1.0);
+                n += 1;
+            }
+        }
+    }
+    (sum, n)
+}
+
 /// Each channel of `augmented`'s runs with the same run's channel of the
 /// same output in `baseline`: (run, before, after).
 pub(crate) fn paired<'a>(

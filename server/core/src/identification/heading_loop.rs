@@ -65,7 +65,7 @@ impl HeadingLoop {
     /// linearization speed u₀ of the grid points serving ν's forward speed
     /// (blended like the sub-models: the u-products then cancel as in
     /// C(δ)δ).
-    fn drive(&self, nu: &DVector<f64>, psi: f64) -> DVector<f64> {
+    pub(crate) fn drive(&self, nu: &DVector<f64>, psi: f64) -> DVector<f64> {
         let g = self.lpv.grid_speeds();
         let (lo, hi, w) = match self.lpv.weights(self.speed(nu, psi), self.lpv.scheduling()) {
             Ok(w) => (w.lower, w.upper, w.w_lower),
@@ -94,7 +94,7 @@ impl HeadingLoop {
     /// The forward speed through the water u_r = u − u_c(ψ) (m/s), which
     /// schedules the sub-models: each is linearized about its speed
     /// through the water.
-    fn speed(&self, nu: &DVector<f64>, psi: f64) -> f64 {
+    pub(crate) fn speed(&self, nu: &DVector<f64>, psi: f64) -> f64 {
         nu[self.surge] - surge_component([self.v[0], self.v[1]], psi)
     }
 

@@ -101,12 +101,14 @@ fn identify(
     // Columns: τ, then η when g(η) is part of the model.
     let with_restoring = settings.estimate_restoring && six_dof;
     let mut cols = regression_columns(inputs, with_restoring);
-    let with_current = settings.ned_current
-        && ned_current::applies(&dofs)
-        && ned_current::heading_logged(&roles, &mut notes);
-    if with_current {
-        cols.push(pose_column(Dof::Yaw).to_string());
+    let with_current =
+        settings.ned_current_for(&dofs) && ned_current::heading_logged(&roles, &mut notes);
+    let psi = pose_column(Dof::Yaw);
+    if with_current && !cols.iter().any(|c| c == psi) {
+        cols.push(psi.to_string());
     }
+    // ψ among the regression columns (η's last when g(η) is estimated).
+    let psi_col = cols.iter().position(|c| c == psi).unwrap_or(n);
     if !six_dof && settings.estimate_restoring && !ned_current::applies(&dofs) {
         notes.push("g(η) needs all six DOFs and the attitude; γ = τ".into());
     }
@@ -166,7 +168,7 @@ fn identify(
                 point
                     .into_iter()
                     .zip(segs)
-                    .map(|(e, s)| ned_current::append(e, s, n))
+                    .map(|(e, s)| ned_current::append(e, s, psi_col))
                     .collect()
             })
             .collect()
@@ -340,7 +342,7 @@ fn identify(
     // Sub-models hold the runs flown at their speed through the water.
     if let (Some(c), Some(surge), true) = (&current, surge, regrid_again)
         && let Some((moved, note)) =
-            through_water::regrid(runs, &roles, &data, grid, surge, n, c.estimate.v)
+            through_water::regrid(runs, &roles, &data, grid, surge, psi_col, c.estimate.v)
     {
         let mut sub = SubProgress::new(progress, 0.4, 0.6);
         return identify(
@@ -371,7 +373,7 @@ fn identify(
         build(g, loads)?,
         &data.segments,
         grid,
-        n,
+        psi_col,
         surge,
         relative.as_ref(),
         &current_forces,
@@ -499,6 +501,7 @@ fn identify(
         cols: &cols,
         outputs: &outputs,
         n,
+        psi_col,
         restoring: g,
         current: current.as_ref().map(|c| {
             let forces = estimates

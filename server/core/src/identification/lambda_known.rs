@@ -21,14 +21,14 @@ pub(crate) struct KnownSide {
 }
 
 impl KnownSide {
-    /// `plain` and `segments` per speed of `grid` (n DOFs, ψ the input
-    /// column after τ); `current_force(u₀)`: the current's force shapes
+    /// `plain` and `segments` per speed of `grid` (ψ their input column
+    /// `psi_col`); `current_force(u₀)`: the current's force shapes
     /// where the current is known; `surge`: the index of surge.
     pub fn new(
         plain: Vec<Vec<Experiment>>,
         segments: &[Vec<Segment>],
         grid: &[f64],
-        n: usize,
+        psi_col: usize,
         surge: Option<usize>,
         relative: Option<&Relative>,
         current_force: &dyn Fn(f64) -> Option<DMatrix<f64>>,
@@ -41,7 +41,7 @@ impl KnownSide {
                 Some((r, f)) => point
                     .into_iter()
                     .zip(segs)
-                    .map(|(e, s)| r.apply(e, s, u0, f))
+                    .map(|(e, s)| r.apply(e, s, psi_col, u0, f))
                     .collect(),
                 None => point,
             };
@@ -50,7 +50,7 @@ impl KnownSide {
                 .zip(segs)
                 .map(|(e, seg)| {
                     let (r, _) = known.as_ref()?;
-                    let psi = ned_current::heading(seg, n);
+                    let psi = ned_current::heading(seg, psi_col);
                     let rows: Vec<_> = psi
                         .get(..e.nu.nrows())?
                         .iter()

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::error::IdentifyError;
+use crate::planning::dof::Dof;
 
 /// The coupling structure to identify.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -130,14 +131,18 @@ pub struct LambdaCampaignSettings {
     /// damping only (the thesis's model).
     #[serde(default = "default_true")]
     pub quadratic_damping: bool,
-    /// Horizontal models (surge, sway, yaw; a surface vessel) whose logs
-    /// carry the heading `psi`: estimate one current fixed in NED for the
-    /// campaign, acting through the damping of the velocity through the
-    /// water, and keep it when the data hold it beyond their noise (χ² of
-    /// no current above its 99 % point). Predictions then integrate ψ from
-    /// the model's yaw rate. False: constant loads only.
-    #[serde(default = "default_true")]
-    pub ned_current: bool,
+    /// Estimate one current fixed in NED for the campaign, acting through
+    /// the damping of the velocity through the water ν_r = ν − ν_c(ψ), and
+    /// keep it when the data hold it beyond their noise (χ² of no current
+    /// above its 99 % point). Needs surge, sway and yaw modelled and the
+    /// heading `psi` logged on every run; predictions then integrate ψ from
+    /// the model's own rates. Absent: on for horizontal models (surge, sway,
+    /// yaw; a surface vessel), off for models with heave, roll or pitch (an
+    /// ROV: discovery tests a current there by identifying again with it).
+    /// True: on for any model with surge, sway and yaw. False: constant
+    /// loads only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ned_current: Option<bool>,
 }
 
 fn default_threshold() -> f64 {
@@ -169,12 +174,21 @@ impl Default for LambdaCampaignSettings {
             symmetric_inertia: true,
             coriolis_second_order: true,
             quadratic_damping: true,
-            ned_current: true,
+            ned_current: None,
         }
     }
 }
 
 impl LambdaCampaignSettings {
+    /// Whether the NED current is estimated for a model of `dofs` (see
+    /// [`LambdaCampaignSettings::ned_current`]).
+    pub fn ned_current_for(&self, dofs: &[Dof]) -> bool {
+        match self.ned_current {
+            None => super::ned_current::applies(dofs),
+            Some(on) => on && super::ned_current::possible(dofs),
+        }
+    }
+
     /// Settings a campaign of `n_inputs` input columns for `n` DOFs on
     /// `grid` can run with; the error names the offending field.
     pub(crate) fn check(

@@ -44,8 +44,8 @@ pub(crate) const SIN_PSI: &str = "sin ψ";
 /// the 99 % point.
 const KEEP_CHI2: f64 = 9.21;
 
-/// Whether `dofs` is a horizontal model a NED current acts on: surge, sway
-/// and yaw modelled, no heave, roll or pitch.
+/// Whether `dofs` is a horizontal model, on which the current is estimated
+/// by default: surge, sway and yaw modelled, no heave, roll or pitch.
 pub(crate) fn applies(dofs: &[Dof]) -> bool {
     [Dof::Surge, Dof::Sway, Dof::Yaw]
         .iter()
@@ -53,6 +53,15 @@ pub(crate) fn applies(dofs: &[Dof]) -> bool {
         && !dofs
             .iter()
             .any(|d| matches!(d, Dof::Heave | Dof::Roll | Dof::Pitch))
+}
+
+/// Whether a current can be estimated for `dofs`: surge, sway and yaw
+/// modelled. With heave, roll and pitch too, ν_c(η) = J₁(η)ᵀ[V_N V_E 0]ᵀ
+/// is taken at small roll and pitch: [u_c, v_c] of the heading alone.
+pub(crate) fn possible(dofs: &[Dof]) -> bool {
+    [Dof::Surge, Dof::Sway, Dof::Yaw]
+        .iter()
+        .all(|d| dofs.contains(d))
 }
 
 /// e(ψ) = [cos ψ, sin ψ] held over each step like γ: row k is the mean of
@@ -72,14 +81,15 @@ pub(crate) fn functions_of(psi: &[f64]) -> DMatrix<f64> {
     })
 }
 
-/// The heading ψ (rad) of a segment whose inputs are the n forces then ψ.
-pub(crate) fn heading(seg: &Segment, n: usize) -> Vec<f64> {
-    seg.u.column(n).iter().copied().collect()
+/// The heading ψ (rad) of a segment: its input column `psi_col`.
+pub(crate) fn heading(seg: &Segment, psi_col: usize) -> Vec<f64> {
+    seg.u.column(psi_col).iter().copied().collect()
 }
 
-/// `exp` with e(ψ) of `seg` appended to its exogenous columns.
-pub(crate) fn append(exp: Experiment, seg: &Segment, n: usize) -> Experiment {
-    let e = functions_of(&heading(seg, n));
+/// `exp` with e(ψ) of `seg` (ψ its input column `psi_col`) appended to
+/// its exogenous columns.
+pub(crate) fn append(exp: Experiment, seg: &Segment, psi_col: usize) -> Experiment {
+    let e = functions_of(&heading(seg, psi_col));
     let rows = exp.exogenous.nrows();
     let q = exp.exogenous.ncols();
     let mut x = DMatrix::zeros(rows, q + 2);
@@ -333,11 +343,19 @@ impl Relative {
         out
     }
 
-    /// `exp` of `seg` (at grid speed `u0`) driven by γ + [`Relative::drive`]
-    /// over each step (at the step means of ν and ψ): the current known.
-    pub fn apply(&self, exp: Experiment, seg: &Segment, u0: f64, f: &DMatrix<f64>) -> Experiment {
+    /// `exp` of `seg` (at grid speed `u0`, ψ its input column `psi_col`)
+    /// driven by γ + [`Relative::drive`] over each step (at the step means
+    /// of ν and ψ): the current known.
+    pub fn apply(
+        &self,
+        exp: Experiment,
+        seg: &Segment,
+        psi_col: usize,
+        u0: f64,
+        f: &DMatrix<f64>,
+    ) -> Experiment {
         let n = self.dofs.len();
-        let psi = heading(seg, n);
+        let psi = heading(seg, psi_col);
         let rows = exp.gamma.nrows().min(psi.len());
         let mut gamma = exp.gamma.clone();
         for k in 0..rows {

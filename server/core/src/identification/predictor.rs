@@ -64,6 +64,16 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
         ModelKind::Lpv if is_augmented(doc) => Ok(Box::new(AugmentedLpv::from_doc(doc)?)),
         ModelKind::Lpv => {
             let model = baseline_lpv(doc)?;
+            if let (Some(g), Some((forces, v))) = (attitude_in_loop(doc), current_in_loop(doc)) {
+                return AttitudeLoop::with_current(model, g, forces, v)
+                    .map(|m| Box::new(m) as Box<dyn Predictor>)
+                    .ok_or_else(|| {
+                        IdentifyError::invalid(
+                            "document.lpv.current",
+                            "a current needs one 6 × 2 F per grid point",
+                        )
+                    });
+            }
             if let Some((forces, v)) = current_in_loop(doc) {
                 return HeadingLoop::new(model, forces, v)
                     .map(|m| Box::new(m) as Box<dyn Predictor>)

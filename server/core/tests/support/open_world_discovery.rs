@@ -19,7 +19,7 @@ use seatrial_core::identification::LambdaCampaignSettings;
 /// baseline it holds for.
 /// `DISCOVERY_BASELINE=default` (the examples) starts from the
 /// identification's defaults instead.
-fn discovery_baseline_settings() -> LambdaCampaignSettings {
+pub fn discovery_baseline_settings() -> LambdaCampaignSettings {
     if std::env::var("DISCOVERY_BASELINE").is_ok_and(|v| v == "default") {
         return LambdaCampaignSettings::default();
     }
@@ -99,6 +99,8 @@ pub struct DiscoveryCase {
     pub stored: bool,
     /// The gate's sentence.
     pub verdict: String,
+    /// The report's whole summary (the gate's sentence last).
+    pub summary: Vec<String>,
     pub gaps: Vec<GapRow>,
     /// Per named effect (same order): the truth's value of its first
     /// coefficient where the truth has it ([`truth_coefficient`]).
@@ -402,6 +404,7 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         grid_points: spec.grid_speeds.len(),
         stored: out.augmented.is_some(),
         verdict: out.report.summary.last().cloned().unwrap_or_default(),
+        summary: out.report.summary.clone(),
         gaps,
         secs: [t_flown, t_identified - t_flown, discovery_s],
         unexplained,
@@ -613,7 +616,13 @@ pub fn format_cases(cases: &[DiscoveryCase]) -> String {
         {
             s += &format!("    first named, left out: {label}: {why}\n");
         }
-        s += &format!("    {}\n", c.verdict);
+        if std::env::var_os("SUMMARY").is_some() {
+            for line in &c.summary {
+                s += &format!("    summary: {line}\n");
+            }
+        } else {
+            s += &format!("    {}\n", c.verdict);
+        }
     }
     s
 }

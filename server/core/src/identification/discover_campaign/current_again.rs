@@ -13,9 +13,7 @@
 
 use nalgebra::{Matrix2, Vector2};
 
-use super::super::discover_gate::{
-    HeldOutVerdict, compare_against, fit_pairs, inertia_verdict, paired,
-};
+use super::super::discover_gate::{HeldOutVerdict, advantage, compare_against, inertia_verdict};
 use super::super::document::{ModelDocument, NedCurrentDoc};
 use super::super::error::IdentifyError;
 use super::super::lambda_campaign::identify_lambda_campaign;
@@ -31,8 +29,8 @@ use crate::estimation::{Progress, SubProgress};
 use crate::numbers::sig3;
 use crate::planning::VesselProfile;
 
-/// Whether to identify again with the current: asked for, a surface model
-/// without a current (in its document or as a carried term) that was not
+/// Whether to identify again with the current: asked for, a model with
+/// surge, sway and yaw without a current (in its document or as a carried term) that was not
 /// identified with one already (`ned_current` in the identification
 /// settings given), and something named that a current could stand behind
 /// (a force fixed in NED, or terms that absorb its force at one speed).
@@ -46,8 +44,8 @@ pub(super) fn applies(
         && !settings
             .identification
             .as_ref()
-            .is_some_and(|s| s.ned_current)
-        && ned_current::applies(&doc.dofs)
+            .is_some_and(|s| s.ned_current_for(&doc.dofs))
+        && ned_current::possible(&doc.dofs)
         && doc.lpv.as_ref().is_some_and(|l| l.current.is_none())
         && !carried.contains(&Effect::Current)
         && !effects.is_empty()
@@ -79,7 +77,7 @@ pub(super) fn identify_again(
         "identifying the campaign again with the NED current estimated",
     )?;
     let mut s = asm.settings.identification.clone().unwrap_or_default();
-    s.ned_current = true;
+    s.ned_current = Some(true);
     s.validation_run_ids = Some(asm.val_ids.to_vec());
     let runs: Vec<_> = asm
         .runs
@@ -146,23 +144,6 @@ pub(super) fn continue_discovery(
         Err(IdentifyError::Cancelled) => Err(IdentifyError::Cancelled),
         Err(_) => Ok(None),
     }
-}
-
-/// Σ (a − b) over the held-out fits both give (run, channel, each of the
-/// four fits), each fit clamped to [−1, 1] so that one divergent channel
-/// counts as a total loss and no more; and how many were compared.
-pub(super) fn advantage(a: &[RunValidation], b: &[RunValidation]) -> (f64, usize) {
-    let mut sum = 0.0;
-    let mut n = 0;
-    for (_, cb, ca) in paired(b, a) {
-        for (_, y, x) in fit_pairs(cb, ca) {
-            if let (Some(x), Some(y)) = (x.filter(|v| v.is_finite()), y.filter(|v| v.is_finite())) {
-                sum += x.clamp(-1.0, 1.0) - y.clamp(-1.0, 1.0);
-                n += 1;
-            }
-        }
-    }
-    (sum, n)
 }
 
 /// The outcome once both explanations are known.

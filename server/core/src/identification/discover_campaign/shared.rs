@@ -325,7 +325,7 @@ pub(super) fn hold_unexamined(
 /// the grid point of its speed through the water u − u_c(ψ). Names the
 /// estimation runs (`est_ids`, no stated grid speed) that the current moves
 /// to another grid point. `None` when the model has a current or is not a
-/// horizontal (surge–sway–yaw) model.
+/// model with surge, sway and yaw.
 pub(super) fn reidentify_note(
     doc: &ModelDocument,
     runs: &[RunInput],
@@ -334,7 +334,7 @@ pub(super) fn reidentify_note(
     v: [f64; 2],
 ) -> Option<String> {
     let lpv = doc.lpv.as_ref()?;
-    if lpv.current.is_some() || !ned_current::applies(&doc.dofs) {
+    if lpv.current.is_some() || !ned_current::possible(&doc.dofs) {
         return None;
     }
     let mut moved = Vec::new();
@@ -385,18 +385,18 @@ pub(super) fn reidentify_note(
         )
     };
     Some(format!(
-        "The model was identified without a current. Identify the campaign again with the NED current estimated (`ned_current: true`, the default): {why}."
+        "The model was identified without a current. Identify the campaign again with the NED current estimated (`ned_current: true`, the default for surface vessels): {why}."
     ))
 }
 
-/// A pull fixed in NED named on a horizontal model identified without a
+/// A pull fixed in NED named on a model (surge, sway, yaw) identified without a
 /// current: at one forward speed a current's force D̄·ν_c(ψ) turns with the
 /// heading as the pull does, so the text names the look-alike and how to
 /// test it.
 pub(super) fn pull_or_current_note(doc: &ModelDocument) -> Option<String> {
     let lpv = doc.lpv.as_ref()?;
-    (lpv.current.is_none() && ned_current::applies(&doc.dofs)).then(|| {
-        "A force fixed in NED was named; a current looks the same at one forward speed (its force D̄·ν_c(ψ) turns with the heading too), and the model was identified without one. Unless the vessel was moored, towed or held in a steady wind, identify the campaign again with the NED current estimated (`ned_current: true`, the default) and compare the held-out fits.".to_owned()
+    (lpv.current.is_none() && ned_current::possible(&doc.dofs)).then(|| {
+        "A force fixed in NED was named; a current looks the same at one forward speed (its force D̄·ν_c(ψ) turns with the heading too), and the model was identified without one. Unless the vessel was moored, tethered, towed or held in a steady wind, identify the campaign again with the NED current estimated (`ned_current: true`, the default for surface vessels) and compare the held-out fits.".to_owned()
     })
 }
 
