@@ -212,12 +212,25 @@ pub fn compare_against(
         .filter(|c| c.gain() < -FIT_NOISE || c.is_worse())
         .collect();
     worse.sort_by(|x, y| x.gain().total_cmp(&y.gain()));
+    let mut better: Vec<&Change> = all.iter().filter(|c| c.gain() > FIT_NOISE).collect();
+    better.sort_by(|x, y| y.gain().total_cmp(&x.gain()));
     if !worse.is_empty() {
         let shown: Vec<String> = worse.iter().take(3).map(|c| c.text()).collect();
+        // What it gained beside: a model better in most fits and worse in
+        // one is a different finding from one worse throughout.
+        let beside = match better.first() {
+            Some(best) => format!(
+                " (it improves {} of {} fits by more than {FIT_NOISE}; largest gain: {})",
+                better.len(),
+                all.len(),
+                best.text()
+            ),
+            None => String::new(),
+        };
         return HeldOutVerdict {
             keep: false,
             reason: format!(
-                "on the held-out runs it is worse than {against} in {}{}",
+                "on the held-out runs it is worse than {against} in {}{}{beside}",
                 shown.join(", "),
                 if worse.len() > 3 {
                     format!(" and {} more", worse.len() - 3)
@@ -227,8 +240,6 @@ pub fn compare_against(
             ),
         };
     }
-    let mut better: Vec<&Change> = all.iter().filter(|c| c.gain() > FIT_NOISE).collect();
-    better.sort_by(|x, y| y.gain().total_cmp(&x.gain()));
     match better.first() {
         None => HeldOutVerdict {
             keep: false,
@@ -331,6 +342,20 @@ pub(crate) mod tests {
             "{}",
             v.text()
         );
+        // What it gained beside is said too; a model worse throughout has
+        // no such clause.
+        let n = 4 * base.iter().map(|r| r.report.channels.len()).sum::<usize>();
+        assert!(
+            v.text().contains(&format!(
+                "(it improves 1 of {n} fits by more than {FIT_NOISE}; largest gain: v on 'run-2' (1-step fit"
+            )),
+            "{}",
+            v.text()
+        );
+        let mut worse = base.clone();
+        shift(&mut worse, "r", -0.02);
+        let w = compare_held_out(&base, &worse);
+        assert!(!w.keep && !w.text().contains("it improves"), "{}", w.text());
 
         let mut within_noise = better.clone();
         shift(&mut within_noise, "r", -0.5 * FIT_NOISE);
