@@ -493,10 +493,7 @@ mod tests {
             },
         });
         base.inputs = (0..6).map(|i| format!("tau{i}")).collect();
-        base.outputs = Dof::ALL
-            .iter()
-            .map(|d| d.velocity_symbol().to_string())
-            .collect();
+        base.outputs = Dof::velocity_symbols(&Dof::ALL);
         let mut aug = base.clone();
         aug.inputs
             .extend(["x", "y", "z", "phi", "theta", "psi"].map(String::from));

@@ -87,10 +87,7 @@ fn identify(
     let n = dofs.len();
     settings.check(inputs.len(), n, grid)?;
     let roles = assign_roles(runs, settings.validation_run_ids.as_deref())?;
-    let outputs: Vec<String> = dofs
-        .iter()
-        .map(|d| d.velocity_symbol().to_string())
-        .collect();
+    let outputs: Vec<String> = Dof::velocity_symbols(&dofs);
     let six_dof = n == 6;
     let mut notes = Vec::new();
     let regrid_again = regridded.is_none();

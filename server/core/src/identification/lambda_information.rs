@@ -97,10 +97,7 @@ pub fn lambda_information(
     } else {
         Functions::Constant
     };
-    let outputs: Vec<String> = dofs
-        .iter()
-        .map(|d| d.velocity_symbol().to_string())
-        .collect();
+    let outputs: Vec<String> = Dof::velocity_symbols(&dofs);
     let mut notes = Vec::new();
     let data = per_point(&roles, grid, &dofs, &cols, &outputs, &mut notes)?;
     let mut out = Vec::new();

@@ -14,6 +14,7 @@ use super::roles::assign_roles;
 use super::state_space::StateSpacePredictor;
 use crate::estimation::n4sid::{N4sidError, N4sidSettings, Weighting, n4sid};
 use crate::estimation::{Progress, SubProgress};
+use crate::planning::Dof;
 use crate::planning::vessel::VesselProfile;
 use crate::validation::{ValidationRecord, ValidationSettings, validate};
 
@@ -107,11 +108,7 @@ pub fn identify_n4sid_campaign(
         ));
     }
     let roles = assign_roles(runs, settings.validation_run_ids.as_deref())?;
-    let outputs: Vec<String> = profile
-        .dofs
-        .iter()
-        .map(|d| d.velocity_symbol().to_string())
-        .collect();
+    let outputs: Vec<String> = Dof::velocity_symbols(&profile.dofs);
     let min_len = 4 * settings.horizon.max(2) + 20;
     let mut segs = Vec::new();
     // Static runs are estimation data too for a black box: they carry the

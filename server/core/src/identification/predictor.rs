@@ -286,11 +286,7 @@ pub fn validation_data(
     let n = doc.dofs.len();
     let run = level_attitude(run, &doc.dofs);
     let run = &*run;
-    let outputs: Vec<String> = doc
-        .dofs
-        .iter()
-        .map(|d| d.velocity_symbol().to_string())
-        .collect();
+    let outputs: Vec<String> = Dof::velocity_symbols(&doc.dofs);
     let restoring = doc.restoring.as_ref().map(|r| r.params);
     let augmented = is_augmented(doc);
     let mut cols = inputs.to_vec();

@@ -94,11 +94,7 @@ pub fn azimuth_angle_columns(vessel: &VesselProfile) -> Vec<String> {
 
 /// Output columns: body velocities of the modeled DOFs (`u`, `v`, `r`, …).
 pub fn output_columns(vessel: &VesselProfile) -> Vec<String> {
-    vessel
-        .dofs
-        .iter()
-        .map(|d| d.velocity_symbol().to_string())
-        .collect()
+    Dof::velocity_symbols(&vessel.dofs)
 }
 
 /// Pose columns of the modeled DOFs (`x`, `y`, `psi`, …).

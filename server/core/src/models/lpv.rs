@@ -584,10 +584,7 @@ impl DiscreteLpv {
 /// [`LpvModel::try_predict_k_step`]).
 impl Predictor for LpvModel {
     fn output_names(&self) -> Vec<String> {
-        self.dofs()
-            .iter()
-            .map(|d| d.velocity_symbol().to_string())
-            .collect()
+        Dof::velocity_symbols(self.dofs())
     }
 
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {

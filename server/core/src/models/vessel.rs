@@ -214,10 +214,7 @@ impl LinearVesselModel {
 /// [`LinearVesselModel::try_predict_k_step`] for the reason.
 impl Predictor for LinearVesselModel {
     fn output_names(&self) -> Vec<String> {
-        self.dofs
-            .iter()
-            .map(|d| d.velocity_symbol().to_string())
-            .collect()
+        Dof::velocity_symbols(&self.dofs)
     }
 
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {

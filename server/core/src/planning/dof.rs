@@ -57,6 +57,13 @@ impl Dof {
         ["u", "v", "w", "p", "q", "r"][self.index()]
     }
 
+    /// The velocity symbols of `dofs`, in order: a model's output names.
+    pub fn velocity_symbols(dofs: &[Dof]) -> Vec<String> {
+        dofs.iter()
+            .map(|d| d.velocity_symbol().to_string())
+            .collect()
+    }
+
     /// Generalized-force log column name (`tau_X` …).
     pub fn force_column(self) -> &'static str {
         ["tau_X", "tau_Y", "tau_Z", "tau_K", "tau_M", "tau_N"][self.index()]

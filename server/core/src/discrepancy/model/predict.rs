@@ -7,6 +7,7 @@ use nalgebra::DMatrix;
 use super::AugmentedModel;
 use crate::discrepancy::data::Record;
 use crate::models::predict::no_prediction;
+use crate::planning::Dof;
 use crate::validation::{Predictor, ValidationRecord};
 
 /// A free run over `rec` (N × n ν): from the measured state at 0, one
@@ -91,10 +92,7 @@ impl State {
 /// (n + 6 columns), `y` holds ν.
 impl Predictor for AugmentedModel {
     fn output_names(&self) -> Vec<String> {
-        self.dofs
-            .iter()
-            .map(|d| d.velocity_symbol().to_string())
-            .collect()
+        Dof::velocity_symbols(&self.dofs)
     }
 
     fn predict_k_step(&self, rec: &ValidationRecord<'_>, k: usize) -> DMatrix<f64> {

@@ -34,10 +34,7 @@ pub(super) fn records(
         .cloned()
         .chain(Dof::ALL.iter().map(|d| pose_column(*d).to_string()))
         .collect();
-    let outputs: Vec<String> = dofs
-        .iter()
-        .map(|d| d.velocity_symbol().to_string())
-        .collect();
+    let outputs: Vec<String> = Dof::velocity_symbols(dofs);
     let segs = segments(run, &cols, &outputs, min_len)
         .map_err(|e| IdentifyError::invalid(format!("runs[{}]", e.run_id), e.to_string()))?;
     let surge = dofs.iter().position(|d| *d == Dof::Surge);
