@@ -197,8 +197,10 @@ export async function discoveryPage(view, id) {
         h('th', { title: 'Held-out free-run fit gained where it was chosen (1 − NRMSE summed over channels and speeds); effects are ranked by the speeds that chose them, then by it' }, 'Held-out gain'),
         h('th', null, 'First coefficient per speed (± std)'),
         h('th', { title: 'The model with every finding, or else each grid speed\u2019s findings added one speed at a time, is kept only where the held-out runs are better with them than without and no worse anywhere' }, 'In the stored model'))),
-      h('tbody', null, effects.map((e) => h('tr', { 'data-testid': 'effect-row' },
-        h('td', null, h('b', null, e.label)),
+      h('tbody', null, effects.map((e) => h('tr', { 'data-testid': 'effect-row', 'data-unconfirmed': e.unconfirmed ? 'true' : 'false' },
+        h('td', null, e.unconfirmed
+          ? [h('span', null, e.label), ' ', h('span', { class: 'badge weak', 'data-testid': 'effect-unconfirmed', title: 'Tried, not confirmed: the held-out runs did not favour it at any grid speed that chose it; not a finding' }, 'not confirmed')]
+          : h('b', null, e.label)),
         h('td', null, e.grid_speeds_mps.length
           ? e.grid_speeds_mps.map((s) => `${fmtKn(s)} kn`).join(', ')
           : (e.campaign_estimate ? 'the whole campaign' : '—')),

@@ -112,6 +112,12 @@ pub struct EffectAcrossGrid {
     /// model holds it (`null` for effects that may vary with speed).
     #[serde(default)]
     pub campaign_estimate: Option<CampaignEstimate>,
+    /// Tried, not confirmed: at every grid speed that chose it, that
+    /// speed's findings added alone to the baseline gain nothing on the
+    /// held-out runs on balance (`held_out_verdict` gives the sums). Such
+    /// effects are listed after the named ones and are not findings.
+    #[serde(default)]
+    pub unconfirmed: bool,
 }
 
 impl EffectAcrossGrid {
@@ -396,9 +402,19 @@ pub fn discover_campaign(
         // The start model through the same validation, on the same runs.
         let before = asm.validate(doc)?;
         let gate = keep_better(&asm, &effects, &before, progress, (0.9, gate_to))?;
-        for (e, v) in effects.iter_mut().zip(&gate.verdicts) {
+        for ((e, v), u) in effects
+            .iter_mut()
+            .zip(&gate.verdicts)
+            .zip(&gate.unconfirmed)
+        {
             e.kept = Some(v.keep && gate.model.is_some());
-            e.held_out_verdict = Some(v.reason.clone());
+            e.held_out_verdict = Some(match u {
+                Some(why) if e.kept != Some(true) => {
+                    e.unconfirmed = true;
+                    format!("{why}; {}", v.reason)
+                }
+                _ => v.reason.clone(),
+            });
         }
         for e in effects
             .iter_mut()
@@ -438,6 +454,12 @@ pub fn discover_campaign(
         }
     }
     shared_notes.extend(advice);
+    // Tried and not confirmed: after the named effects (a model's
+    // re-identification that keeps an effect confirms it).
+    for e in &mut effects {
+        e.unconfirmed &= e.kept != Some(true);
+    }
+    effects.sort_by_key(|e| e.unconfirmed);
     let mut summary = summarize(&points, &effects, &skipped);
     summary.extend(shared_notes);
     summary.extend(overall);
@@ -470,6 +492,7 @@ fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
                 kept: None,
                 held_out_verdict: None,
                 campaign_estimate: None,
+                unconfirmed: false,
             });
             e.grid_speeds_mps.push(p.grid_speed_mps);
             let gain = p

@@ -105,6 +105,8 @@ pub struct DiscoveryCase {
     pub verdict: String,
     /// The report's whole summary (the gate's sentence last).
     pub summary: Vec<String>,
+    /// Effects tried and not confirmed on the held-out runs (labels).
+    pub unconfirmed: Vec<String>,
     pub gaps: Vec<GapRow>,
     /// Per named effect (same order): the truth's value of its first
     /// coefficient where the truth has it ([`truth_coefficient`]).
@@ -205,10 +207,17 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
     )
     .expect("discovery runs");
     let discovery_s = t0.elapsed().as_secs_f64() - t_identified;
-    let named = out
+    // What the report names: effects tried and not confirmed on the
+    // held-out runs are not findings.
+    let named_effects: Vec<_> = out
         .report
         .effects
         .iter()
+        .filter(|e| !e.unconfirmed)
+        .collect();
+    let named = named_effects
+        .iter()
+        .copied()
         .map(|e| {
             (
                 e.label.clone(),
@@ -217,16 +226,14 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
             )
         })
         .collect();
-    let in_truth = out
-        .report
-        .effects
+    let in_truth = named_effects
         .iter()
+        .copied()
         .map(|e| in_truth(&vessel, &e.effect))
         .collect();
-    let estimates = out
-        .report
-        .effects
+    let estimates = named_effects
         .iter()
+        .copied()
         .map(|e| {
             out.report
                 .points
@@ -247,10 +254,9 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
                 .collect()
         })
         .collect();
-    let first_values = out
-        .report
-        .effects
+    let first_values = named_effects
         .first()
+        .copied()
         .map(|e| {
             out.report
                 .points
@@ -266,13 +272,12 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
                 .collect()
         })
         .unwrap_or_default();
-    let campaign_values = out
-        .report
-        .effects
+    let campaign_values = named_effects
         .first()
+        .copied()
         .and_then(|e| e.campaign_estimate.as_ref())
         .map(|c| c.coefficients.iter().map(|c| c.value).collect());
-    let stored_values = match (&out.augmented, out.report.effects.first()) {
+    let stored_values = match (&out.augmented, named_effects.first().copied()) {
         (Some(a), Some(e)) => a
             .document
             .lpv
@@ -291,10 +296,9 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
             .unwrap_or_default(),
         _ => vec![],
     };
-    let kept = out
-        .report
-        .effects
+    let kept = named_effects
         .iter()
+        .copied()
         .map(|e| (e.kept, e.held_out_verdict.clone()))
         .collect();
     let unexplained = out
@@ -397,10 +401,9 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         first_values,
         campaign_values,
         stored_values,
-        truth_values: out
-            .report
-            .effects
+        truth_values: named_effects
             .iter()
+            .copied()
             .map(|e| truth_coefficient(&vessel, &e.effect))
             .collect(),
         vessel: vessel.clone(),
@@ -409,6 +412,20 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         stored: out.augmented.is_some(),
         verdict: out.report.summary.last().cloned().unwrap_or_default(),
         summary: out.report.summary.clone(),
+        unconfirmed: out
+            .report
+            .effects
+            .iter()
+            .filter(|e| e.unconfirmed)
+            .map(|e| {
+                format!(
+                    "{} ({}/{})",
+                    e.label,
+                    e.grid_speeds_mps.len(),
+                    spec.grid_speeds.len()
+                )
+            })
+            .collect(),
         gaps,
         secs: [t_flown, t_identified - t_flown, discovery_s],
         unexplained,

@@ -315,6 +315,7 @@ pub(super) fn settle(
             kept: None,
             held_out_verdict: None,
             campaign_estimate: None,
+            unconfirmed: false,
         });
     entry.kept = Some(true);
     entry.held_out_verdict = Some(reason.clone());

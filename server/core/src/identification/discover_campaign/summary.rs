@@ -83,9 +83,13 @@ pub(super) fn summarize(
             out.push(format!("{}:{once}{gate}", e.label));
             continue;
         }
+        let (label, named) = if e.unconfirmed {
+            (format!("Tried, not confirmed: {}", e.label), "chosen")
+        } else {
+            (e.label.clone(), "named")
+        };
         out.push(format!(
-            "{}: named {scope}; {range}; held-out fit gained {:.3} (summed over speeds and channels).{once}{gate}",
-            e.label,
+            "{label}: {named} {scope}; {range}; held-out fit gained {:.3} (summed over speeds and channels).{once}{gate}",
             e.evidence()
         ));
     }

@@ -115,6 +115,9 @@ pub fn format_cases(cases: &[DiscoveryCase]) -> String {
         {
             s += &format!("    first named, left out: {label}: {why}\n");
         }
+        if !c.unconfirmed.is_empty() {
+            s += &format!("    tried, not confirmed: {}\n", c.unconfirmed.join("; "));
+        }
         if std::env::var_os("SUMMARY").is_some() {
             for line in &c.summary {
                 s += &format!("    summary: {line}\n");
