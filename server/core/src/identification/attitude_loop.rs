@@ -222,6 +222,7 @@ impl Predictor for AttitudeLoop {
 mod tests {
     use super::*;
     use crate::models::LinearVesselModel;
+    use crate::simulation::integrate::rk4_step;
 
     const M: [f64; 6] = [100.0, 120.0, 140.0, 10.0, 20.0, 30.0];
     const D: [f64; 6] = [50.0, 60.0, 70.0, 3.0, 4.0, 9.0];
@@ -246,7 +247,7 @@ mod tests {
     /// The unforced vehicle released at (φ, θ) = (0.1, 0.05) rad, integrated
     /// by RK4 at 1 ms on M ν̇ = −D ν − g(η) and the Euler-angle kinematics.
     fn released(n: usize, h: f64) -> (Vec<[f64; 6]>, Vec<Attitude>) {
-        let f = |s: &[f64; 8]| -> [f64; 8] {
+        let mut f = |s: &[f64], _: &[f64], d: &mut [f64]| {
             let (phi, theta) = (s[6], s[7]);
             let g = [
                 0.0,
@@ -256,14 +257,12 @@ mod tests {
                 BGW * theta.sin(),
                 0.0,
             ];
-            let mut d = [0.0; 8];
             for i in 0..6 {
                 d[i] = (-D[i] * s[i] - g[i]) / M[i];
             }
             let (dphi, dtheta) = euler_rates(phi, theta, s[3], s[4], s[5]);
             d[6] = dphi;
             d[7] = dtheta;
-            d
         };
         let mut s = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 0.05];
         let fine = 1e-3;
@@ -273,16 +272,7 @@ mod tests {
             nu.push([s[0], s[1], s[2], s[3], s[4], s[5]]);
             att.push((s[6], s[7]));
             for _ in 0..per {
-                let add = |a: &[f64; 8], b: &[f64; 8], c: f64| -> [f64; 8] {
-                    std::array::from_fn(|i| a[i] + c * b[i])
-                };
-                let k1 = f(&s);
-                let k2 = f(&add(&s, &k1, fine / 2.0));
-                let k3 = f(&add(&s, &k2, fine / 2.0));
-                let k4 = f(&add(&s, &k3, fine));
-                s = std::array::from_fn(|i| {
-                    s[i] + fine / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-                });
+                rk4_step(&mut f, &mut s, &[], fine);
             }
         }
         (nu, att)
@@ -355,10 +345,9 @@ mod tests {
             let (s, c) = psi.sin_cos();
             [v[0] * c + v[1] * s, -v[0] * s + v[1] * c]
         };
-        let f = |x: &[f64; 7]| -> [f64; 7] {
+        let mut f = |x: &[f64], _: &[f64], d: &mut [f64]| {
             let (psi, r) = (x[6], x[5]);
             let [uc, vc] = nu_c(psi);
-            let mut d = [0.0; 7];
             for i in 0..6 {
                 let rel = x[i]
                     - match i {
@@ -372,23 +361,13 @@ mod tests {
             d[1] -= r * uc;
             d[5] += tau_n / M[5];
             d[6] = r;
-            d
         };
         let mut x = [0.0; 7];
         let mut truth = Vec::new();
         for _ in 0..n {
             truth.push(x);
             for _ in 0..100 {
-                let add = |a: &[f64; 7], b: &[f64; 7], c: f64| -> [f64; 7] {
-                    std::array::from_fn(|i| a[i] + c * b[i])
-                };
-                let k1 = f(&x);
-                let k2 = f(&add(&x, &k1, 5e-4));
-                let k3 = f(&add(&x, &k2, 5e-4));
-                let k4 = f(&add(&x, &k3, 1e-3));
-                x = std::array::from_fn(|i| {
-                    x[i] + 1e-3 / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-                });
+                rk4_step(&mut f, &mut x, &[], 1e-3);
             }
         }
         let base = model();

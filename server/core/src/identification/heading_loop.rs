@@ -185,6 +185,7 @@ mod tests {
     use super::*;
     use crate::identification::ned_current::force;
     use crate::models::LinearVesselModel;
+    use crate::simulation::integrate::rk4_step;
 
     const M: [f64; 3] = [100.0, 150.0, 40.0];
     const D: [f64; 3] = [50.0, 120.0, 30.0];
@@ -193,7 +194,7 @@ mod tests {
     /// integrated by RK4 at 1 ms on M ν̇_r = τ − D ν_r, ν_r = ν − ν_c(ψ),
     /// ψ̇ = r.
     fn drifting(n: usize, h: f64, v: Vector2<f64>, tau_n: f64) -> (Vec<[f64; 4]>, f64) {
-        let f = |s: &[f64; 4]| -> [f64; 4] {
+        let mut f = |s: &[f64], _: &[f64], d: &mut [f64]| {
             let psi = s[3];
             let nu_c = [
                 v[0] * psi.cos() + v[1] * psi.sin(),
@@ -203,12 +204,10 @@ mod tests {
             let tau = [0.0, 0.0, tau_n];
             // ν̇_c = r·[v_c, −u_c, 0] for a current constant in NED.
             let nu_c_dot = [s[2] * nu_c[1], -s[2] * nu_c[0], 0.0];
-            let mut d = [0.0; 4];
             for i in 0..3 {
                 d[i] = (tau[i] - D[i] * (s[i] - nu_c[i])) / M[i] + nu_c_dot[i];
             }
             d[3] = s[2];
-            d
         };
         let mut s = [0.0, 0.0, 0.0, 0.3];
         let fine = 1e-3;
@@ -217,16 +216,7 @@ mod tests {
         for _ in 0..n {
             out.push(s);
             for _ in 0..per {
-                let add = |a: &[f64; 4], b: &[f64; 4], c: f64| -> [f64; 4] {
-                    std::array::from_fn(|i| a[i] + c * b[i])
-                };
-                let k1 = f(&s);
-                let k2 = f(&add(&s, &k1, fine / 2.0));
-                let k3 = f(&add(&s, &k2, fine / 2.0));
-                let k4 = f(&add(&s, &k3, fine));
-                s = std::array::from_fn(|i| {
-                    s[i] + fine / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-                });
+                rk4_step(&mut f, &mut s, &[], fine);
             }
         }
         (out, tau_n)

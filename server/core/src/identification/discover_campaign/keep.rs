@@ -72,7 +72,23 @@ pub(super) fn keep_better(
     let full = asm.model(&all)?;
     let verdict = inertia_verdict(&full.document)
         .unwrap_or_else(|| compare_against(before, &full.validation, "the baseline"));
-    let unconfirmed = confirmation(asm, effects, &order, before, &full)?;
+    // Each speed's findings alone on the baseline (the model with every
+    // finding when only one speed has any): for the confirmation, and the
+    // gate's candidates while nothing is kept.
+    let mut alone: Vec<Option<Identified>> = Vec::new();
+    if order.len() > 1 {
+        for &i in &order {
+            alone.push(Some(asm.model(&std::iter::once(i).collect())?));
+        }
+    }
+    let unconfirmed = {
+        let models: Vec<&Identified> = if alone.is_empty() {
+            vec![&full]
+        } else {
+            alone.iter().flatten().collect()
+        };
+        confirmation(asm, effects, &order, before, &models)
+    };
     if verdict.keep || order.len() == 1 {
         return Ok(Kept {
             model: verdict.keep.then_some(full),
@@ -98,7 +114,10 @@ pub(super) fn keep_better(
         )?;
         let mut trial = kept.clone();
         trial.insert(i);
-        let candidate = asm.model(&trial)?;
+        let candidate = match alone[n].take() {
+            Some(m) if kept.is_empty() => m,
+            _ => asm.model(&trial)?,
+        };
         let reference = best.as_ref().map_or(before, |b| b.validation.as_slice());
         let against = if best.is_some() {
             "the model without them"
@@ -190,38 +209,33 @@ pub(super) fn keep_better(
 /// zero: a hypothesis the estimation runs favoured and the held-out runs
 /// did not, reported as tried rather than named (on the independent
 /// truth's clean ROV, seed 1: cross-flow |q|r in yaw at 0.50 m/s, its
-/// fits 1.09 lower over 24). `full` is the model with every speed's
-/// findings (the one speed's model when only one has any).
+/// fits 1.09 lower over 24). `models`: each speed's (in `order`).
 fn confirmation(
     asm: &Assembly<'_>,
     effects: &[EffectAcrossGrid],
     order: &[usize],
     before: &[RunValidation],
-    full: &Identified,
-) -> Result<Vec<Option<String>>, IdentifyError> {
-    let mut gains: Vec<(usize, f64)> = Vec::with_capacity(order.len());
-    for &i in order {
-        let alone;
-        let model = if order.len() == 1 {
-            full
-        } else {
-            alone = asm.model(&std::iter::once(i).collect())?;
-            &alone
-        };
-        let lost = inertia_verdict(&model.document).is_some()
-            || paired(before, &model.validation).any(|(_, b, a)| {
-                fit_pairs(b, a)
-                    .iter()
-                    .any(|(_, x, y)| x.is_some() && y.is_none())
-            });
-        let gain = if lost {
-            f64::NEG_INFINITY
-        } else {
-            advantage(&model.validation, before).0
-        };
-        gains.push((i, gain));
-    }
-    Ok(effects
+    models: &[&Identified],
+) -> Vec<Option<String>> {
+    let gains: Vec<(usize, f64)> = order
+        .iter()
+        .zip(models)
+        .map(|(&i, model)| {
+            let lost = inertia_verdict(&model.document).is_some()
+                || paired(before, &model.validation).any(|(_, b, a)| {
+                    fit_pairs(b, a)
+                        .iter()
+                        .any(|(_, x, y)| x.is_some() && y.is_none())
+                });
+            let gain = if lost {
+                f64::NEG_INFINITY
+            } else {
+                advantage(&model.validation, before).0
+            };
+            (i, gain)
+        })
+        .collect();
+    effects
         .iter()
         .map(|e| {
             let at: Vec<(f64, f64)> = gains
@@ -253,5 +267,5 @@ fn confirmation(
                 )
             })
         })
-        .collect())
+        .collect()
 }
