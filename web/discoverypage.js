@@ -194,7 +194,8 @@ export async function discoveryPage(view, id) {
   const effectsTable = effects.length
     ? h('div', { class: 'table-x' }, h('table', { class: 'grid-table compact', 'data-testid': 'effects-table' },
       h('thead', null, h('tr', null, h('th', null, 'Effect'), h('th', null, 'Grid speeds'),
-        h('th', { title: 'Held-out free-run fit gained where it was chosen (1 − NRMSE summed over channels and speeds); effects are ranked by the speeds that chose them, then by it' }, 'Held-out gain'),
+        h('th', { title: 'What the findings of the grid speeds that chose it gain, added alone to the baseline, on the held-out runs: the 1-step, k-step, 10 s restarted and whole-run free-run fits (each clamped to [−1, 1]) summed, less the baseline\u2019s; the speeds that gain count (a force the campaign shares is held at every speed: all of them count). Effects are ranked by it, then by the speeds that chose them, then by the held-out gain' }, 'Held-out advantage'),
+        h('th', { title: 'Held-out free-run fit gained where it was chosen, given the terms chosen before it there (1 − NRMSE summed over channels and speeds)' }, 'Held-out gain'),
         h('th', null, 'First coefficient per speed (± std)'),
         h('th', { title: 'The model with every finding, or else each grid speed\u2019s findings added one speed at a time, is kept only where the held-out runs are better with them than without and no worse anywhere' }, 'In the stored model'))),
       h('tbody', null, effects.map((e) => h('tr', { 'data-testid': 'effect-row', 'data-unconfirmed': e.unconfirmed ? 'true' : 'false' },
@@ -204,6 +205,8 @@ export async function discoveryPage(view, id) {
         h('td', null, e.grid_speeds_mps.length
           ? e.grid_speeds_mps.map((s) => `${fmtKn(s)} kn`).join(', ')
           : (e.campaign_estimate ? 'the whole campaign' : '—')),
+        h('td', { class: 'num mono', 'data-testid': 'effect-advantage' },
+          fmt(e.held_out_advantage ?? 0, 3)),
         h('td', { class: 'num mono', 'data-testid': 'effect-evidence' }, fmt((e.held_out_gains || []).reduce((a, b) => a + b, 0), 3)),
         h('td', { class: 'mono small', 'data-testid': 'effect-coefficients' },
           e.magnitudes.map((m) => `${exact(m[0])}${m[1] != null ? ` ± ${exact(m[1])}` : ''}`).join('; '),

@@ -61,11 +61,15 @@ test('discover the demo ROV\'s missing restoring from the model page and read th
     assert.match(summary, /restoring sin θ in pitch/, summary);
     const effects = await page.locator(tid('effect-row')).allTextContents();
     assert.ok(effects.some((e) => /roll/.test(e)) && effects.some((e) => /pitch/.test(e)), effects.join('\n'));
-    // Ranked by the speeds that chose them, then by held-out evidence.
-    const gains = (await page.locator(tid('effect-evidence')).allTextContents()).map((t) => parseFloat(t.replace(/\u2212/g, '-')));
+    // Ranked by what their speeds' findings gain alone on the held-out
+    // runs, then by the speeds that chose them, then by held-out gain.
+    const num = async (t) => (await page.locator(tid(t)).allTextContents()).map((x) => parseFloat(x.replace(/\u2212/g, '-')));
+    const [advantages, gains] = [await num('effect-advantage'), await num('effect-evidence')];
     const speeds = (await page.locator(`${tid('effect-row')} td:nth-child(2)`).allTextContents()).map((t) => t.split(',').length);
-    assert.ok(gains.every((g, i) => g > 0 && (i === 0 || speeds[i] < speeds[i - 1] || (speeds[i] === speeds[i - 1] && g <= gains[i - 1]))),
-      `${gains.join(', ')} at ${speeds.join(', ')} speeds`);
+    const after = (i) => advantages[i] < advantages[i - 1]
+      || (advantages[i] === advantages[i - 1] && (speeds[i] < speeds[i - 1] || (speeds[i] === speeds[i - 1] && gains[i] <= gains[i - 1])));
+    assert.ok(advantages[0] > 0 && gains.every((g, i) => g > 0 && (i === 0 || after(i))),
+      `advantages ${advantages.join(', ')}, gains ${gains.join(', ')} at ${speeds.join(', ')} speeds`);
     // Each effect says whether the stored model keeps it, and why.
     const kept = await page.locator(tid('effect-kept')).evaluateAll((xs) => xs.map((x) => x.dataset.kept));
     assert.ok(kept.length === effects.length && kept.every((k) => k === 'true' || k === 'false') && kept.includes('true'), kept.join(', '));

@@ -94,10 +94,25 @@ pub struct EffectAcrossGrid {
     /// `null` when the fit gives none).
     pub magnitudes: Vec<[Option<f64>; 2]>,
     /// The evidence at each of those speeds: the held-out free-run fit it
-    /// gained there when chosen (1 − NRMSE, summed over channels). Effects
-    /// are ranked by how many speeds chose them, then by its sum.
+    /// gained there when chosen (1 − NRMSE, summed over channels), given
+    /// the terms chosen before it at that speed.
     #[serde(default)]
     pub held_out_gains: Vec<f64>,
+    /// At each of those speeds, what that speed's findings gain added
+    /// alone to the baseline: their held-out fits (1-step, k-step, 10 s
+    /// restarted and whole-run free run, each clamped to [−1, 1]) summed,
+    /// less the baseline's (`null` where a fit was lost, M was not
+    /// positive definite, or it was not judged).
+    #[serde(default)]
+    pub held_out_advantages: Vec<Option<f64>>,
+    /// The campaign's held-out case for the effect, by which effects are
+    /// ranked (then by how many speeds chose them, then by the sum of
+    /// `held_out_gains`; those not confirmed come last): the positive
+    /// `held_out_advantages` summed. A force the campaign shares
+    /// (`campaign_estimate`) is held at every grid speed examined, so
+    /// every speed's findings carry it: its sum runs over all of them.
+    #[serde(default)]
+    pub held_out_advantage: f64,
     /// Whether the stored model keeps it: the model with every finding, or
     /// else each grid speed's findings added one speed at a time, is kept
     /// only where the held-out runs are better with them than without and
@@ -402,6 +417,32 @@ pub fn discover_campaign(
         // The start model through the same validation, on the same runs.
         let before = asm.validate(doc)?;
         let gate = keep_better(&asm, &effects, &before, progress, (0.9, gate_to))?;
+        // A speed whose findings lose on balance (perhaps through another
+        // of them) adds nothing to an effect's case.
+        let positive = |a: &[Option<f64>]| a.iter().flatten().filter(|a| **a > 0.0).sum();
+        let every: Vec<Option<f64>> = gate
+            .alone
+            .iter()
+            .map(|&(_, a)| Some(a).filter(|a| a.is_finite()))
+            .collect();
+        for e in effects.iter_mut() {
+            e.held_out_advantages = e
+                .grid_speeds_mps
+                .iter()
+                .map(|&s| {
+                    gate.alone
+                        .iter()
+                        .find(|(i, _)| asm.points[*i].grid_speed_mps == s)
+                        .map(|&(_, a)| a)
+                        .filter(|a| a.is_finite())
+                })
+                .collect();
+            e.held_out_advantage = if e.campaign_estimate.is_some() && assembled.is_some() {
+                positive(&every)
+            } else {
+                positive(&e.held_out_advantages)
+            };
+        }
         for ((e, v), u) in effects
             .iter_mut()
             .zip(&gate.verdicts)
@@ -428,6 +469,10 @@ pub fn discover_campaign(
                     .map_or_else(String::new, |(t, _)| t.effect.label())
             ));
         }
+        // Ranked by what their speeds' findings gain alone on the held-out
+        // runs, then (stable) by how many speeds chose them and their
+        // gains there.
+        effects.sort_by(|a, b| b.held_out_advantage.total_cmp(&a.held_out_advantage));
         (gate.model, Some(gate.overall.text()), Some(before))
     };
     // A force fixed in NED on a surface model without a current: the
@@ -489,6 +534,8 @@ fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
                 grid_speeds_mps: vec![],
                 magnitudes: vec![],
                 held_out_gains: vec![],
+                held_out_advantages: vec![],
+                held_out_advantage: 0.0,
                 kept: None,
                 held_out_verdict: None,
                 campaign_estimate: None,

@@ -122,6 +122,12 @@ pub struct DiscoveryCase {
     pub lines: Vec<(f64, Dof, SpectralLine)>,
     /// The window test of a chosen current, per grid speed that ran it.
     pub current_drift: Vec<String>,
+    /// Per named effect (same order): at each grid speed that chose it,
+    /// what that speed's findings gain alone on the held-out runs.
+    pub advantages: Vec<Vec<Option<f64>>>,
+    /// Per named effect (same order): the held-out advantage it is ranked
+    /// by.
+    pub ranking: Vec<f64>,
 }
 
 impl DiscoveryCase {
@@ -226,6 +232,11 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
             )
         })
         .collect();
+    let advantages = named_effects
+        .iter()
+        .map(|e| e.held_out_advantages.clone())
+        .collect();
+    let ranking = named_effects.iter().map(|e| e.held_out_advantage).collect();
     let in_truth = named_effects
         .iter()
         .copied()
@@ -388,6 +399,8 @@ pub fn discover_case(seed: u64, concealed: Concealed, spec: &CampaignSpec) -> Di
         concealed,
         seed,
         named,
+        advantages,
+        ranking,
         in_truth,
         estimates,
         truth_size: match concealed {

@@ -312,6 +312,8 @@ pub(super) fn settle(
             grid_speeds_mps: vec![],
             magnitudes: vec![],
             held_out_gains: vec![gain],
+            held_out_advantages: vec![],
+            held_out_advantage: 0.0,
             kept: None,
             held_out_verdict: None,
             campaign_estimate: None,

@@ -39,6 +39,10 @@ pub(super) struct Kept {
     /// Per effect: `Some(why)` when it is not confirmed (see
     /// [`confirmation`]).
     pub unconfirmed: Vec<Option<String>>,
+    /// Per grid speed with findings (its index in the assembly's points):
+    /// the held-out advantage of its findings alone on the baseline, −∞
+    /// where a fit was lost or M is not positive definite.
+    pub alone: Vec<(usize, f64)>,
 }
 
 /// The held-out evidence discovery gave a grid speed's findings: the
@@ -81,13 +85,14 @@ pub(super) fn keep_better(
             alone.push(Some(asm.model(&std::iter::once(i).collect())?));
         }
     }
-    let unconfirmed = {
+    let (unconfirmed, alone_gains) = {
         let models: Vec<&Identified> = if alone.is_empty() {
             vec![&full]
         } else {
             alone.iter().flatten().collect()
         };
-        confirmation(asm, effects, &order, before, &models)
+        let gains = alone_advantages(&order, before, &models);
+        (confirmation(asm, effects, &gains), gains)
     };
     if verdict.keep || order.len() == 1 {
         return Ok(Kept {
@@ -95,6 +100,7 @@ pub(super) fn keep_better(
             verdicts: vec![verdict.clone(); effects.len()],
             overall: verdict,
             unconfirmed,
+            alone: alone_gains,
         });
     }
     let step = (to - from) / (order.len() + 1) as f64;
@@ -198,26 +204,21 @@ pub(super) fn keep_better(
         verdicts,
         overall,
         unconfirmed,
+        alone: alone_gains,
     })
 }
 
 /// Each grid speed's findings alone on the baseline, judged on balance:
 /// their held-out fits against the baseline's (1-step, k-step, 10 s
 /// restarted and whole-run free run, each clamped to [−1, 1], summed), a
-/// fit lost or M not positive definite counting as no gain. An effect is
-/// not confirmed when at every speed that chose it this sum is not above
-/// zero: a hypothesis the estimation runs favoured and the held-out runs
-/// did not, reported as tried rather than named (on the independent
-/// truth's clean ROV, seed 1: cross-flow |q|r in yaw at 0.50 m/s, its
-/// fits 1.09 lower over 24). `models`: each speed's (in `order`).
-fn confirmation(
-    asm: &Assembly<'_>,
-    effects: &[EffectAcrossGrid],
+/// fit lost or M not positive definite counting as −∞. `models`: each
+/// speed's (in `order`). Returns (point index, advantage).
+fn alone_advantages(
     order: &[usize],
     before: &[RunValidation],
     models: &[&Identified],
-) -> Vec<Option<String>> {
-    let gains: Vec<(usize, f64)> = order
+) -> Vec<(usize, f64)> {
+    order
         .iter()
         .zip(models)
         .map(|(&i, model)| {
@@ -234,7 +235,20 @@ fn confirmation(
             };
             (i, gain)
         })
-        .collect();
+        .collect()
+}
+
+/// An effect is not confirmed when at every speed that chose it the
+/// advantage of that speed's findings alone ([`alone_advantages`]) is not
+/// above zero: a hypothesis the estimation runs favoured and the held-out
+/// runs did not, reported as tried rather than named (on the independent
+/// truth's clean ROV, seed 1: cross-flow |q|r in yaw at 0.50 m/s, its
+/// fits 1.09 lower over 24).
+fn confirmation(
+    asm: &Assembly<'_>,
+    effects: &[EffectAcrossGrid],
+    gains: &[(usize, f64)],
+) -> Vec<Option<String>> {
     effects
         .iter()
         .map(|e| {

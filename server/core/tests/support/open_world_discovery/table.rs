@@ -14,8 +14,15 @@ pub fn format_cases(cases: &[DiscoveryCase]) -> String {
         let named: Vec<String> = c
             .named
             .iter()
+            .zip(&c.advantages)
             .take(4)
-            .map(|(l, n, _)| format!("{l} ({n}/{})", c.grid_points))
+            .map(|((l, n, _), a)| {
+                let a: Vec<String> = a
+                    .iter()
+                    .map(|a| a.map_or("lost".into(), |a| format!("{a:+.2}")))
+                    .collect();
+                format!("{l} ({n}/{}; {})", c.grid_points, a.join(" "))
+            })
             .collect();
         s += &format!(
             "{:<24} {:>4}  {:<8} {:<7} {:<60} {:>5.0}/{:>5.0}/{:>5.1}\n",
