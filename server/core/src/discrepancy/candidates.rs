@@ -105,6 +105,9 @@ pub enum Effect {
     /// One pure delay of d whole samples on every DOF's command: a
     /// transport delay of the command link or the logger's time stamps.
     CommonInputDelay,
+    /// One first-order lag τ_a = τ_c/(1 + s·T_a) on every DOF's command:
+    /// thrusters of one kind answering alike.
+    CommonActuatorLag,
     /// Thrust saturation τ_a = clip(τ_c, ±τ_max).
     Saturation {
         /// The DOF.
@@ -229,7 +232,7 @@ impl Effect {
             Effect::Current => Family::Current,
             Effect::TetherPull => Family::Tether,
             Effect::Coupling { .. } => Family::Coupling,
-            Effect::ActuatorLag { .. } => Family::ActuatorLag,
+            Effect::ActuatorLag { .. } | Effect::CommonActuatorLag => Family::ActuatorLag,
             Effect::InputDelay { .. } | Effect::CommonInputDelay => Family::InputDelay,
             Effect::Saturation { .. } => Family::Saturation,
             Effect::DeadZone { .. } => Family::DeadZone,
@@ -253,14 +256,15 @@ impl Effect {
             Effect::CoriolisFromM
             | Effect::Current
             | Effect::TetherPull
-            | Effect::CommonInputDelay => None,
+            | Effect::CommonInputDelay
+            | Effect::CommonActuatorLag => None,
         }
     }
 
     /// The shape parameter of an actuator effect.
     pub fn shape(&self) -> Option<ShapeKind> {
         match self {
-            Effect::ActuatorLag { .. } => Some(ShapeKind::LagTime),
+            Effect::ActuatorLag { .. } | Effect::CommonActuatorLag => Some(ShapeKind::LagTime),
             Effect::InputDelay { .. } | Effect::CommonInputDelay => Some(ShapeKind::DelaySamples),
             Effect::Saturation { .. } => Some(ShapeKind::SaturationLevel),
             Effect::DeadZone { .. } => Some(ShapeKind::DeadZoneWidth),
@@ -279,7 +283,8 @@ impl Effect {
     /// It changes the force acting in `dof` (actuator effects).
     pub fn acts_on(&self, dof: Dof) -> bool {
         self.shape().is_some()
-            && (self.dof() == Some(dof) || matches!(self, Effect::CommonInputDelay))
+            && (self.dof() == Some(dof)
+                || matches!(self, Effect::CommonInputDelay | Effect::CommonActuatorLag))
     }
 
     /// Number of coefficients that enter linearly.
@@ -401,6 +406,7 @@ impl Effect {
             Effect::ActuatorLag { dof } => format!("actuator lag in {}", dof.name()),
             Effect::InputDelay { dof } => format!("input delay in {}", dof.name()),
             Effect::CommonInputDelay => "input delay in every DOF (command link)".into(),
+            Effect::CommonActuatorLag => "actuator lag in every DOF (thrusters alike)".into(),
             Effect::Saturation { dof } => format!("thrust saturation in {}", dof.name()),
             Effect::DeadZone { dof } => format!("thrust dead zone in {}", dof.name()),
         }
@@ -410,7 +416,9 @@ impl Effect {
     pub fn rows(&self, dofs: &[Dof], d_ref: &DMatrix<f64>) -> Vec<usize> {
         let idx = |d: Dof| dofs.iter().position(|&x| x == d);
         match *self {
-            Effect::CoriolisFromM | Effect::CommonInputDelay => (0..dofs.len()).collect(),
+            Effect::CoriolisFromM | Effect::CommonInputDelay | Effect::CommonActuatorLag => {
+                (0..dofs.len()).collect()
+            }
             Effect::Current => match (idx(Dof::Surge), idx(Dof::Sway)) {
                 (Some(iu), Some(iv)) => (0..dofs.len())
                     .filter(|&i| d_ref[(i, iu)] != 0.0 || d_ref[(i, iv)] != 0.0)
@@ -558,6 +566,9 @@ pub fn library(
     }
     if s.input_delay && dofs.len() > 1 {
         out.push(Effect::CommonInputDelay);
+    }
+    if s.actuator_lag && dofs.len() > 1 {
+        out.push(Effect::CommonActuatorLag);
     }
     if s.coriolis && dofs.len() > 1 {
         out.push(Effect::CoriolisFromM);

@@ -135,6 +135,10 @@ pub(crate) fn effect_text(t: &ModelTerm, h: f64) -> String {
             dof.name(),
             pm(t.shape.unwrap_or(f64::NAN), t.shape_std)
         ),
+        Effect::CommonActuatorLag => format!(
+            "Thrust in every DOF follows the command through one first-order lag T_a = {} s: thrusters of one kind answering alike.",
+            pm(t.shape.unwrap_or(f64::NAN), t.shape_std)
+        ),
         Effect::InputDelay { dof } => {
             let d = t.shape.unwrap_or(0.0);
             format!(

@@ -331,7 +331,9 @@ fn conflicts(e: &Effect, taken: &[Effect]) -> bool {
         (Effect::CoriolisFromM, Effect::CoriolisProduct { .. })
         | (Effect::CoriolisProduct { .. }, Effect::CoriolisFromM)
         | (Effect::CommonInputDelay, Effect::InputDelay { .. })
-        | (Effect::InputDelay { .. }, Effect::CommonInputDelay) => true,
+        | (Effect::InputDelay { .. }, Effect::CommonInputDelay)
+        | (Effect::CommonActuatorLag, Effect::ActuatorLag { .. })
+        | (Effect::ActuatorLag { .. }, Effect::CommonActuatorLag) => true,
         _ => t.shape().is_some() && e.shape() == t.shape() && t.dof() == e.dof(),
     })
 }

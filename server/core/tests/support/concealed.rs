@@ -100,13 +100,15 @@ impl Concealed {
                     dof: Dof::Surge | Dof::Sway,
                 },
             ) => Some(false),
-            (Concealed::Lag, Effect::ActuatorLag { .. }) => Some(true),
+            (Concealed::Lag, Effect::ActuatorLag { .. } | Effect::CommonActuatorLag) => Some(true),
             (Concealed::Lag, Effect::InputDelay { .. } | Effect::CommonInputDelay) => Some(false),
             (Concealed::Saturation, Effect::Saturation { dof: Dof::Heave }) => Some(true),
             (Concealed::QuadraticSway, Effect::QuadraticDamping { dof: Dof::Sway }) => Some(true),
             (Concealed::QuadraticSway, Effect::CubicDamping { dof: Dof::Sway }) => Some(false),
             (Concealed::Delay, Effect::InputDelay { .. } | Effect::CommonInputDelay) => Some(true),
-            (Concealed::Delay, Effect::ActuatorLag { .. }) => Some(false),
+            (Concealed::Delay, Effect::ActuatorLag { .. } | Effect::CommonActuatorLag) => {
+                Some(false)
+            }
             (Concealed::DeadZone, Effect::DeadZone { dof: Dof::Heave }) => Some(true),
             (Concealed::DriftingCurrent, Effect::Current) => Some(true),
             _ => None,
