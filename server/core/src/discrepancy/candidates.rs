@@ -280,11 +280,14 @@ impl Effect {
         matches!(self, Effect::Current | Effect::TetherPull)
     }
 
+    /// An actuator effect on every DOF's command (the common delay or lag).
+    pub fn on_every_command(&self) -> bool {
+        matches!(self, Effect::CommonInputDelay | Effect::CommonActuatorLag)
+    }
+
     /// It changes the force acting in `dof` (actuator effects).
     pub fn acts_on(&self, dof: Dof) -> bool {
-        self.shape().is_some()
-            && (self.dof() == Some(dof)
-                || matches!(self, Effect::CommonInputDelay | Effect::CommonActuatorLag))
+        self.shape().is_some() && (self.dof() == Some(dof) || self.on_every_command())
     }
 
     /// Number of coefficients that enter linearly.
@@ -416,9 +419,7 @@ impl Effect {
     pub fn rows(&self, dofs: &[Dof], d_ref: &DMatrix<f64>) -> Vec<usize> {
         let idx = |d: Dof| dofs.iter().position(|&x| x == d);
         match *self {
-            Effect::CoriolisFromM | Effect::CommonInputDelay | Effect::CommonActuatorLag => {
-                (0..dofs.len()).collect()
-            }
+            e if e == Effect::CoriolisFromM || e.on_every_command() => (0..dofs.len()).collect(),
             Effect::Current => match (idx(Dof::Surge), idx(Dof::Sway)) {
                 (Some(iu), Some(iv)) => (0..dofs.len())
                     .filter(|&i| d_ref[(i, iu)] != 0.0 || d_ref[(i, iv)] != 0.0)

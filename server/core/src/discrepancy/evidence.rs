@@ -209,6 +209,18 @@ pub(crate) fn xcorr_peak(
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
+/// [`xcorr_peak`] of row `r`'s baseline 1-step residual, over 20 samples.
+fn row_peak(runs: &[&Record], baseline_resid: &[Vec<Vec<f64>>], r: usize) -> Option<(usize, f64)> {
+    let resid: Vec<Vec<f64>> = baseline_resid.iter().map(|v| v[r].clone()).collect();
+    xcorr_peak(runs, &resid, r, 20)
+}
+
+/// A peak two samples or more after the command's change: a pure delay's
+/// answer (a first-order lag answers at 0–1 samples and fades).
+fn answers_late(lag: usize) -> bool {
+    lag >= 2
+}
+
 /// For an actuator effect on every DOF (a common lag or delay): after how
 /// many samples each DOF's baseline 1-step residual follows a change of
 /// its command most strongly ([`xcorr_peak`]), and how many answer late,
@@ -223,15 +235,12 @@ fn answer_delays(
     let peaks: Vec<(Dof, usize, f64)> = dofs
         .iter()
         .enumerate()
-        .filter_map(|(r, &d)| {
-            let resid: Vec<Vec<f64>> = baseline_resid.iter().map(|v| v[r].clone()).collect();
-            xcorr_peak(runs, &resid, r, 20).map(|(lag, rho)| (d, lag, rho))
-        })
+        .filter_map(|(r, &d)| row_peak(runs, baseline_resid, r).map(|(lag, rho)| (d, lag, rho)))
         .collect();
     if peaks.is_empty() {
         return None;
     }
-    let late = peaks.iter().filter(|p| p.1 >= 2).count();
+    let late = peaks.iter().filter(|p| answers_late(p.1)).count();
     let each: Vec<String> = peaks
         .iter()
         .map(|(d, lag, rho)| {
@@ -297,15 +306,14 @@ pub(crate) fn separating_evidence(
     let mut out = Vec::new();
     match (e, row) {
         (Effect::ActuatorLag { dof } | Effect::InputDelay { dof }, Some(r)) => {
-            let resid: Vec<Vec<f64>> = baseline_resid.iter().map(|v| v[r].clone()).collect();
-            if let Some((lag, rho)) = xcorr_peak(runs, &resid, r, 20) {
+            if let Some((lag, rho)) = row_peak(runs, baseline_resid, r) {
                 out.push(format!(
                     "The baseline's 1-step residual in {} follows a change of {} most strongly after {lag} samples ({} s, ρ = {:.2}): {}.",
                     dof.name(),
                     dof.force_column(),
                     sig(lag as f64 * h),
                     rho,
-                    if lag >= 2 {
+                    if answers_late(lag) {
                         "a pure delay shows this way; a lag would answer at once and fade"
                     } else {
                         "an immediate, fading answer, as a first-order lag gives; a delay would answer later"
@@ -313,7 +321,7 @@ pub(crate) fn separating_evidence(
                 ));
             }
         }
-        (Effect::CommonActuatorLag | Effect::CommonInputDelay, _) => {
+        (e, _) if e.on_every_command() => {
             out.extend(answer_delays(runs, baseline_resid, dofs, h));
         }
         (Effect::Current, _) => {

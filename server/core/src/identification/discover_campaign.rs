@@ -417,32 +417,7 @@ pub fn discover_campaign(
         // The start model through the same validation, on the same runs.
         let before = asm.validate(doc)?;
         let gate = keep_better(&asm, &effects, &before, progress, (0.9, gate_to))?;
-        // A speed whose findings lose on balance (perhaps through another
-        // of them) adds nothing to an effect's case.
-        let positive = |a: &[Option<f64>]| a.iter().flatten().filter(|a| **a > 0.0).sum();
-        let every: Vec<Option<f64>> = gate
-            .alone
-            .iter()
-            .map(|&(_, a)| Some(a).filter(|a| a.is_finite()))
-            .collect();
-        for e in effects.iter_mut() {
-            e.held_out_advantages = e
-                .grid_speeds_mps
-                .iter()
-                .map(|&s| {
-                    gate.alone
-                        .iter()
-                        .find(|(i, _)| asm.points[*i].grid_speed_mps == s)
-                        .map(|&(_, a)| a)
-                        .filter(|a| a.is_finite())
-                })
-                .collect();
-            e.held_out_advantage = if e.campaign_estimate.is_some() && assembled.is_some() {
-                positive(&every)
-            } else {
-                positive(&e.held_out_advantages)
-            };
-        }
+        keep::set_advantages(&asm, &mut effects, &gate.alone, assembled.is_some());
         for ((e, v), u) in effects
             .iter_mut()
             .zip(&gate.verdicts)

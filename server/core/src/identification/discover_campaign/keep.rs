@@ -208,6 +208,40 @@ pub(super) fn keep_better(
     })
 }
 
+/// Sets each effect's `held_out_advantages` (at each speed that chose it,
+/// that speed's `alone` advantage; `None` where a fit was lost) and the
+/// `held_out_advantage` it is ranked by: their positive sum (a speed whose
+/// findings lose on balance, perhaps through another of them, adds
+/// nothing), over every speed judged for a force the campaign shares when
+/// `shared_held` (it is held at each of them).
+pub(super) fn set_advantages(
+    asm: &Assembly<'_>,
+    effects: &mut [EffectAcrossGrid],
+    alone: &[(usize, f64)],
+    shared_held: bool,
+) {
+    let finite = |a: f64| Some(a).filter(|a| a.is_finite());
+    let positive = |a: &[Option<f64>]| a.iter().flatten().filter(|a| **a > 0.0).sum();
+    let every: Vec<Option<f64>> = alone.iter().map(|&(_, a)| finite(a)).collect();
+    for e in effects.iter_mut() {
+        e.held_out_advantages = e
+            .grid_speeds_mps
+            .iter()
+            .map(|&s| {
+                alone
+                    .iter()
+                    .find(|(i, _)| asm.points[*i].grid_speed_mps == s)
+                    .and_then(|&(_, a)| finite(a))
+            })
+            .collect();
+        e.held_out_advantage = if e.campaign_estimate.is_some() && shared_held {
+            positive(&every)
+        } else {
+            positive(&e.held_out_advantages)
+        };
+    }
+}
+
 /// Each grid speed's findings alone on the baseline, judged on balance:
 /// their held-out fits against the baseline's (1-step, k-step, 10 s
 /// restarted and whole-run free run, each clamped to [−1, 1], summed), a
