@@ -416,8 +416,20 @@ pub fn discover_campaign(
     } else {
         // The start model through the same validation, on the same runs.
         let before = asm.validate(doc)?;
-        let gate = keep_better(&asm, &effects, &before, progress, (0.9, gate_to))?;
+        let starts = todo
+            .iter()
+            .map(|&i| Ok((augmented_at(doc, &lpv.points[i])?, &est[i].0[..])))
+            .collect::<Result<Vec<_>, IdentifyError>>()?;
+        let gate = keep_better(
+            &asm,
+            (&starts, &dset),
+            &effects,
+            &before,
+            progress,
+            (0.9, gate_to),
+        )?;
         keep::set_advantages(&asm, &mut effects, &gate.alone, assembled.is_some());
+        shared_notes.extend(keep::refit_note(&gate.refits));
         for ((e, v), u) in effects
             .iter_mut()
             .zip(&gate.verdicts)

@@ -58,6 +58,25 @@ impl Assembly<'_> {
     /// term, carried or new — and the others as the start model has them,
     /// validated on the held-out runs.
     pub fn model(&self, kept: &BTreeSet<usize>) -> Result<Identified, IdentifyError> {
+        let at: Vec<(f64, &ModelReport)> = self
+            .points
+            .iter()
+            .enumerate()
+            .filter(|(i, p)| kept.contains(i) && !p.report.findings.is_empty())
+            .map(|(_, p)| (p.grid_speed_mps, &p.report.model))
+            .collect();
+        self.model_from(&at, true)
+    }
+
+    /// The start model with the grid points at the speeds of `at` replaced
+    /// by their refitted models (and, when `hold` and one was applied, the
+    /// speeds not examined holding the campaign's shared force), validated
+    /// on the held-out runs.
+    pub fn model_from(
+        &self,
+        at: &[(f64, &ModelReport)],
+        hold: bool,
+    ) -> Result<Identified, IdentifyError> {
         let doc = self.doc;
         let mut out = doc.clone();
         out.method = Method::Discovery;
@@ -71,21 +90,18 @@ impl Assembly<'_> {
         let lpv = out.lpv.as_mut().expect("checked: LPV");
         let logged_controller = lpv.logged_controller.clone();
         let mut applied = false;
-        for (i, p) in self.points.iter().enumerate() {
-            if !kept.contains(&i) || p.report.findings.is_empty() {
-                continue;
-            }
+        for &(speed, model) in at {
             applied |= apply_at(
                 doc,
                 lpv,
                 logged_controller.as_ref(),
                 &mut out.parameters,
-                p.grid_speed_mps,
-                &p.report.model,
+                speed,
+                model,
             )?;
         }
         // The speeds not examined hold the campaign's shared force too.
-        if applied {
+        if applied && hold {
             for (speed, model) in self.held_only {
                 apply_at(
                     doc,

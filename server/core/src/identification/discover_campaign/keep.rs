@@ -7,6 +7,13 @@
 //! with it passes the same test against the model without it and against
 //! the baseline (so losses within noise cannot add up).
 //!
+//! Each speed is also refitted with no new term (its null refit: the same
+//! rows on the same estimation runs). A speed's findings are credited only
+//! with what they add to that refit where it beats the baseline; a speed
+//! whose findings add nothing is added one at a time as its null refit,
+//! and only beside another speed's findings (a refit alone is no
+//! discovery).
+//!
 //! The unit is a grid speed's augmentation as discovery fitted it: its
 //! terms were fitted together with refitted rows of M and D̄, and a subset
 //! of them on those rows is a model nobody fitted (one term's row without
@@ -24,6 +31,8 @@ use super::super::outcome::{Identified, RunValidation};
 use super::assemble::Assembly;
 use super::{EffectAcrossGrid, speeds_text};
 use crate::discrepancy::Verdict;
+use crate::discrepancy::report::ModelReport;
+use crate::discrepancy::{AugmentedModel, DiscoverySettings, Record, refit_holding};
 use crate::estimation::Progress;
 use crate::numbers::sig3;
 
@@ -40,9 +49,38 @@ pub(super) struct Kept {
     /// [`confirmation`]).
     pub unconfirmed: Vec<Option<String>>,
     /// Per grid speed with findings (its index in the assembly's points):
-    /// the held-out advantage of its findings alone on the baseline, −∞
-    /// where a fit was lost or M is not positive definite.
+    /// the held-out advantage of its findings alone on the baseline over
+    /// its null refit's ([`alone_advantages`]), −∞ where a fit was lost or
+    /// M is not positive definite.
     pub alone: Vec<(usize, f64)>,
+    /// (grid speed, held-out advantage) where the null refit alone is
+    /// better than the baseline ([`refit_gains`]).
+    pub refits: Vec<(f64, f64)>,
+}
+
+/// Per grid point (in the assembly's order): its start model and
+/// estimation records, for its null refit ([`null_model`]).
+pub(super) type Starts<'a> = [(AugmentedModel, &'a [Record])];
+
+/// Grid point `i` refitted with no new term (the null refit: the start
+/// model's rows of M and D̄ and its carried terms refitted on the same
+/// estimation runs, by the same choice of rows, as discovery fitted its
+/// findings), and that model validated: what the refit gains on the
+/// held-out runs is the refit's, not a term's. `None` when the refit fails
+/// (the baseline is then the reference).
+fn null_model(
+    asm: &Assembly<'_>,
+    starts: &Starts<'_>,
+    settings: &DiscoverySettings,
+    i: usize,
+) -> Result<Option<Box<(ModelReport, Identified)>>, IdentifyError> {
+    let (start, est) = &starts[i];
+    let Ok(refit) = refit_holding(start, est, settings, &[], &[]) else {
+        return Ok(None);
+    };
+    let report = ModelReport::of(&refit);
+    let model = asm.model_from(&[(asm.points[i].grid_speed_mps, &report)], false)?;
+    Ok(Some(Box::new((report, model))))
 }
 
 /// The held-out evidence discovery gave a grid speed's findings: the
@@ -58,10 +96,34 @@ fn evidence(asm: &Assembly<'_>, i: usize) -> f64 {
         .sum()
 }
 
+/// Whether grid point `i`'s findings name `e`.
+fn chose(asm: &Assembly<'_>, e: &EffectAcrossGrid, i: usize) -> bool {
+    asm.points[i]
+        .report
+        .findings
+        .iter()
+        .any(|f| f.effect == e.effect)
+}
+
+/// A model built for the confirmation.
+enum Built {
+    Alone(Box<Identified>),
+    Null(Option<Box<(ModelReport, Identified)>>),
+}
+
+/// What the gate may put at a grid speed: discovery's model with its
+/// findings, or — where those add nothing to it and it is better than the
+/// baseline — the null refit.
+enum Candidate {
+    Findings,
+    Refit(Box<ModelReport>),
+}
+
 /// Runs the gate over the grid speeds with findings, between progress
 /// `from` and `to`.
 pub(super) fn keep_better(
     asm: &Assembly<'_>,
+    (starts, settings): (&Starts<'_>, &DiscoverySettings),
     effects: &[EffectAcrossGrid],
     before: &[RunValidation],
     progress: &mut dyn Progress,
@@ -72,57 +134,169 @@ pub(super) fn keep_better(
         .collect();
     order.sort_by(|&a, &b| evidence(asm, b).total_cmp(&evidence(asm, a)));
     let all: BTreeSet<usize> = order.iter().copied().collect();
-    progress.update(from, "held-out check of the model with every effect found")?;
-    let full = asm.model(&all)?;
-    let verdict = inertia_verdict(&full.document)
-        .unwrap_or_else(|| compare_against(before, &full.validation, "the baseline"));
-    // Each speed's findings alone on the baseline (the model with every
-    // finding when only one speed has any): for the confirmation, and the
-    // gate's candidates while nothing is kept.
-    let mut alone: Vec<Option<Identified>> = Vec::new();
-    if order.len() > 1 {
-        for &i in &order {
-            alone.push(Some(asm.model(&std::iter::once(i).collect())?));
+    // The model with every finding; each speed's findings alone on the
+    // baseline (when more than one speed has any) and each speed's null
+    // refit, for the confirmation and as the gate's candidates while
+    // nothing is kept: side by side on the pool.
+    let singles = if order.len() > 1 { order.len() } else { 0 };
+    let built = crate::par::fan_out(
+        1 + singles + order.len(),
+        progress,
+        (from, from + (to - from) / 2.0),
+        "held-out check of the model with every effect found, of each grid speed's findings alone and of its null refit",
+        |k, _| match k {
+            0 => Ok(Built::Alone(Box::new(asm.model(&all)?))),
+            k if k <= singles => Ok(Built::Alone(Box::new(
+                asm.model(&std::iter::once(order[k - 1]).collect())?,
+            ))),
+            k => null_model(asm, starts, settings, order[k - 1 - singles]).map(Built::Null),
+        },
+    )?;
+    let (mut alone, mut nulls) = (Vec::new(), Vec::new());
+    for b in built {
+        match b {
+            Built::Alone(m) => alone.push(*m),
+            Built::Null(m) => nulls.push(m),
         }
     }
-    let (unconfirmed, alone_gains) = {
-        let models: Vec<&Identified> = if alone.is_empty() {
-            vec![&full]
-        } else {
-            alone.iter().flatten().collect()
-        };
-        let gains = alone_advantages(&order, before, &models);
-        (confirmation(asm, effects, &gains), gains)
+    let full = alone.remove(0);
+    let singles_built = !alone.is_empty();
+    let null_models: Vec<Option<&Identified>> =
+        nulls.iter().map(|n| n.as_ref().map(|b| &b.1)).collect();
+    let models: Vec<&Identified> = if alone.is_empty() {
+        vec![&full]
+    } else {
+        alone.iter().collect()
     };
-    if verdict.keep || order.len() == 1 {
+    let alone_gains = alone_advantages(&order, before, &models, &null_models);
+    let refits = refit_gains(asm, &order, before, &null_models);
+    let unconfirmed = confirmation(asm, effects, &alone_gains);
+
+    // The candidates: the speeds whose findings add to their null refit
+    // (strongest evidence first), then those whose null refit alone is
+    // better than the baseline.
+    let adds = |i: usize| alone_gains.iter().any(|&(j, g)| j == i && g > 0.0);
+    let better = |i: usize| {
+        refits
+            .iter()
+            .any(|&(s, _)| s == asm.points[i].grid_speed_mps)
+    };
+    // Beside each, its model alone on the baseline where already built.
+    let (mut cands, mut prebuilt): (Vec<(usize, Candidate)>, Vec<Option<Identified>>) =
+        (Vec::new(), Vec::new());
+    let mut later = Vec::new();
+    let mut alone = alone.into_iter();
+    for (&i, null) in order.iter().zip(nulls) {
+        let single = if singles_built {
+            alone.next()
+        } else {
+            Some(full.clone())
+        };
+        match null {
+            _ if adds(i) => {
+                cands.push((i, Candidate::Findings));
+                prebuilt.push(single);
+            }
+            Some(b) if better(i) => {
+                let (report, model) = *b;
+                later.push((i, Box::new(report), model));
+            }
+            _ => {}
+        }
+    }
+    for (i, report, model) in later {
+        cands.push((i, Candidate::Refit(report)));
+        prebuilt.push(Some(model));
+    }
+    let idle: Vec<f64> = order
+        .iter()
+        .filter(|&&i| !adds(i))
+        .map(|&i| asm.points[i].grid_speed_mps)
+        .collect();
+    let named_at = |i: usize| {
+        cands
+            .iter()
+            .any(|(j, c)| *j == i && matches!(c, Candidate::Findings))
+    };
+    let add_nothing = |e: &EffectAcrossGrid| HeldOutVerdict {
+        keep: false,
+        reason: format!(
+            "with the findings at {} m/s, the held-out fits gain nothing over that grid speed refitted without a new term",
+            speeds_text(&e.grid_speeds_mps)
+        ),
+    };
+    let build = |set: &BTreeSet<usize>| {
+        let at: Vec<(f64, &ModelReport)> = cands
+            .iter()
+            .filter(|(i, _)| set.contains(i))
+            .map(|(i, c)| {
+                let speed = asm.points[*i].grid_speed_mps;
+                match c {
+                    Candidate::Findings => (speed, &asm.points[*i].report.model),
+                    Candidate::Refit(r) => (speed, &**r),
+                }
+            })
+            .collect();
+        asm.model_from(&at, set.iter().any(|&i| named_at(i)))
+    };
+    // The model with every grid speed's findings, as discovery fitted
+    // them, is stored if it passes as a whole.
+    let verdict = inertia_verdict(&full.document)
+        .unwrap_or_else(|| compare_against(before, &full.validation, "the baseline"));
+    if verdict.keep {
         return Ok(Kept {
-            model: verdict.keep.then_some(full),
+            model: Some(full),
             verdicts: vec![verdict.clone(); effects.len()],
             overall: verdict,
             unconfirmed,
             alone: alone_gains,
+            refits,
         });
     }
-    let step = (to - from) / (order.len() + 1) as f64;
+    if !cands.iter().any(|(i, _)| named_at(*i)) {
+        return Ok(Kept {
+            model: None,
+            verdicts: effects.iter().map(add_nothing).collect(),
+            overall: HeldOutVerdict {
+                keep: false,
+                reason: format!(
+                    "with every effect found, {}; the findings at {} m/s gain nothing on the held-out runs over those grid speeds refitted without a new term (their rows of M and D̄ and carried terms refitted on the same runs)",
+                    verdict.reason,
+                    speeds_text(&idle)
+                ),
+            },
+            unconfirmed,
+            alone: alone_gains,
+            refits,
+        });
+    }
+    let from = from + (to - from) / 2.0;
+    let step = (to - from) / (cands.len() + 1) as f64;
     let mut kept = BTreeSet::new();
     let mut best: Option<Identified> = None;
     // Per grid point tried: its verdict against the model without it.
     let mut at: Vec<(usize, HeldOutVerdict)> = Vec::new();
-    for (n, &i) in order.iter().enumerate() {
+    for n in 0..cands.len() {
+        let i = cands[n].0;
+        // A refit alone is no discovery: it enters only beside a speed's
+        // findings (they come first).
+        if !named_at(i) && !kept.iter().any(|&j| named_at(j)) {
+            break;
+        }
         let speed = asm.points[i].grid_speed_mps;
         progress.update(
             from + step * (n + 1) as f64,
             &format!(
                 "held-out check of the findings at {speed:.2} m/s ({} of {})",
                 n + 1,
-                order.len()
+                cands.len()
             ),
         )?;
         let mut trial = kept.clone();
         trial.insert(i);
-        let candidate = match alone[n].take() {
+        let candidate = match prebuilt[n].take() {
             Some(m) if kept.is_empty() => m,
-            _ => asm.model(&trial)?,
+            _ => build(&trial)?,
         };
         let reference = best.as_ref().map_or(before, |b| b.validation.as_slice());
         let against = if best.is_some() {
@@ -145,17 +319,26 @@ pub(super) fn keep_better(
         }
         at.push((i, v));
     }
-    let kept_speeds: Vec<f64> = kept.iter().map(|&i| asm.points[i].grid_speed_mps).collect();
+    let findings_kept: Vec<f64> = kept
+        .iter()
+        .filter(|&&i| named_at(i))
+        .map(|&i| asm.points[i].grid_speed_mps)
+        .collect();
     let overall = match &best {
         Some(b) => {
             let mut v = compare_against(before, &b.validation, "the baseline");
-            v.reason = format!(
-                "with the findings at {} of {} grid speeds ({} m/s; the model with all of them was refused: {}), {}",
-                kept.len(),
-                order.len(),
-                speeds_text(&kept_speeds),
-                verdict.reason,
-                v.reason
+            v.reason = with_refits(
+                &format!(
+                    "with the findings at {} of {} grid speeds ({} m/s; the model with all of them was refused: {}), {}",
+                    findings_kept.len(),
+                    order.len(),
+                    speeds_text(&findings_kept),
+                    verdict.reason,
+                    v.reason
+                ),
+                asm,
+                &cands,
+                &kept,
             );
             v
         }
@@ -173,17 +356,11 @@ pub(super) fn keep_better(
     let verdicts = effects
         .iter()
         .map(|e| {
-            let chose = |i: usize| {
-                asm.points[i]
-                    .report
-                    .findings
-                    .iter()
-                    .any(|f| f.effect == e.effect)
-            };
+            let named = |i: usize| named_at(i) && chose(asm, e, i);
             let pick = at
                 .iter()
-                .find(|(i, v)| v.keep && stored && chose(*i))
-                .or_else(|| at.iter().find(|(i, _)| chose(*i)));
+                .find(|(i, v)| v.keep && stored && named(*i))
+                .or_else(|| at.iter().find(|(i, _)| named(*i)));
             match pick {
                 Some((i, v)) => HeldOutVerdict {
                     keep: v.keep && stored,
@@ -192,10 +369,7 @@ pub(super) fn keep_better(
                         asm.points[*i].grid_speed_mps, v.reason
                     ),
                 },
-                None => HeldOutVerdict {
-                    keep: false,
-                    reason: verdict.reason.clone(),
-                },
+                None => add_nothing(e),
             }
         })
         .collect();
@@ -205,6 +379,45 @@ pub(super) fn keep_better(
         overall,
         unconfirmed,
         alone: alone_gains,
+        refits,
+    })
+}
+
+/// `reason`, and where `kept` holds null refits, at which speeds the model
+/// takes its rows refitted without a new term.
+fn with_refits(
+    reason: &str,
+    asm: &Assembly<'_>,
+    cands: &[(usize, Candidate)],
+    kept: &BTreeSet<usize>,
+) -> String {
+    let speeds: Vec<f64> = cands
+        .iter()
+        .filter(|(i, c)| kept.contains(i) && matches!(c, Candidate::Refit(_)))
+        .map(|(i, _)| asm.points[*i].grid_speed_mps)
+        .collect();
+    if speeds.is_empty() {
+        reason.to_owned()
+    } else {
+        format!(
+            "{reason}; at {} m/s, whose findings add nothing to it, the model takes the rows refitted without a new term",
+            speeds_text(&speeds)
+        )
+    }
+}
+
+/// What the summary says of null refits better than the baseline
+/// (`refits`: [`Kept::refits`]), if any.
+pub(super) fn refit_note(refits: &[(f64, f64)]) -> Option<String> {
+    let each: Vec<String> = refits
+        .iter()
+        .map(|&(s, a)| format!("{s:.2} m/s (+{})", sig3(a)))
+        .collect();
+    (!each.is_empty()).then(|| {
+        format!(
+            "Refitted on the same estimation runs without any new term, the start model's rows of M and D̄ (and its carried terms) already gain on the held-out runs at {} (fits summed, each clamped to [−1, 1]): the model is not the best its own structure gives on these runs, and each effect is credited only with what it adds to that refit.",
+            each.join(", ")
+        )
     })
 }
 
@@ -243,31 +456,63 @@ pub(super) fn set_advantages(
 }
 
 /// Each grid speed's findings alone on the baseline, judged on balance:
-/// their held-out fits against the baseline's (1-step, k-step, 10 s
-/// restarted and whole-run free run, each clamped to [−1, 1], summed), a
-/// fit lost or M not positive definite counting as −∞. `models`: each
-/// speed's (in `order`). Returns (point index, advantage).
+/// their held-out fits (1-step, k-step, 10 s restarted and whole-run free
+/// run, each clamped to [−1, 1], summed) against its null refit's where
+/// that is better than the baseline, else against the baseline's — so a
+/// term is credited only with what it adds to the rows refitted with it.
+/// A fit lost or M not positive definite counts as −∞. `models` and
+/// `nulls`: each speed's (in `order`). Returns (point index, advantage).
 fn alone_advantages(
     order: &[usize],
     before: &[RunValidation],
     models: &[&Identified],
+    nulls: &[Option<&Identified>],
 ) -> Vec<(usize, f64)> {
+    let lost = |m: &Identified| loses(before, m);
     order
         .iter()
         .zip(models)
-        .map(|(&i, model)| {
-            let lost = inertia_verdict(&model.document).is_some()
-                || paired(before, &model.validation).any(|(_, b, a)| {
-                    fit_pairs(b, a)
-                        .iter()
-                        .any(|(_, x, y)| x.is_some() && y.is_none())
-                });
-            let gain = if lost {
+        .zip(nulls)
+        .map(|((&i, model), null)| {
+            let reference = match null {
+                Some(n) if !lost(n) && advantage(&n.validation, before).0 > 0.0 => &n.validation,
+                _ => before,
+            };
+            let gain = if lost(model) {
                 f64::NEG_INFINITY
             } else {
-                advantage(&model.validation, before).0
+                advantage(&model.validation, reference).0
             };
             (i, gain)
+        })
+        .collect()
+}
+
+/// Whether `m` loses a fit `before` had, or its M is not positive definite.
+fn loses(before: &[RunValidation], m: &Identified) -> bool {
+    inertia_verdict(&m.document).is_some()
+        || paired(before, &m.validation).any(|(_, b, a)| {
+            fit_pairs(b, a)
+                .iter()
+                .any(|(_, x, y)| x.is_some() && y.is_none())
+        })
+}
+
+/// (grid speed, held-out advantage) of each null refit better than the
+/// baseline on balance and losing no fit.
+fn refit_gains(
+    asm: &Assembly<'_>,
+    order: &[usize],
+    before: &[RunValidation],
+    nulls: &[Option<&Identified>],
+) -> Vec<(f64, f64)> {
+    order
+        .iter()
+        .zip(nulls)
+        .filter_map(|(&i, n)| {
+            let n = n.filter(|n| !loses(before, n))?;
+            let a = advantage(&n.validation, before).0;
+            (a > 0.0).then_some((asm.points[i].grid_speed_mps, a))
         })
         .collect()
 }
@@ -310,7 +555,7 @@ fn confirmation(
                     })
                     .collect();
                 format!(
-                    "not confirmed: with only its grid speed's findings added to the baseline, the held-out fits (1-step, k-step, 10 s restarted and whole-run free run, each clamped to [−1, 1]) gain nothing on balance ({})",
+                    "not confirmed: with only its grid speed's findings added to the baseline, the held-out fits (1-step, k-step, 10 s restarted and whole-run free run, each clamped to [−1, 1]) gain nothing on balance over that speed refitted without a new term, or over the baseline where that refit is not better ({})",
                     each.join("; ")
                 )
             })
