@@ -381,3 +381,27 @@ fn a_term_that_adds_nothing_to_a_plain_refit_is_not_named() {
         clean.summary
     );
 }
+
+/// An actuator's lag belongs to the thrusters, not to the forward speed:
+/// where the grid speeds' estimates of it agree within their standard
+/// deviations they are pooled into one T_a for the campaign and every speed
+/// is refitted with it held. Seed 4's concealed 0.4 s lag: one lag in every
+/// DOF named first at 4/4 speeds, one T_a (0.373 s) held at all of them.
+#[test]
+fn an_actuator_lag_the_speeds_agree_on_is_estimated_once_for_the_campaign() {
+    let spec = seatrial_truth::CampaignSpec::default();
+    let lag = discover_case(4, Concealed::Lag, &spec);
+    let (label, points, hit) = lag.named.first().expect("an effect is named");
+    assert_eq!(*hit, Some(true), "{label} named first");
+    assert_eq!(*points, lag.grid_points, "{label}");
+    let t_a = lag
+        .campaign_values
+        .as_ref()
+        .and_then(|v| v.first().copied())
+        .unwrap_or_else(|| panic!("no campaign T_a: {:#?}", lag.summary));
+    assert!((t_a / 0.4 - 1.0).abs() < 0.1, "T_a {t_a} s against 0.4 s");
+    for v in &lag.first_values {
+        assert_eq!(v.first().copied(), Some(t_a), "{:?}", lag.first_values);
+    }
+    gate_holds(&lag);
+}

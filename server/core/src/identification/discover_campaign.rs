@@ -122,9 +122,12 @@ pub struct EffectAcrossGrid {
     /// Why it was kept or left out, with the deciding held-out fits.
     #[serde(default)]
     pub held_out_verdict: Option<String>,
-    /// A force the campaign shares (a current, a pull fixed in NED): its
-    /// one estimate, pooled over the grid speeds, at which every speed's
-    /// model holds it (`null` for effects that may vary with speed).
+    /// What the campaign shares of the effect, estimated once: a force (a
+    /// current, a pull fixed in NED), pooled over the grid speeds and held
+    /// by every speed's model; or an actuator's shape parameter (a lag, a
+    /// delay, a saturation level or dead zone), pooled over the speeds that
+    /// chose it and held by theirs (`null` for effects that may vary with
+    /// speed).
     #[serde(default)]
     pub campaign_estimate: Option<CampaignEstimate>,
     /// Tried, not confirmed: at every grid speed that chose it, that
@@ -341,7 +344,26 @@ pub fn discover_campaign(
         })
         .collect();
 
+    // Shape parameters the campaign shares (a lag, a delay, a thruster's
+    // limits): pooled, and held at every speed that chose them.
+    let (shapes, scattered): (Vec<_>, Vec<_>) = shapes::pool_shapes(&points)
+        .into_iter()
+        .partition(|s| s.agree);
+    if !shapes.is_empty() {
+        for (k, p) in points.iter_mut().enumerate() {
+            let i = todo[k];
+            let start = augmented_at(doc, &lpv.points[i])?;
+            if let Some(q) = shapes::held_shapes(p, &start, &est[i].0, &dset, &shapes) {
+                *p = q;
+            }
+        }
+    }
     let mut effects = effects_across(&points);
+    for s in &shapes {
+        if let Some(e) = effects.iter_mut().find(|e| e.effect == s.effect) {
+            e.campaign_estimate = Some(s.estimate.clone());
+        }
+    }
     // Forces the campaign shares: one estimate, held at every grid speed.
     // A current and a pull fixed in NED both turn with the heading: the
     // campaign holds one force fixed in NED, and the other is its look-alike.
@@ -351,7 +373,7 @@ pub fn discover_campaign(
         .collect();
     let (pooled, look_alikes) =
         shared::one_ned_force(shared::pool_all(&points), &effects, &carried);
-    let mut shared_notes = Vec::new();
+    let mut shared_notes: Vec<String> = scattered.into_iter().map(|s| s.estimate.text).collect();
     for (term, estimate) in &pooled {
         match effects.iter_mut().find(|e| e.effect == term.effect) {
             Some(e) => e.campaign_estimate = Some(estimate.clone()),
@@ -572,6 +594,7 @@ mod assemble;
 mod current_again;
 mod keep;
 mod records;
+mod shapes;
 mod shared;
 mod start;
 mod summary;

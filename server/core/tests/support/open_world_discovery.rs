@@ -91,7 +91,8 @@ pub struct DiscoveryCase {
     /// grid speed that chose it.
     pub first_values: Vec<Vec<f64>>,
     /// The first-named effect's one estimate for the campaign, when it is a
-    /// force the campaign shares (coefficients).
+    /// force the campaign shares (coefficients) or an actuator's shape
+    /// parameter the speeds agree on (its value).
     pub campaign_values: Option<Vec<f64>>,
     /// Per grid point of the stored model: the coefficients of its term of
     /// the first-named effect (`None` where it has none).

@@ -447,11 +447,12 @@ pub(super) fn set_advantages(
                     .and_then(|&(_, a)| finite(a))
             })
             .collect();
-        e.held_out_advantage = if e.campaign_estimate.is_some() && shared_held {
-            positive(&every)
-        } else {
-            positive(&e.held_out_advantages)
-        };
+        e.held_out_advantage =
+            if e.effect.fixed_in_ned() && e.campaign_estimate.is_some() && shared_held {
+                positive(&every)
+            } else {
+                positive(&e.held_out_advantages)
+            };
     }
 }
 

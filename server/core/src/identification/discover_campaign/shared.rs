@@ -46,7 +46,7 @@ pub struct CampaignEstimate {
 /// The 95 % point of χ² with `dof` degrees of freedom (Wilson–Hilferty;
 /// 5.93 for 2 against the exact 5.99): above it the speeds' estimates
 /// disagree, and the std is widened.
-fn chi2_95(dof: usize) -> f64 {
+pub(super) fn chi2_95(dof: usize) -> f64 {
     let k = dof as f64;
     let a = 2.0 / (9.0 * k);
     k * (1.0 - a + 1.645 * a.sqrt()).powi(3)
