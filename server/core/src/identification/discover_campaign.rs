@@ -7,8 +7,6 @@
 //! were chosen — the augmented LPV model, validated on the same held-out runs
 //! as the original so the two can be compared number for number.
 
-use std::collections::BTreeMap;
-
 use serde::{Deserialize, Serialize};
 
 use super::augmented::augmented_at;
@@ -18,7 +16,7 @@ use super::error::IdentifyError;
 use super::lambda_settings::LambdaCampaignSettings;
 use super::outcome::Identified;
 use crate::discrepancy::{
-    AugmentedModel, DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, Record, Verdict,
+    AugmentedModel, DiscoveryError, DiscoveryReport, DiscoverySettings, Effect, Record,
     discover_from,
 };
 use crate::estimation::Progress;
@@ -533,56 +531,6 @@ pub fn discover_campaign(
     })
 }
 
-fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
-    let mut by: BTreeMap<Effect, EffectAcrossGrid> = BTreeMap::new();
-    for p in points {
-        for f in &p.report.findings {
-            let e = by.entry(f.effect).or_insert_with(|| EffectAcrossGrid {
-                effect: f.effect,
-                label: f.label.clone(),
-                grid_speeds_mps: vec![],
-                magnitudes: vec![],
-                held_out_gains: vec![],
-                held_out_advantages: vec![],
-                held_out_advantage: 0.0,
-                kept: None,
-                held_out_verdict: None,
-                campaign_estimate: None,
-                unconfirmed: false,
-            });
-            e.grid_speeds_mps.push(p.grid_speed_mps);
-            let gain = p
-                .report
-                .hypotheses
-                .iter()
-                .find(|h| h.effect == f.effect && h.verdict == Verdict::Chosen)
-                .and_then(|h| h.cv_gain)
-                .filter(|g| g.is_finite())
-                .unwrap_or(0.0);
-            e.held_out_gains.push(gain);
-            let m = f
-                .coefficients
-                .first()
-                .map(|c| [Some(c.value), c.std])
-                .or(f.shape.as_ref().map(|s| [Some(s.value), s.std]))
-                .unwrap_or([None, None]);
-            e.magnitudes.push(m);
-        }
-    }
-    // By how many speeds chose it (a property of the vehicle shows at
-    // every speed), then by the held-out evidence. (By evidence alone, a
-    // term one speed chose late could outrank one every speed chose: each
-    // gain is conditional on the terms chosen before it there.)
-    let mut v: Vec<_> = by.into_values().collect();
-    v.sort_by(|a, b| {
-        b.grid_speeds_mps
-            .len()
-            .cmp(&a.grid_speeds_mps.len())
-            .then(b.evidence().total_cmp(&a.evidence()))
-    });
-    v
-}
-
 pub(super) fn speeds_text(v: &[f64]) -> String {
     v.iter()
         .map(|s| format!("{s:.2}"))
@@ -604,7 +552,7 @@ pub use shared::CampaignEstimate;
 
 use assemble::Assembly;
 use keep::keep_better;
-use summary::summarize;
+use summary::{effects_across, summarize};
 
 #[cfg(test)]
 mod tests;

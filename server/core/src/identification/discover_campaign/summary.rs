@@ -1,15 +1,68 @@
-//! The campaign's story in sentences: what was named at which grid
-//! speeds and how large, what the held-out gate decided, and the structure
-//! no candidate explains (per DOF across the grid).
+//! The effects across the grid (each named effect with the speeds that
+//! chose it), and the campaign's story in sentences: what was named at
+//! which grid speeds and how large, what the held-out gate decided, and the
+//! structure no candidate explains (per DOF across the grid).
 
 use std::collections::BTreeMap;
 
 use super::{EffectAcrossGrid, PointDiscovery, speeds_text};
-use crate::discrepancy::Effect;
 use crate::discrepancy::lines::SpectralLine;
 use crate::discrepancy::locate::capital;
+use crate::discrepancy::{Effect, Verdict};
 use crate::numbers::sig3;
 use crate::planning::dof::Dof;
+
+/// Each effect the grid speeds' findings name, with the speeds that chose
+/// it, its magnitude and held-out gain at each.
+pub(super) fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid> {
+    let mut by: BTreeMap<Effect, EffectAcrossGrid> = BTreeMap::new();
+    for p in points {
+        for f in &p.report.findings {
+            let e = by.entry(f.effect).or_insert_with(|| EffectAcrossGrid {
+                effect: f.effect,
+                label: f.label.clone(),
+                grid_speeds_mps: vec![],
+                magnitudes: vec![],
+                held_out_gains: vec![],
+                held_out_advantages: vec![],
+                held_out_advantage: 0.0,
+                kept: None,
+                held_out_verdict: None,
+                campaign_estimate: None,
+                unconfirmed: false,
+            });
+            e.grid_speeds_mps.push(p.grid_speed_mps);
+            let gain = p
+                .report
+                .hypotheses
+                .iter()
+                .find(|h| h.effect == f.effect && h.verdict == Verdict::Chosen)
+                .and_then(|h| h.cv_gain)
+                .filter(|g| g.is_finite())
+                .unwrap_or(0.0);
+            e.held_out_gains.push(gain);
+            let m = f
+                .coefficients
+                .first()
+                .map(|c| [Some(c.value), c.std])
+                .or(f.shape.as_ref().map(|s| [Some(s.value), s.std]))
+                .unwrap_or([None, None]);
+            e.magnitudes.push(m);
+        }
+    }
+    // By how many speeds chose it (a property of the vehicle shows at
+    // every speed), then by the held-out evidence. (By evidence alone, a
+    // term one speed chose late could outrank one every speed chose: each
+    // gain is conditional on the terms chosen before it there.)
+    let mut v: Vec<_> = by.into_values().collect();
+    v.sort_by(|a, b| {
+        b.grid_speeds_mps
+            .len()
+            .cmp(&a.grid_speeds_mps.len())
+            .then(b.evidence().total_cmp(&a.evidence()))
+    });
+    v
+}
 
 pub(super) fn summarize(
     points: &[PointDiscovery],
