@@ -137,6 +137,23 @@ pub struct EffectAcrossGrid {
 }
 
 impl EffectAcrossGrid {
+    /// `effect` named at no grid speed yet: nothing measured, nothing kept.
+    pub(super) fn unnamed(effect: Effect, label: String) -> Self {
+        EffectAcrossGrid {
+            effect,
+            label,
+            grid_speeds_mps: vec![],
+            magnitudes: vec![],
+            held_out_gains: vec![],
+            held_out_advantages: vec![],
+            held_out_advantage: 0.0,
+            kept: None,
+            held_out_verdict: None,
+            campaign_estimate: None,
+            unconfirmed: false,
+        }
+    }
+
     /// The campaign's evidence for the effect: its held-out gains summed
     /// over the grid speeds.
     pub fn evidence(&self) -> f64 {

@@ -307,17 +307,8 @@ pub(super) fn settle(
         .position(|e| e.effect == Effect::Current)
         .map(|i| effects.remove(i))
         .unwrap_or_else(|| EffectAcrossGrid {
-            effect: Effect::Current,
-            label: Effect::Current.label(),
-            grid_speeds_mps: vec![],
-            magnitudes: vec![],
             held_out_gains: vec![gain],
-            held_out_advantages: vec![],
-            held_out_advantage: 0.0,
-            kept: None,
-            held_out_verdict: None,
-            campaign_estimate: None,
-            unconfirmed: false,
+            ..EffectAcrossGrid::unnamed(Effect::Current, Effect::Current.label())
         });
     entry.kept = Some(true);
     entry.held_out_verdict = Some(reason.clone());

@@ -18,19 +18,9 @@ pub(super) fn effects_across(points: &[PointDiscovery]) -> Vec<EffectAcrossGrid>
     let mut by: BTreeMap<Effect, EffectAcrossGrid> = BTreeMap::new();
     for p in points {
         for f in &p.report.findings {
-            let e = by.entry(f.effect).or_insert_with(|| EffectAcrossGrid {
-                effect: f.effect,
-                label: f.label.clone(),
-                grid_speeds_mps: vec![],
-                magnitudes: vec![],
-                held_out_gains: vec![],
-                held_out_advantages: vec![],
-                held_out_advantage: 0.0,
-                kept: None,
-                held_out_verdict: None,
-                campaign_estimate: None,
-                unconfirmed: false,
-            });
+            let e = by
+                .entry(f.effect)
+                .or_insert_with(|| EffectAcrossGrid::unnamed(f.effect, f.label.clone()));
             e.grid_speeds_mps.push(p.grid_speed_mps);
             let gain = p
                 .report
