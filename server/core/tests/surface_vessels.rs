@@ -214,6 +214,32 @@ fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
             r.notes.join("\n")
         );
         close += usize::from(gap <= 0.05);
+        below_grid_note_is_true(r);
     }
     assert!(close >= 4, "{close} of {} seeds within 0.05", current.len());
+}
+
+/// The note on how much of the held-out run lies below the grid speaks of
+/// the speed through the water, which the model is scheduled on: its share
+/// within 5 points of the truth's, and no note where the truth's is under
+/// 4 % (the note starts at 5 %).
+fn below_grid_note_is_true(r: &SurfaceReport) {
+    let said = r.notes.iter().find_map(|n| {
+        let rest = n.strip_prefix("validation run VAL: ")?;
+        let (pct, tail) = rest.split_once(" % of it was flown ")?;
+        tail.starts_with("below").then(|| pct.parse::<f64>().ok())?
+    });
+    let truth = 100.0 * r.below_grid_share;
+    match said {
+        Some(pct) => assert!(
+            (pct - truth).abs() <= 5.0,
+            "seed {}: the note says {pct} % below the grid, the truth {truth:.1} %",
+            r.seed
+        ),
+        None => assert!(
+            truth < 4.0,
+            "seed {}: {truth:.1} % below the grid, no note",
+            r.seed
+        ),
+    }
 }

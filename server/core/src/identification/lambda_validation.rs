@@ -7,6 +7,7 @@ use super::error::IdentifyError;
 use super::heading_loop::HeadingLoop;
 use super::lambda_data::experiment;
 use super::lambda_extension::speed_coverage_notes;
+use super::ned_current::surge_component;
 use super::outcome::RunValidation;
 use crate::estimation::restoring::RestoringParams;
 use crate::models::LpvModel;
@@ -39,9 +40,10 @@ pub(crate) struct HeldOut<'a> {
 }
 
 impl HeldOut<'_> {
-    /// Notes on where each held-out run's surge speed (output column
+    /// Notes on where each held-out run's forward speed (output column
     /// `surge`, its longest valid block) leaves `lpv`'s grid speeds and
-    /// extension.
+    /// extension: in a current, its speed through the water
+    /// u_r = u − u_c(ψ), which the model is scheduled on.
     pub fn speed_coverage(&self, surge: usize, lpv: &LpvModel) -> Vec<String> {
         let grid = lpv.grid_speeds();
         let mut notes = Vec::new();
@@ -49,7 +51,17 @@ impl HeldOut<'_> {
             if let Ok(segs) = segments(r, self.cols, self.outputs, 50)
                 && let Some(longest) = segs.iter().max_by_key(|s| s.y.nrows())
             {
-                let u: Vec<f64> = longest.y.column(surge).iter().copied().collect();
+                let u: Vec<f64> = (0..longest.y.nrows())
+                    .map(|k| {
+                        let u = longest.y[(k, surge)];
+                        match &self.current {
+                            Some((_, v)) => {
+                                u - surge_component([v[0], v[1]], longest.u[(k, self.psi_col)])
+                            }
+                            None => u,
+                        }
+                    })
+                    .collect();
                 notes.extend(speed_coverage_notes(&r.name, &u, grid, lpv.extension()));
             }
         }

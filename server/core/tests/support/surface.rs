@@ -36,6 +36,10 @@ pub struct SurfaceReport {
     /// fit and the true model's (its exact states against the log).
     pub free_run: Vec<(String, Option<f64>, Option<f64>)>,
     pub notes: Vec<String>,
+    /// The share of the held-out run whose true speed through the water
+    /// u_r = u − u_c(ψ) (noise-free log, true current) lies below the
+    /// lowest grid speed.
+    pub below_grid_share: f64,
 }
 
 impl SurfaceReport {
@@ -264,8 +268,16 @@ fn grade(
             (c.to_string(), report.channels[i].fit_simulation, truth)
         })
         .collect();
+    let (u, psi) = (column(&val_exact.csv, 4), column(&val_exact.csv, 9));
+    let below = (0..u.len())
+        .filter(|&k| {
+            let u_c = val_exact.current.segment(k, 1.0).body(psi[k])[0];
+            u[k] - u_c < grid[0]
+        })
+        .count();
     let report = SurfaceReport {
         label: label.into(),
+        below_grid_share: below as f64 / u.len().max(1) as f64,
         seed,
         current_true: current_of(effects, campaign),
         current_est: out.document.lpv.as_ref().and_then(|l| l.current.clone()),
