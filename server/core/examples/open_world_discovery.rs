@@ -6,7 +6,10 @@
 //!
 //! `cargo run --release -p seatrial-core --example open_world_discovery [seeds…]`
 //! (default seed 1); `CASES=current,tether` keeps cases whose name contains
-//! one of those words.
+//! one of those words; `TIER=small` runs the small tier instead (the
+//! issue's sensitivity sizes: 0.04 s lag and delay, saturation at 70 %, a
+//! 5–10 % dead zone, a 0.05 m/s current, quadratic yaw damping doubled),
+//! `TIER=all` both.
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -25,10 +28,15 @@ fn main() {
             .as_deref()
             .is_none_or(|w| w.split(',').any(|x| name.contains(x.trim())))
     };
+    let tier: Vec<Concealed> = match std::env::var("TIER").as_deref() {
+        Ok("small") => Concealed::SMALL.to_vec(),
+        Ok("all") => [Concealed::ALL.as_slice(), Concealed::SMALL.as_slice()].concat(),
+        _ => Concealed::ALL.to_vec(),
+    };
     let spec = seatrial_truth::CampaignSpec::default();
     let mut cases = Vec::new();
     for &seed in &seeds {
-        for c in Concealed::ALL.into_iter().filter(|c| keep(c.name())) {
+        for c in tier.iter().copied().filter(|c| keep(c.name())) {
             let case = discover_case(seed, c, &spec);
             eprint!("{}", format_cases(std::slice::from_ref(&case)));
             cases.push(case);

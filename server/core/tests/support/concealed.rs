@@ -48,6 +48,23 @@ pub enum Concealed {
     /// east parts drift as slow sinusoids (seeded amplitudes 0.08–0.12 m/s,
     /// periods 300–600 s, phases): its direction and speed wander.
     DriftingCurrent,
+    /// The small tier: a 0.04 s first-order actuator lag in every DOF,
+    /// under half a log sample at 10 Hz.
+    SmallLag,
+    /// The small tier: a 0.04 s input delay in every DOF.
+    SmallDelay,
+    /// The small tier: heave thrust clipped at 70 % of the clean
+    /// campaign's largest heave command (a mild saturation).
+    MildSaturation,
+    /// The small tier: a heave dead zone of a seeded 5–10 % of the clean
+    /// campaign's RMS heave command.
+    SmallDeadZone,
+    /// The small tier: a steady current of 0.05 m/s (0.04 north, 0.03
+    /// east).
+    SmallCurrent,
+    /// The small tier: quadratic yaw damping twice the drawn one, half the
+    /// large tier's fourfold.
+    QuadraticYaw,
 }
 
 impl Concealed {
@@ -64,6 +81,17 @@ impl Concealed {
         Concealed::DriftingCurrent,
     ];
 
+    /// The small tier of the sensitivity goal, each effect at the
+    /// size it names.
+    pub const SMALL: [Concealed; 6] = [
+        Concealed::SmallLag,
+        Concealed::SmallDelay,
+        Concealed::MildSaturation,
+        Concealed::SmallDeadZone,
+        Concealed::SmallCurrent,
+        Concealed::QuadraticYaw,
+    ];
+
     pub fn name(self) -> &'static str {
         match self {
             Concealed::Clean => "clean",
@@ -76,6 +104,12 @@ impl Concealed {
             Concealed::DeadZone => "dead zone",
             Concealed::Disturbance => "sway disturbance",
             Concealed::DriftingCurrent => "drifting current",
+            Concealed::SmallLag => "small actuator lag",
+            Concealed::SmallDelay => "small input delay",
+            Concealed::MildSaturation => "mild saturation",
+            Concealed::SmallDeadZone => "small dead zone",
+            Concealed::SmallCurrent => "small current",
+            Concealed::QuadraticYaw => "quadratic yaw damping",
         }
     }
 
@@ -92,7 +126,7 @@ impl Concealed {
     /// library: everything is `None`.
     pub fn names(self, e: &Effect) -> Option<bool> {
         match (self, e) {
-            (Concealed::Current, Effect::Current) => Some(true),
+            (Concealed::Current | Concealed::SmallCurrent, Effect::Current) => Some(true),
             (Concealed::Tether, Effect::TetherPull) => Some(true),
             (
                 Concealed::Tether,
@@ -100,16 +134,34 @@ impl Concealed {
                     dof: Dof::Surge | Dof::Sway,
                 },
             ) => Some(false),
-            (Concealed::Lag, Effect::ActuatorLag { .. } | Effect::CommonActuatorLag) => Some(true),
-            (Concealed::Lag, Effect::InputDelay { .. } | Effect::CommonInputDelay) => Some(false),
-            (Concealed::Saturation, Effect::Saturation { dof: Dof::Heave }) => Some(true),
+            (
+                Concealed::Lag | Concealed::SmallLag,
+                Effect::ActuatorLag { .. } | Effect::CommonActuatorLag,
+            ) => Some(true),
+            (
+                Concealed::Lag | Concealed::SmallLag,
+                Effect::InputDelay { .. } | Effect::CommonInputDelay,
+            ) => Some(false),
+            (
+                Concealed::Saturation | Concealed::MildSaturation,
+                Effect::Saturation { dof: Dof::Heave },
+            ) => Some(true),
+            (Concealed::QuadraticYaw, Effect::QuadraticDamping { dof: Dof::Yaw }) => Some(true),
+            (Concealed::QuadraticYaw, Effect::CubicDamping { dof: Dof::Yaw }) => Some(false),
             (Concealed::QuadraticSway, Effect::QuadraticDamping { dof: Dof::Sway }) => Some(true),
             (Concealed::QuadraticSway, Effect::CubicDamping { dof: Dof::Sway }) => Some(false),
-            (Concealed::Delay, Effect::InputDelay { .. } | Effect::CommonInputDelay) => Some(true),
-            (Concealed::Delay, Effect::ActuatorLag { .. } | Effect::CommonActuatorLag) => {
-                Some(false)
-            }
-            (Concealed::DeadZone, Effect::DeadZone { dof: Dof::Heave }) => Some(true),
+            (
+                Concealed::Delay | Concealed::SmallDelay,
+                Effect::InputDelay { .. } | Effect::CommonInputDelay,
+            ) => Some(true),
+            (
+                Concealed::Delay | Concealed::SmallDelay,
+                Effect::ActuatorLag { .. } | Effect::CommonActuatorLag,
+            ) => Some(false),
+            (
+                Concealed::DeadZone | Concealed::SmallDeadZone,
+                Effect::DeadZone { dof: Dof::Heave },
+            ) => Some(true),
             (Concealed::DriftingCurrent, Effect::Current) => Some(true),
             _ => None,
         }
@@ -119,7 +171,7 @@ impl Concealed {
     pub fn truth_text(self, vessel: &Vessel) -> String {
         match self {
             Concealed::Clean => "none concealed".into(),
-            Concealed::Current => format!(
+            Concealed::Current | Concealed::SmallCurrent => format!(
                 "V_N {:.3}, V_E {:.3} m/s",
                 vessel.current_ned.x, vessel.current_ned.y
             ),
@@ -128,7 +180,8 @@ impl Concealed {
                 vessel.tether_ned.x, vessel.tether_ned.y
             ),
             Concealed::Lag => "T_a 0.4 s in every DOF".into(),
-            Concealed::Saturation => format!(
+            Concealed::SmallLag => "T_a 0.04 s in every DOF".into(),
+            Concealed::Saturation | Concealed::MildSaturation => format!(
                 "heave τ_max {:.1} N",
                 vessel.actuator.limits.map_or(f64::NAN, |l| l[2])
             ),
@@ -137,14 +190,19 @@ impl Concealed {
                 vessel.damping_quadratic[1],
                 vessel.damping_quadratic[1] / 4.0
             ),
-            Concealed::Delay => {
+            Concealed::QuadraticYaw => format!(
+                "d_r|r| {:.1} N·m·s²/rad² (drawn {:.1})",
+                vessel.damping_quadratic[5],
+                vessel.damping_quadratic[5] / 2.0
+            ),
+            Concealed::Delay | Concealed::SmallDelay => {
                 let d = vessel.actuator.delay_s.unwrap_or(f64::NAN);
                 format!(
                     "d {d:.3} s = {:.2} log samples (10 Hz) in every DOF",
                     d / 0.1
                 )
             }
-            Concealed::DeadZone => format!(
+            Concealed::DeadZone | Concealed::SmallDeadZone => format!(
                 "heave δ {:.1} N",
                 vessel.actuator.dead_zone.map_or(f64::NAN, |d| d[2])
             ),
@@ -190,15 +248,33 @@ impl Concealed {
                 vessel.tether_ned = Vector3::new(size * bearing.cos(), size * bearing.sin(), 0.0);
             }
             Concealed::Lag => vessel.actuator.lag_s = Some(Vector6::repeat(0.4)),
-            Concealed::Saturation => {
+            Concealed::SmallLag => vessel.actuator.lag_s = Some(Vector6::repeat(0.04)),
+            Concealed::Saturation | Concealed::MildSaturation => {
                 let peak = clean
                     .runs
                     .iter()
                     .map(|r| r.log.tau.column(2).amax())
                     .fold(0.0, f64::max);
+                let share = if self == Concealed::Saturation {
+                    0.6
+                } else {
+                    0.7
+                };
                 let mut lim = Vector6::repeat(f64::INFINITY);
-                lim[2] = 0.6 * peak;
+                lim[2] = share * peak;
                 vessel.actuator.limits = Some(lim);
+            }
+            Concealed::SmallCurrent => vessel.current_ned = Vector3::new(0.04, 0.03, 0.0),
+            Concealed::QuadraticYaw => vessel.damping_quadratic[5] *= 2.0,
+            Concealed::SmallDelay => {
+                let h = 1.0 / clean.spec.integration_rate_hz;
+                vessel.actuator.delay_s = Some((0.04 / h).round() * h);
+            }
+            Concealed::SmallDeadZone => {
+                let mut rng = case_rng(clean, 5);
+                let mut delta = Vector6::zeros();
+                delta[2] = rng.range(0.05, 0.10) * rms_command(clean, 2);
+                vessel.actuator.dead_zone = Some(delta);
             }
             Concealed::QuadraticSway => vessel.damping_quadratic[1] *= 4.0,
             Concealed::Delay => {
