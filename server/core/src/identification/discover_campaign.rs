@@ -465,8 +465,8 @@ pub fn discover_campaign(
             progress,
             (0.9, gate_to),
         )?;
-        keep::set_advantages(&asm, &mut effects, &gate.alone, assembled.is_some());
-        shared_notes.extend(keep::refit_note(&gate.refits));
+        credit::set_advantages(&asm, &mut effects, &gate.alone, assembled.is_some());
+        shared_notes.extend(credit::refit_note(&gate.refits));
         for ((e, v), u) in effects
             .iter_mut()
             .zip(&gate.verdicts)
@@ -556,6 +556,7 @@ pub(super) fn speeds_text(v: &[f64]) -> String {
 }
 
 mod assemble;
+mod credit;
 mod current_again;
 mod keep;
 mod records;

@@ -2,7 +2,10 @@
 //! is kept if, on the held-out runs, it is better than the start model
 //! beyond noise in some fit and worse in none (1-step, k-step, 10 s
 //! restarted and whole-run free run), simulates wherever that model did, and keeps M
-//! positive definite. Otherwise the grid speeds' augmentations are added
+//! positive definite — less the findings of speeds that add nothing to
+//! their null refit (below) and share no effect with a speed that adds,
+//! where the model without them is no worse on the held-out fits summed.
+//! Otherwise the grid speeds' augmentations are added
 //! one at a time, strongest evidence first, each staying only if the model
 //! with it passes the same test against the model without it and against
 //! the baseline (so losses within noise cannot add up).
@@ -23,12 +26,11 @@
 
 use std::collections::BTreeSet;
 
-use super::super::discover_gate::{
-    HeldOutVerdict, advantage, compare_against, fit_pairs, inertia_verdict, paired,
-};
+use super::super::discover_gate::{HeldOutVerdict, advantage, compare_against, inertia_verdict};
 use super::super::error::IdentifyError;
 use super::super::outcome::{Identified, RunValidation};
 use super::assemble::Assembly;
+use super::credit::{alone_advantages, confirmation, refit_gains};
 use super::{EffectAcrossGrid, speeds_text};
 use crate::discrepancy::Verdict;
 use crate::discrepancy::report::ModelReport;
@@ -56,6 +58,31 @@ pub(super) struct Kept {
     /// (grid speed, held-out advantage) where the null refit alone is
     /// better than the baseline ([`refit_gains`]).
     pub refits: Vec<(f64, f64)>,
+}
+
+/// What each effect was credited with: [`Kept::unconfirmed`],
+/// [`Kept::alone`], [`Kept::refits`].
+type Credit = (Vec<Option<String>>, Vec<(usize, f64)>, Vec<(f64, f64)>);
+
+impl Kept {
+    /// Nothing stored, for `reason`, with what each effect was credited.
+    fn nothing(
+        verdicts: Vec<HeldOutVerdict>,
+        reason: String,
+        (unconfirmed, alone, refits): Credit,
+    ) -> Self {
+        Kept {
+            model: None,
+            verdicts,
+            overall: HeldOutVerdict {
+                keep: false,
+                reason,
+            },
+            unconfirmed,
+            alone,
+            refits,
+        }
+    }
 }
 
 /// Per grid point (in the assembly's order): its start model and
@@ -244,6 +271,113 @@ pub(super) fn keep_better(
     let verdict = inertia_verdict(&full.document)
         .unwrap_or_else(|| compare_against(before, &full.validation, "the baseline"));
     if verdict.keep {
+        // Findings that add nothing to their speed's null refit are left
+        // out where the model without them is as good on the held-out runs
+        // — unless an effect among them is kept at a speed where findings
+        // add (an actuator limit or a current is one for the campaign).
+        let shares = |i: usize| {
+            asm.points[i].report.findings.iter().any(|f| {
+                order.iter().any(|&j| {
+                    adds(j)
+                        && asm.points[j]
+                            .report
+                            .findings
+                            .iter()
+                            .any(|g| g.effect == f.effect)
+                })
+            })
+        };
+        let dropped: Vec<usize> = order
+            .iter()
+            .copied()
+            .filter(|&i| !adds(i) && !shares(i))
+            .collect();
+        if dropped.len() == order.len()
+            && let Some(gain) = beyond_refits(asm, &full, &cands)?
+            && gain <= 0.0
+        {
+            let reason = format!(
+                "with every effect found, {}; but the findings at {} m/s gain nothing over those grid speeds refitted without a new term, alone or together (fits summed against the refits alone: {}), so no effect is named",
+                verdict.reason,
+                speeds_text(&idle),
+                sig3(gain)
+            );
+            let verdicts = effects.iter().map(add_nothing).collect();
+            return Ok(Kept::nothing(
+                verdicts,
+                reason,
+                (unconfirmed, alone_gains, refits),
+            ));
+        }
+        let slim = if dropped.is_empty() || dropped.len() == order.len() {
+            None
+        } else {
+            let at: Vec<(f64, &ModelReport)> = order
+                .iter()
+                .filter_map(|&i| {
+                    let speed = asm.points[i].grid_speed_mps;
+                    if !dropped.contains(&i) {
+                        return Some((speed, &asm.points[i].report.model));
+                    }
+                    cands.iter().find_map(|(j, c)| match c {
+                        Candidate::Refit(r) if *j == i => Some((speed, &**r)),
+                        _ => None,
+                    })
+                })
+                .collect();
+            let slim = asm.model_from(&at, true)?;
+            let passes = inertia_verdict(&slim.document)
+                .unwrap_or_else(|| compare_against(before, &slim.validation, "the baseline"));
+            let (gain, _) = advantage(&full.validation, &slim.validation);
+            (passes.keep && gain <= 0.0).then_some((slim, passes, gain))
+        };
+        if let Some((slim, mut overall, gain)) = slim {
+            let kept_at: Vec<f64> = order
+                .iter()
+                .filter(|i| !dropped.contains(i))
+                .map(|&i| asm.points[i].grid_speed_mps)
+                .collect();
+            let dropped_at: Vec<f64> = dropped
+                .iter()
+                .map(|&i| asm.points[i].grid_speed_mps)
+                .collect();
+            let refitted: BTreeSet<usize> = dropped.iter().copied().collect();
+            overall.reason = with_refits(
+                &format!(
+                    "with the findings at {} of {} grid speeds ({} m/s), {}; those at {} m/s add nothing over their speed refitted without a new term and are left out (the model with them too is no better on the held-out runs: fits summed {})",
+                    kept_at.len(),
+                    order.len(),
+                    speeds_text(&kept_at),
+                    overall.reason,
+                    speeds_text(&dropped_at),
+                    sig3(gain)
+                ),
+                asm,
+                &cands,
+                &refitted,
+            );
+            let verdicts = effects
+                .iter()
+                .map(|e| {
+                    if order
+                        .iter()
+                        .any(|i| !dropped.contains(i) && chose(asm, e, *i))
+                    {
+                        overall.clone()
+                    } else {
+                        add_nothing(e)
+                    }
+                })
+                .collect();
+            return Ok(Kept {
+                model: Some(slim),
+                verdicts,
+                overall,
+                unconfirmed,
+                alone: alone_gains,
+                refits,
+            });
+        }
         return Ok(Kept {
             model: Some(full),
             verdicts: vec![verdict.clone(); effects.len()],
@@ -254,21 +388,17 @@ pub(super) fn keep_better(
         });
     }
     if !cands.iter().any(|(i, _)| named_at(*i)) {
-        return Ok(Kept {
-            model: None,
-            verdicts: effects.iter().map(add_nothing).collect(),
-            overall: HeldOutVerdict {
-                keep: false,
-                reason: format!(
-                    "with every effect found, {}; the findings at {} m/s gain nothing on the held-out runs over those grid speeds refitted without a new term (their rows of M and D̄ and carried terms refitted on the same runs)",
-                    verdict.reason,
-                    speeds_text(&idle)
-                ),
-            },
-            unconfirmed,
-            alone: alone_gains,
-            refits,
-        });
+        let reason = format!(
+            "with every effect found, {}; the findings at {} m/s gain nothing on the held-out runs over those grid speeds refitted without a new term (their rows of M and D̄ and carried terms refitted on the same runs)",
+            verdict.reason,
+            speeds_text(&idle)
+        );
+        let verdicts = effects.iter().map(add_nothing).collect();
+        return Ok(Kept::nothing(
+            verdicts,
+            reason,
+            (unconfirmed, alone_gains, refits),
+        ));
     }
     let from = from + (to - from) / 2.0;
     let step = (to - from) / (cands.len() + 1) as f64;
@@ -383,6 +513,27 @@ pub(super) fn keep_better(
     })
 }
 
+/// What `full` gains on the held-out fits (summed) over the model with
+/// only the null refits among `cands`; `None` when there are none.
+fn beyond_refits(
+    asm: &Assembly<'_>,
+    full: &Identified,
+    cands: &[(usize, Candidate)],
+) -> Result<Option<f64>, IdentifyError> {
+    let at: Vec<(f64, &ModelReport)> = cands
+        .iter()
+        .filter_map(|(i, c)| match c {
+            Candidate::Refit(r) => Some((asm.points[*i].grid_speed_mps, &**r)),
+            Candidate::Findings => None,
+        })
+        .collect();
+    if at.is_empty() {
+        return Ok(None);
+    }
+    let refitted = asm.model_from(&at, false)?;
+    Ok(Some(advantage(&full.validation, &refitted.validation).0))
+}
+
 /// `reason`, and where `kept` holds null refits, at which speeds the model
 /// takes its rows refitted without a new term.
 fn with_refits(
@@ -404,162 +555,4 @@ fn with_refits(
             speeds_text(&speeds)
         )
     }
-}
-
-/// What the summary says of null refits better than the baseline
-/// (`refits`: [`Kept::refits`]), if any.
-pub(super) fn refit_note(refits: &[(f64, f64)]) -> Option<String> {
-    let each: Vec<String> = refits
-        .iter()
-        .map(|&(s, a)| format!("{s:.2} m/s (+{})", sig3(a)))
-        .collect();
-    (!each.is_empty()).then(|| {
-        format!(
-            "Refitted on the same estimation runs without any new term, the start model's rows of M and D̄ (and its carried terms) already gain on the held-out runs at {} (fits summed, each clamped to [−1, 1]): the model is not the best its own structure gives on these runs, and each effect is credited only with what it adds to that refit.",
-            each.join(", ")
-        )
-    })
-}
-
-/// Sets each effect's `held_out_advantages` (at each speed that chose it,
-/// that speed's `alone` advantage; `None` where a fit was lost) and the
-/// `held_out_advantage` it is ranked by: their positive sum (a speed whose
-/// findings lose on balance, perhaps through another of them, adds
-/// nothing), over every speed judged for a force the campaign shares when
-/// `shared_held` (it is held at each of them).
-pub(super) fn set_advantages(
-    asm: &Assembly<'_>,
-    effects: &mut [EffectAcrossGrid],
-    alone: &[(usize, f64)],
-    shared_held: bool,
-) {
-    let finite = |a: f64| Some(a).filter(|a| a.is_finite());
-    let positive = |a: &[Option<f64>]| a.iter().flatten().filter(|a| **a > 0.0).sum();
-    let every: Vec<Option<f64>> = alone.iter().map(|&(_, a)| finite(a)).collect();
-    for e in effects.iter_mut() {
-        e.held_out_advantages = e
-            .grid_speeds_mps
-            .iter()
-            .map(|&s| {
-                alone
-                    .iter()
-                    .find(|(i, _)| asm.points[*i].grid_speed_mps == s)
-                    .and_then(|&(_, a)| finite(a))
-            })
-            .collect();
-        e.held_out_advantage =
-            if e.effect.fixed_in_ned() && e.campaign_estimate.is_some() && shared_held {
-                positive(&every)
-            } else {
-                positive(&e.held_out_advantages)
-            };
-    }
-}
-
-/// Each grid speed's findings alone on the baseline, judged on balance:
-/// their held-out fits (1-step, k-step, 10 s restarted and whole-run free
-/// run, each clamped to [−1, 1], summed) against its null refit's where
-/// that is better than the baseline, else against the baseline's — so a
-/// term is credited only with what it adds to the rows refitted with it.
-/// A fit lost or M not positive definite counts as −∞. `models` and
-/// `nulls`: each speed's (in `order`). Returns (point index, advantage).
-fn alone_advantages(
-    order: &[usize],
-    before: &[RunValidation],
-    models: &[&Identified],
-    nulls: &[Option<&Identified>],
-) -> Vec<(usize, f64)> {
-    let lost = |m: &Identified| loses(before, m);
-    order
-        .iter()
-        .zip(models)
-        .zip(nulls)
-        .map(|((&i, model), null)| {
-            let reference = match null {
-                Some(n) if !lost(n) && advantage(&n.validation, before).0 > 0.0 => &n.validation,
-                _ => before,
-            };
-            let gain = if lost(model) {
-                f64::NEG_INFINITY
-            } else {
-                advantage(&model.validation, reference).0
-            };
-            (i, gain)
-        })
-        .collect()
-}
-
-/// Whether `m` loses a fit `before` had, or its M is not positive definite.
-fn loses(before: &[RunValidation], m: &Identified) -> bool {
-    inertia_verdict(&m.document).is_some()
-        || paired(before, &m.validation).any(|(_, b, a)| {
-            fit_pairs(b, a)
-                .iter()
-                .any(|(_, x, y)| x.is_some() && y.is_none())
-        })
-}
-
-/// (grid speed, held-out advantage) of each null refit better than the
-/// baseline on balance and losing no fit.
-fn refit_gains(
-    asm: &Assembly<'_>,
-    order: &[usize],
-    before: &[RunValidation],
-    nulls: &[Option<&Identified>],
-) -> Vec<(f64, f64)> {
-    order
-        .iter()
-        .zip(nulls)
-        .filter_map(|(&i, n)| {
-            let n = n.filter(|n| !loses(before, n))?;
-            let a = advantage(&n.validation, before).0;
-            (a > 0.0).then_some((asm.points[i].grid_speed_mps, a))
-        })
-        .collect()
-}
-
-/// An effect is not confirmed when at every speed that chose it the
-/// advantage of that speed's findings alone ([`alone_advantages`]) is not
-/// above zero: a hypothesis the estimation runs favoured and the held-out
-/// runs did not, reported as tried rather than named (on the independent
-/// truth's clean ROV, seed 1: cross-flow |q|r in yaw at 0.50 m/s, its
-/// fits 1.09 lower over 24).
-fn confirmation(
-    asm: &Assembly<'_>,
-    effects: &[EffectAcrossGrid],
-    gains: &[(usize, f64)],
-) -> Vec<Option<String>> {
-    effects
-        .iter()
-        .map(|e| {
-            let at: Vec<(f64, f64)> = gains
-                .iter()
-                .filter(|(i, _)| {
-                    asm.points[*i]
-                        .report
-                        .findings
-                        .iter()
-                        .any(|f| f.effect == e.effect)
-                })
-                .map(|&(i, g)| (asm.points[i].grid_speed_mps, g))
-                .collect();
-            let confirmed = at.is_empty() || at.iter().any(|&(_, g)| g > 0.0);
-            (!confirmed).then(|| {
-                let each: Vec<String> = at
-                    .iter()
-                    .map(|&(s, g)| {
-                        if g.is_finite() {
-                            format!("{s:.2} m/s: {}", sig3(g))
-                        } else {
-                            format!("{s:.2} m/s: a fit lost or M not positive definite")
-                        }
-                    })
-                    .collect();
-                format!(
-                    "not confirmed: with only its grid speed's findings added to the baseline, the held-out fits (1-step, k-step, 10 s restarted and whole-run free run, each clamped to [−1, 1]) gain nothing on balance over that speed refitted without a new term, or over the baseline where that refit is not better ({})",
-                    each.join("; ")
-                )
-            })
-        })
-        .collect()
 }

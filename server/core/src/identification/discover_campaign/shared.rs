@@ -138,7 +138,17 @@ fn pool(terms: &[(f64, &ModelTerm)], effect: Effect) -> Option<(ModelTerm, Campa
     let dof = 2 * (ests.len() - 1);
     let ratio = chi2 / dof as f64;
     let disagree = chi2 > chi2_95(dof);
-    let cov = if disagree { cov * ratio } else { cov };
+    // One value carried at every speed is one estimate, not n.
+    let identical = ests
+        .iter()
+        .all(|(x, _)| (x - ests[0].0).amax() <= 1e-12 * ests[0].0.amax().max(1e-300));
+    let cov = if identical {
+        ests[0].1.try_inverse()?
+    } else if disagree {
+        cov * ratio
+    } else {
+        cov
+    };
     if !(mean.iter().chain(cov.iter()).all(|v| v.is_finite())) {
         return None;
     }
@@ -159,7 +169,10 @@ fn pool(terms: &[(f64, &ModelTerm)], effect: Effect) -> Option<(ModelTerm, Campa
             std: Some(cov[(j, j)].sqrt()),
         })
         .collect();
-    let agreement = if disagree {
+    let agreement = if identical {
+        "every one of them carries the same value, the start model's (no speed re-estimated it)"
+            .to_owned()
+    } else if disagree {
         format!(
             "the speeds' estimates scatter more than their standard deviations allow (χ² {} on {dof} degrees of freedom), so the standard deviation is widened {}×: the force changed during the campaign, or a speed's other terms traded against it",
             sig3(chi2),
@@ -531,6 +544,19 @@ mod tests {
                 .len(),
             0
         );
+    }
+
+    /// The same value carried at every speed (the start model's campaign
+    /// term, re-estimated nowhere) keeps its own std, not one shrunk by
+    /// √n, and the text says so instead of quoting a χ² of zero.
+    #[test]
+    fn one_value_carried_at_every_speed_is_one_estimate() {
+        let a = term([0.1, -0.2], 1e-4);
+        let (t, e) = pool(&[(0.3, &a), (0.6, &a), (0.9, &a)], Effect::Current).expect("pooled");
+        assert_eq!(t.coefficients, vec![0.1, -0.2]);
+        assert!((e.coefficients[0].std.unwrap() - 0.01).abs() < 1e-12);
+        assert!(e.text.contains("carries the same value"), "{}", e.text);
+        assert!(!e.text.contains("χ²"), "{}", e.text);
     }
 
     /// One speed's estimate, or a term without covariance, is no pool.
