@@ -7,8 +7,8 @@ use super::error::IdentifyError;
 use super::heading_loop::HeadingLoop;
 use super::lambda_data::experiment;
 use super::lambda_extension::speed_coverage_notes;
-use super::ned_current::surge_component;
 use super::outcome::RunValidation;
+use super::through_water::speed_through_water;
 use crate::estimation::restoring::RestoringParams;
 use crate::models::LpvModel;
 use crate::numbers::sig3;
@@ -51,17 +51,8 @@ impl HeldOut<'_> {
             if let Ok(segs) = segments(r, self.cols, self.outputs, 50)
                 && let Some(longest) = segs.iter().max_by_key(|s| s.y.nrows())
             {
-                let u: Vec<f64> = (0..longest.y.nrows())
-                    .map(|k| {
-                        let u = longest.y[(k, surge)];
-                        match &self.current {
-                            Some((_, v)) => {
-                                u - surge_component([v[0], v[1]], longest.u[(k, self.psi_col)])
-                            }
-                            None => u,
-                        }
-                    })
-                    .collect();
+                let v = self.current.as_ref().map(|(_, v)| *v);
+                let u = speed_through_water(longest, surge, self.psi_col, v);
                 notes.extend(speed_coverage_notes(&r.name, &u, grid, lpv.extension()));
             }
         }

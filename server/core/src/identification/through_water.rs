@@ -12,11 +12,31 @@
 
 use nalgebra::Vector2;
 
-use super::dataset::RunInput;
+use super::dataset::{RunInput, Segment};
 use super::lambda_data::PointData;
 use super::ned_current::surge_component;
 use super::roles::{Roles, nearest_grid_index};
 use crate::numbers::sig3;
+
+/// The forward speed through the water u_r = u − u_c(ψ) (m/s) at each
+/// sample of `seg` (u its output column `surge`, ψ its input column
+/// `psi_col`) in the current V = [V_N, V_E]; without one, u.
+pub(crate) fn speed_through_water(
+    seg: &Segment,
+    surge: usize,
+    psi_col: usize,
+    v: Option<Vector2<f64>>,
+) -> Vec<f64> {
+    (0..seg.y.nrows())
+        .map(|k| {
+            let u = seg.y[(k, surge)];
+            match v {
+                Some(v) => u - surge_component([v[0], v[1]], seg.u[(k, psi_col)]),
+                None => u,
+            }
+        })
+        .collect()
+}
 
 /// One run's mean speeds (m/s) and where its segments sit.
 struct RunSpeeds {
@@ -53,12 +73,8 @@ pub(crate) fn regrid(
                 continue;
             }
             let rows = s.y.nrows();
-            let (mut ground, mut water) = (0.0, 0.0);
-            for k in 0..rows {
-                let u = s.y[(k, surge)];
-                ground += u;
-                water += u - surge_component([v[0], v[1]], s.u[(k, psi_col)]);
-            }
+            let ground: f64 = s.y.column(surge).sum();
+            let water: f64 = speed_through_water(s, surge, psi_col, Some(v)).iter().sum();
             let entry = match speeds.iter_mut().find(|e| e.id == s.run_id) {
                 Some(e) => e,
                 None => {
