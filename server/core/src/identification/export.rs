@@ -192,7 +192,7 @@ pub fn fossen_parameter_set(doc: &ModelDocument) -> Result<FossenParameterSet, S
                 notes.push(format!("Second-order Coriolis–centripetal force: add C(δ)δ to the left-hand side, C(ν) from {from} (Fossen 2011, eq. 6.43) at δ = ν with the forward speed u set to zero — the turning, heaving and rolling forces about straight-ahead motion; the linear part about U is in D and b."));
             }
             if lpv.quadratic_damping.is_some() {
-                notes.push("Quadratic damping: add D_q|δ|δ to the left-hand side, D_q diagonal (`D_q`, one for every U), δ = ν with the forward speed u set to zero — hull damping that grows with the amplitude of sway, heave and the rotations; surge's is in D and b per U.".into());
+                notes.push("Quadratic damping: add D_q|δ|δ to the left-hand side, D_q diagonal (`D_q`, one for every U), δ = ν with the forward speed u set to zero — hull damping that grows with the amplitude of sway, heave and the rotations; in surge D_q times the part of |u|u beyond its tangent at U, |u|u − |U|U − 2|U|(u − U) (|u|u itself at U = 0), the tangent being in D and b per U.".into());
             }
             if augmented {
                 notes.push("Discovered physics: each point's `terms` add to the left-hand side (their coefficients times the regressor named in `label`), or shape τ before it acts (lag, delay, saturation, dead zone); M and D are then the refitted ones.".into());

@@ -228,7 +228,7 @@ fn identify(
 
     let second_order = settings.coriolis_second_order && dofs.contains(&Dof::Surge);
     let quad_cols = if settings.quadratic_damping {
-        lambda_quadratic::columns(&dofs)
+        lambda_quadratic::columns(&dofs, grid)
     } else {
         Vec::new()
     };

@@ -57,9 +57,19 @@ pub(crate) fn name(d: Dof) -> String {
 }
 
 /// The columns of ν that get a quadratic column in the regression: all
-/// but surge (whose X_|u|u [`surge_drag`] gives).
-pub(crate) fn columns(dofs: &[Dof]) -> Vec<usize> {
-    (0..dofs.len()).filter(|&i| dofs[i] != Dof::Surge).collect()
+/// but surge (whose X_|u|u [`surge_drag`] gives), and surge too when every
+/// grid speed is 0 m/s (a DP vessel: no drag curve over speeds, and at
+/// u₀ = 0 surge's remainder beyond its tangent is |u|u itself).
+pub(crate) fn columns(dofs: &[Dof], grid: &[f64]) -> Vec<usize> {
+    let at_rest = at_rest(grid);
+    (0..dofs.len())
+        .filter(|&i| dofs[i] != Dof::Surge || at_rest)
+        .collect()
+}
+
+/// Every grid speed is 0 m/s (and there is one).
+pub(crate) fn at_rest(grid: &[f64]) -> bool {
+    !grid.is_empty() && grid.iter().all(|u| *u == 0.0)
 }
 
 /// X_|u|u and its std from the sub-models' D̄[surge,surge] (index
@@ -230,6 +240,8 @@ pub(crate) fn pool(
     dofs: &[Dof],
     notes: &mut Vec<String>,
 ) -> Option<(DVector<f64>, DVector<f64>)> {
+    let grid: Vec<f64> = points.iter().map(|(u0, _)| *u0).collect();
+    let columns = |dofs: &[Dof]| columns(dofs, &grid);
     let per_point: Vec<(DVector<f64>, DVector<f64>)> = points
         .iter()
         .filter_map(|(_, e)| of_estimate(e, dofs))
@@ -263,8 +275,13 @@ pub(crate) fn pool(
         s[i] = p.std;
     }
     notes.push(format!(
-        "quadratic damping D_q|δ|δ estimated with M and D̄ at every grid point and pooled over {} point(s) (δ = ν except surge, whose X_|u|u the drag curve over the grid gives): {}",
+        "quadratic damping D_q|δ|δ estimated with M and D̄ at every grid point and pooled over {} point(s) ({}): {}",
         per_point.len(),
+        if at_rest(&grid) {
+            "δ = ν: at 0 m/s surge's X_|u|u too"
+        } else {
+            "δ = ν except surge, whose X_|u|u the drag curve over the grid gives"
+        },
         columns(dofs)
             .iter()
             .filter(|&&i| s[i] > 0.0)
@@ -413,7 +430,7 @@ mod tests {
     fn each_dof_gets_its_own_column_and_surge_its_remainder_about_the_grid_speed() {
         let dofs = vec![Dof::Surge, Dof::Sway, Dof::Yaw];
         // The regression's columns leave surge to the drag curve.
-        let cols = columns(&dofs);
+        let cols = columns(&dofs, &[1.0]);
         assert_eq!(cols, vec![1, 2]);
         let spec = specification(None, &surveyor_rov(), &dofs, &cols).unwrap();
         assert_eq!(spec.names, vec!["|v|v", "|r|r"]);
@@ -509,7 +526,7 @@ mod tests {
                 gamma: tau,
                 exogenous: DMatrix::zeros(n, 0),
             };
-            exps.push(append(exp, &columns(&dofs)));
+            exps.push(append(exp, &columns(&dofs, &[1.0])));
         }
         let mut settings = LambdaSettings::new(
             dofs.clone(),
@@ -520,7 +537,7 @@ mod tests {
                 DMatrix::from_element(1, 1, 300.0),
             ),
         );
-        settings.exogenous = specification(None, &surveyor_rov(), &dofs, &columns(&dofs));
+        settings.exogenous = specification(None, &surveyor_rov(), &dofs, &columns(&dofs, &[1.0]));
         let est = identify(&exps, &settings).unwrap();
         let (d_q, d_q_std) = of_estimate(&est, &dofs).unwrap();
         for (what, got, want, std) in [

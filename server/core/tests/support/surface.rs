@@ -40,6 +40,9 @@ pub struct SurfaceReport {
     /// u_r = u − u_c(ψ) (noise-free log, true current) lies below the
     /// lowest grid speed.
     pub below_grid_share: f64,
+    /// The model's surge quadratic drag D_q[surge] and its std (N·s²/m²),
+    /// when it carries one.
+    pub surge_drag: Option<(f64, f64)>,
 }
 
 impl SurfaceReport {
@@ -281,6 +284,11 @@ fn grade(
         seed,
         current_true: current_of(effects, campaign),
         current_est: out.document.lpv.as_ref().and_then(|l| l.current.clone()),
+        surge_drag: out.document.lpv.as_ref().and_then(|l| {
+            let d = l.quadratic_damping.as_ref()?.first().copied()?;
+            let s = l.quadratic_damping_std.as_ref()?.first().copied()?;
+            (d != 0.0).then_some((d, s))
+        }),
         free_run,
         notes: out.document.notes.clone(),
     };
