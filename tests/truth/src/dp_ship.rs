@@ -21,6 +21,10 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::rng::{Rng, derive_seed};
 
+mod commands;
+
+use commands::{binary, m_sequence, pitch};
+
 /// Ship length L (m).
 pub const LENGTH_M: f64 = 76.2;
 /// Gravity of the Bis units (m/s²).
@@ -167,52 +171,6 @@ impl Default for DpTrial {
     }
 }
 
-/// Feedback taps (bit positions, 1-based) of a primitive polynomial of
-/// each order 3 … 10 (x³+x²+1, x⁴+x³+1, x⁵+x³+1, x⁶+x⁵+1, x⁷+x⁶+1,
-/// x⁸+x⁶+x⁵+x⁴+1, x⁹+x⁵+1, x¹⁰+x⁷+1).
-fn taps(order: u32) -> &'static [u32] {
-    match order {
-        3 => &[3, 2],
-        4 => &[4, 3],
-        5 => &[5, 3],
-        6 => &[6, 5],
-        7 => &[7, 6],
-        8 => &[8, 6, 5, 4],
-        9 => &[9, 5],
-        10 => &[10, 7],
-        _ => panic!("PRBS order {order} is outside 3 … 10"),
-    }
-}
-
-/// One period (2ⁿ − 1 chips, ±1) of the maximum-length sequence of a
-/// Fibonacci shift register of order n from a random nonzero state.
-fn m_sequence(rng: &mut Rng, order: u32) -> Vec<f64> {
-    let m = (1usize << order) - 1;
-    let mut reg = 1 + rng.below(m as u64) as u32;
-    (0..m)
-        .map(|_| {
-            let out = reg & 1;
-            let fb = taps(order)
-                .iter()
-                .fold(0, |acc, &t| acc ^ ((reg >> (order - t)) & 1));
-            reg = (reg >> 1) | (fb << (order - 1));
-            if out == 1 { 1.0 } else { -1.0 }
-        })
-        .collect()
-}
-
-/// Commands u (n samples) holding `chips[c]`·level over chip c, slewed.
-fn binary(chips: &[f64], chip_s: f64, n: usize, level: f64, slew: f64) -> Vec<f64> {
-    let mut u = 0.0_f64;
-    (0..n)
-        .map(|k| {
-            let c = ((k as f64 + 1e-9) / chip_s).floor() as usize % chips.len();
-            u += (level * chips[c] - u).clamp(-slew, slew);
-            u
-        })
-        .collect()
-}
-
 fn mat(a: &[[f64; 3]; 3]) -> Matrix3<f64> {
     Matrix3::from_fn(|i, j| a[i][j])
 }
@@ -245,30 +203,6 @@ fn deriv(
         sn * nu[0] + cs * nu[1],
         nu[2],
     ]
-}
-
-/// Random held pitch ratios (alternating sign, |p| in `level`), slewed at
-/// 5 % per sample, zero for the first 10 samples.
-fn pitch(rng: &mut Rng, n: usize, hold: (f64, f64), level: (f64, f64)) -> Vec<f64> {
-    let mut goal = vec![0.0; n];
-    let mut k = n.min(10);
-    let mut sign = rng.sign();
-    while k < n {
-        let len = rng.range(hold.0, hold.1).round() as usize;
-        let l = sign * rng.range(level.0, level.1);
-        sign = -sign;
-        for g in goal.iter_mut().skip(k).take(len.max(1)) {
-            *g = l;
-        }
-        k += len.max(1);
-    }
-    let mut p = 0.0_f64;
-    goal.iter()
-        .map(|&g| {
-            p += (g - p).clamp(-0.05, 0.05);
-            p.abs() * p
-        })
-        .collect()
 }
 
 /// Samples of a run of `kind`.
@@ -636,103 +570,4 @@ pub fn fly_dp_campaign(trial: &DpTrial, seed: u64) -> Vec<DpLog> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A steady surge under constant thrust settles at u = K·2·c / (−A_h11·M11)
-    /// (D·ν = T·K·u with D = −A_h·M), and νᵀC(ν)ν = 0.
-    #[test]
-    fn steady_surge_and_coriolis_do_no_work() {
-        let m = mat(&M);
-        let nu = Vector3::new(0.3, -0.2, 0.05);
-        assert!(nu.dot(&coriolis(&m, &nu)).abs() < 1e-15);
-        let m_inv = m.try_inverse().unwrap();
-        let d = -mat(&A_H) * m;
-        let c = 0.25;
-        let f = Vector3::new(2.0 * K[0] * c, 0.0, 0.0);
-        let mut s = [0.0; 6];
-        let dt = 0.05;
-        for _ in 0..40_000 {
-            let k = deriv(&m_inv, &m, &d, &s, &f);
-            for i in 0..6 {
-                s[i] += dt * k[i];
-            }
-        }
-        let expected = 2.0 * K[0] * c / (-A_H[0][0] * M[0][0]);
-        assert!(
-            (s[0] / expected - 1.0).abs() < 1e-6,
-            "{} vs {expected}",
-            s[0]
-        );
-        assert!(s[1].abs() < 1e-12 && s[2].abs() < 1e-12);
-    }
-
-    #[test]
-    fn campaign_logs_position_only_at_one_hertz() {
-        let logs = fly_dp_campaign(&DpTrial::default(), 7);
-        assert_eq!(logs.len(), 7);
-        let first = &logs[0].csv;
-        assert!(first.starts_with("t,thr_1,thr_2,thr_3,thr_4,thr_5,thr_6,x,y,psi\n"));
-        assert_eq!(first.lines().count(), 601);
-        assert_eq!(logs[6].manoeuvre.family(), "validation");
-    }
-
-    /// Every order's register runs through all 2ⁿ − 1 nonzero states: the
-    /// sequence is balanced (one more +1 than −1) and has 2ⁿ⁻¹ runs.
-    #[test]
-    fn shift_register_sequences_are_maximum_length() {
-        let mut rng = Rng::new(3);
-        for order in 3..=10 {
-            let s = m_sequence(&mut rng, order);
-            let m = (1usize << order) - 1;
-            assert_eq!(s.len(), m);
-            assert_eq!(s.iter().sum::<f64>(), 1.0, "order {order}");
-            let runs = (0..m).filter(|&i| s[i] != s[(i + m - 1) % m]).count();
-            assert_eq!(runs, 1 << (order - 1), "order {order}");
-        }
-    }
-
-    #[test]
-    fn prbs_campaign_flies_binary_slewed_commands() {
-        let run = |order, chip_s, samples| PrbsRun {
-            order,
-            chip_s,
-            samples,
-        };
-        let trial = DpTrial {
-            inputs: DpInputs::Prbs {
-                level: 0.5,
-                slew: 0.1,
-                surge: run(3, 87.6, 613),
-                sway_yaw: run(5, 20.0, 620),
-                azimuth: run(5, 20.0, 620),
-                validation: run(0, 20.0, 600),
-            },
-            validation_runs: 2,
-            ..DpTrial::default()
-        };
-        let logs = fly_dp_campaign(&trial, 4);
-        assert_eq!(logs.len(), 8);
-        assert_eq!(logs[7].name, "VAL-2");
-        let col = |log: &DpLog, c: usize| -> Vec<f64> {
-            log.csv
-                .lines()
-                .skip(1)
-                .map(|l| l.split(',').nth(c).unwrap().parse().unwrap())
-                .collect()
-        };
-        assert_eq!(col(&logs[0], 1).len(), 613);
-        let stern = col(&logs[2], 3);
-        let bow = col(&logs[2], 5);
-        assert_eq!(stern.len(), 620);
-        assert!((stern[0].abs() - 0.1).abs() < 1e-9);
-        assert!(stern.iter().all(|u| u.abs() <= 0.5 + 1e-9));
-        assert!(stern.windows(2).all(|w| (w[1] - w[0]).abs() <= 0.1 + 1e-9));
-        // 31 chips of 20 s: 16 holds, each a whole number of chips.
-        let held: Vec<f64> = stern.iter().copied().filter(|u| u.abs() > 0.25).collect();
-        let flips = held.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
-        assert!((14..=16).contains(&flips), "{flips}");
-        assert_ne!(stern, bow);
-        assert!(col(&logs[4], 1).iter().all(|&u| u == 0.0));
-    }
-}
+mod tests;
