@@ -121,6 +121,30 @@ pub(crate) fn advantage(a: &[RunValidation], b: &[RunValidation]) -> (f64, usize
     (sum, n)
 }
 
+/// How many held-out fits of `augmented` on the channels `outputs` are
+/// better than `baseline`'s by more than [`FIT_NOISE`] and how many worse
+/// beyond noise (the rules of [`compare_against`]): (better, worse).
+pub(crate) fn fit_tally(
+    baseline: &[RunValidation],
+    augmented: &[RunValidation],
+    outputs: &[&str],
+) -> (usize, usize) {
+    let (mut better, mut worse) = (0, 0);
+    for (a, cb, ca) in paired(baseline, augmented) {
+        if !outputs.contains(&ca.output.as_str()) {
+            continue;
+        }
+        for c in changes(&a.run_name, cb, ca) {
+            if c.gain() < -FIT_NOISE || c.is_worse() {
+                worse += 1;
+            } else if c.gain() > FIT_NOISE {
+                better += 1;
+            }
+        }
+    }
+    (better, worse)
+}
+
 /// Each channel of `augmented`'s runs with the same run's channel of the
 /// same output in `baseline`: (run, before, after).
 pub(crate) fn paired<'a>(

@@ -30,7 +30,7 @@ use super::super::discover_gate::{HeldOutVerdict, advantage, compare_against, in
 use super::super::error::IdentifyError;
 use super::super::outcome::{Identified, RunValidation};
 use super::assemble::Assembly;
-use super::credit::{alone_advantages, confirmation, refit_gains};
+use super::credit::{Alone, alone_advantages, confirmation, refit_gains};
 use super::{EffectAcrossGrid, speeds_text};
 use crate::discrepancy::Verdict;
 use crate::discrepancy::report::ModelReport;
@@ -50,11 +50,9 @@ pub(super) struct Kept {
     /// Per effect: `Some(why)` when it is not confirmed (see
     /// [`confirmation`]).
     pub unconfirmed: Vec<Option<String>>,
-    /// Per grid speed with findings (its index in the assembly's points):
-    /// the held-out advantage of its findings alone on the baseline over
-    /// its null refit's ([`alone_advantages`]), −∞ where a fit was lost or
-    /// M is not positive definite.
-    pub alone: Vec<(usize, f64)>,
+    /// Per grid speed with findings: its findings alone on the baseline
+    /// against its null refit ([`alone_advantages`]).
+    pub alone: Vec<Alone>,
     /// (grid speed, held-out advantage) where the null refit alone is
     /// better than the baseline ([`refit_gains`]).
     pub refits: Vec<(f64, f64)>,
@@ -62,7 +60,7 @@ pub(super) struct Kept {
 
 /// What each effect was credited with: [`Kept::unconfirmed`],
 /// [`Kept::alone`], [`Kept::refits`].
-type Credit = (Vec<Option<String>>, Vec<(usize, f64)>, Vec<(f64, f64)>);
+type Credit = (Vec<Option<String>>, Vec<Alone>, Vec<(f64, f64)>);
 
 impl Kept {
     /// Nothing stored, for `reason`, with what each effect was credited.
@@ -195,14 +193,14 @@ pub(super) fn keep_better(
     } else {
         alone.iter().collect()
     };
-    let alone_gains = alone_advantages(&order, before, &models, &null_models);
+    let alone_gains = alone_advantages(asm, &order, before, &models, &null_models);
     let refits = refit_gains(asm, &order, before, &null_models);
     let unconfirmed = confirmation(asm, effects, &alone_gains);
 
     // The candidates: the speeds whose findings add to their null refit
     // (strongest evidence first), then those whose null refit alone is
     // better than the baseline.
-    let adds = |i: usize| alone_gains.iter().any(|&(j, g)| j == i && g > 0.0);
+    let adds = |i: usize| alone_gains.iter().any(|a| a.point == i && a.adds());
     let better = |i: usize| {
         refits
             .iter()
