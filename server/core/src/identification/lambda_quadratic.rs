@@ -241,7 +241,7 @@ pub(crate) fn pool(
     notes: &mut Vec<String>,
 ) -> Option<(DVector<f64>, DVector<f64>)> {
     let grid: Vec<f64> = points.iter().map(|(u0, _)| *u0).collect();
-    let columns = |dofs: &[Dof]| columns(dofs, &grid);
+    let cols = columns(dofs, &grid);
     let per_point: Vec<(DVector<f64>, DVector<f64>)> = points
         .iter()
         .filter_map(|(_, e)| of_estimate(e, dofs))
@@ -253,7 +253,7 @@ pub(crate) fn pool(
     let mut d = DVector::zeros(n);
     let mut s = DVector::zeros(n);
     let mut left_out = Vec::new();
-    for i in columns(dofs) {
+    for i in cols.iter().copied() {
         let pairs: Vec<(f64, f64)> = per_point.iter().map(|(d, s)| (d[i], s[i])).collect();
         let Some(p) = super::joint_restoring::pool(&pairs) else {
             continue;
@@ -282,7 +282,7 @@ pub(crate) fn pool(
         } else {
             "δ = ν except surge, whose X_|u|u the drag curve over the grid gives"
         },
-        columns(dofs)
+        cols
             .iter()
             .filter(|&&i| s[i] > 0.0)
             .map(|&i| format!("{} {} ± {} {}", dofs[i].name(), sig3(d[i]), sig3(s[i]), unit(dofs[i])))
