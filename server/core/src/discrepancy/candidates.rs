@@ -600,6 +600,7 @@ pub fn library(
 }
 
 mod force;
+pub use force::Trig;
 
 #[cfg(test)]
 mod tests;

@@ -70,7 +70,18 @@ pub(crate) struct Prepared<'a> {
     /// Baseline parts of the regression blocks, shared by every
     /// hypothesis that frees the same entries of a row.
     base_blocks: BaseCache,
+    /// Sines and cosines of η at the RK4 stages of each run's intervals,
+    /// by run (see `kstep`).
+    stage_trig: RefCell<HashMap<usize, Rc<Vec<[super::candidates::Trig; 3]>>>>,
+    /// C(ν)ν at the samples of each run for the last M it was built with
+    /// (that M's bits).
+    coriolis: CoriolisCache,
+    /// Weighted columns of data alone, and their products.
+    columns: blocks::ColumnCache,
 }
+
+/// C(ν)ν per sample by run, with the bits of the M it was built from.
+type CoriolisCache = RefCell<HashMap<usize, (Vec<u64>, Rc<Vec<[f64; 6]>>)>>;
 
 /// Filtered regressors by (term, coefficient, row, run).
 type RegressorCache = RefCell<HashMap<(Effect, usize, usize, usize), Rc<Vec<f64>>>>;
@@ -199,6 +210,9 @@ impl<'a> Prepared<'a> {
             hac_lags,
             regressors: RefCell::new(HashMap::new()),
             base_blocks: RefCell::new(HashMap::new()),
+            stage_trig: RefCell::new(HashMap::new()),
+            coriolis: RefCell::new(HashMap::new()),
+            columns: blocks::ColumnCache::default(),
         };
         let all: Vec<usize> = (0..records.len()).collect();
         let mut weights = vec![1.0; n];

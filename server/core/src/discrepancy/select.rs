@@ -13,6 +13,9 @@
 //! equation-error statistics only screen; held-out simulation decides, so
 //! a term that fits noise in the equation but not the vessel never joins.
 
+use std::collections::HashMap;
+use std::rc::Rc;
+
 use super::candidates::{Effect, Family, ShapeKind};
 use super::data::Record;
 use super::fit::{FitOut, Prepared, Spec, profile};
@@ -109,8 +112,51 @@ fn shape_grid(prep: &Prepared<'_>, effect: Effect, runs: &[usize], c: &Criteria)
     }
 }
 
+/// The fits of the chosen terms alone on a set of rows (and their k-step
+/// output errors), shared by the candidates of one step that act on the
+/// same rows: each candidate is judged against them.
+#[derive(Default)]
+pub(crate) struct Nulls {
+    fits: HashMap<Vec<usize>, Option<Rc<FitOut>>>,
+    ksteps: HashMap<(Vec<usize>, usize), Option<Rc<KStep>>>,
+}
+
+/// A k-step output error: its sum of squares and the residual runs.
+type KStep = (f64, Vec<Vec<f64>>);
+
+impl Nulls {
+    fn fit(
+        &mut self,
+        prep: &Prepared<'_>,
+        chosen: &[Spec],
+        rows: &[usize],
+        runs: &[usize],
+    ) -> Option<Rc<FitOut>> {
+        self.fits
+            .entry(rows.to_vec())
+            .or_insert_with(|| prep.fit(chosen, rows, runs, false).map(Rc::new))
+            .clone()
+    }
+
+    fn kstep(
+        &mut self,
+        prep: &Prepared<'_>,
+        chosen: &[Spec],
+        null: &FitOut,
+        rows: &[usize],
+        runs: &[usize],
+        k: usize,
+    ) -> Option<Rc<KStep>> {
+        self.ksteps
+            .entry((rows.to_vec(), k))
+            .or_insert_with(|| prep.kstep_rows(chosen, null, rows, runs, k).map(Rc::new))
+            .clone()
+    }
+}
+
 /// Fits `effect` on top of `chosen` over `runs`, with its statistics
 /// against `chosen` alone refitted on the same rows.
+#[cfg(test)]
 pub(crate) fn score(
     prep: &Prepared<'_>,
     chosen: &[Spec],
@@ -118,11 +164,24 @@ pub(crate) fn score(
     runs: &[usize],
     c: &Criteria,
 ) -> Option<Scored> {
+    score_against(prep, chosen, effect, runs, c, &mut Nulls::default())
+}
+
+/// [`score`] with the fits of `chosen` alone taken from (or kept in)
+/// `nulls`: the same `chosen` and `runs` for every call on one `nulls`.
+pub(crate) fn score_against(
+    prep: &Prepared<'_>,
+    chosen: &[Spec],
+    effect: Effect,
+    runs: &[usize],
+    c: &Criteria,
+    nulls: &mut Nulls,
+) -> Option<Scored> {
     let rows = effect.rows(&prep.baseline.dofs, &prep.baseline.d_bar);
     if rows.is_empty() {
         return None;
     }
-    let null = prep.fit(chosen, &rows, runs, false)?;
+    let null = nulls.fit(prep, chosen, &rows, runs)?;
     if effect.shape().is_some() {
         let grid = shape_grid(prep, effect, runs, c);
         if grid.is_empty() {
@@ -132,8 +191,9 @@ pub(crate) fn score(
         let k = c.k_step.min(4);
         let p = profile(prep, chosen, effect, &rows, runs, &grid, continuous, k)?;
         // Output-error statistics against the chosen terms alone.
-        let (s0, r0) = prep.kstep_rows(chosen, &null, &rows, runs, k)?;
-        let kappa = super::fit::long_run_inflation(&r0, prep.hac_lags.max(2 * k));
+        let null_kstep = nulls.kstep(prep, chosen, &null, &rows, runs, k)?;
+        let (s0, r0) = (null_kstep.0, &null_kstep.1);
+        let kappa = super::fit::long_run_inflation(r0, prep.hac_lags.max(2 * k));
         let n_eff = (p.n as f64 / kappa).max(2.0);
         let lr = n_eff * (s0 / p.sse.max(f64::MIN_POSITIVE)).ln();
         // An optimum on the edge of the search range is a bound, not an
@@ -295,10 +355,11 @@ pub(crate) fn step(
     c: &Criteria,
 ) -> Step {
     let taken: Vec<Effect> = chosen.iter().map(|s| s.effect).collect();
+    let mut nulls = Nulls::default();
     let mut scored: Vec<Scored> = library
         .iter()
         .filter(|e| !taken.contains(e) && !conflicts(e, &taken))
-        .filter_map(|&e| score(prep, chosen, e, runs, c))
+        .filter_map(|&e| score_against(prep, chosen, e, runs, c, &mut nulls))
         .collect();
     scored.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
     let mut evaluated = 0;

@@ -4,6 +4,43 @@
 use super::*;
 use crate::models::coriolis::coriolis_force6;
 
+/// (sin, cos) of the attitude angles φ, θ, ψ of one η: the terms' forces
+/// read them many times per state, and the loops that evaluate many terms
+/// at the same η compute them once.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Trig {
+    /// (sin φ, cos φ).
+    pub phi: (f64, f64),
+    /// (sin θ, cos θ).
+    pub theta: (f64, f64),
+    /// (sin ψ, cos ψ).
+    pub psi: (f64, f64),
+}
+
+impl Trig {
+    /// The angles of `eta` = (x, y, z, φ, θ, ψ).
+    pub fn of(eta: &[f64; 6]) -> Self {
+        Trig {
+            phi: eta[3].sin_cos(),
+            theta: eta[4].sin_cos(),
+            psi: eta[5].sin_cos(),
+        }
+    }
+}
+
+/// The body axes x and y in NED's horizontal plane, (north, east) each:
+/// the first two columns of R(Θ) = R_z(ψ)R_y(θ)R_x(φ), with a pull fixed
+/// in NED's body components their dot products with [F_N F_E].
+fn horizontal_axes(t: &Trig) -> [[f64; 2]; 2] {
+    let (sp, cp) = t.phi;
+    let (st, ct) = t.theta;
+    let (ss, cs) = t.psi;
+    [
+        [cs * ct, ss * ct],
+        [cs * st * sp - ss * cp, ss * st * sp + cs * cp],
+    ]
+}
+
 impl Effect {
     /// φ_p for coefficient `p` in equation row `row` at (ν, η), the force
     /// it adds to the left-hand side per unit coefficient. Not used for
@@ -16,6 +53,21 @@ impl Effect {
         nu: &[f64],
         eta: &[f64; 6],
     ) -> f64 {
+        self.regressor_at(p, row, ctx, nu, eta, None)
+    }
+
+    /// [`Self::regressor`] with the angles' sines and cosines given when
+    /// the caller has them (`trig` must be [`Trig::of`] `eta`).
+    pub fn regressor_at(
+        &self,
+        p: usize,
+        row: usize,
+        ctx: &TermContext<'_>,
+        nu: &[f64],
+        eta: &[f64; 6],
+        trig: Option<&Trig>,
+    ) -> f64 {
+        let trig = || trig.copied().unwrap_or_else(|| Trig::of(eta));
         let row_dof = ctx.dofs[row];
         let v = |d: Dof| ctx.dofs.iter().position(|&x| x == d).map_or(0.0, |j| nu[j]);
         match *self {
@@ -28,9 +80,8 @@ impl Effect {
             Effect::CoriolisFromM => coriolis_force6(ctx.dofs, ctx.m_ref, nu)[row_dof.index()],
             Effect::CoriolisProduct { dof, a, b } if dof == row_dof => v(a) * v(b),
             Effect::Restoring { dof, shape } if dof == row_dof => {
-                let (sp, cp) = eta[3].sin_cos();
-                let (st, ct) = eta[4].sin_cos();
-                let _ = cp;
+                let t = trig();
+                let ((sp, _), (st, ct)) = (t.phi, t.theta);
                 match shape {
                     RestoringShape::SinTheta => st,
                     RestoringShape::CosThetaSinPhi => ct * sp,
@@ -44,7 +95,7 @@ impl Effect {
                 let (du, dv) = (ctx.d_ref[(row, iu)], ctx.d_ref[(row, iv)]);
                 let (mu, mv) = (ctx.m_ref[(row, iu)], ctx.m_ref[(row, iv)]);
                 let r = v(Dof::Yaw);
-                let (s, c) = eta[5].sin_cos();
+                let (s, c) = trig().psi;
                 // The hull feels ν_r = ν − ν_c, ν_c = R(ψ)ᵀ[V_N V_E]ᵀ =
                 // [V_N c + V_E s, −V_N s + V_E c]: M ν̇_r + D̄ ν_r = τ moves
                 // −D̄ ν_c and −M ν̇_c to the right, where the current turning
@@ -56,18 +107,13 @@ impl Effect {
                 }
             }
             Effect::TetherPull => {
-                // Columns of R(Θ) = R_z(ψ)R_y(θ)R_x(φ) are the body axes in
-                // NED: the pull's body components are their dot products
-                // with [F_N F_E 0], moved to the left-hand side.
-                let (sp, cp) = eta[3].sin_cos();
-                let (st, ct) = eta[4].sin_cos();
-                let (ss, cs) = eta[5].sin_cos();
+                // The pull's body components, moved to the left-hand side.
                 let axis = match row_dof {
-                    Dof::Surge => [cs * ct, ss * ct],
-                    Dof::Sway => [cs * st * sp - ss * cp, ss * st * sp + cs * cp],
+                    Dof::Surge => 0,
+                    Dof::Sway => 1,
                     _ => return 0.0,
                 };
-                -axis[p.min(1)]
+                -horizontal_axes(&trig())[axis][p.min(1)]
             }
             _ => 0.0,
         }
@@ -75,6 +121,15 @@ impl Effect {
 }
 
 impl Effect {
+    /// Whether the term's force reads the attitude angles (through
+    /// [`Trig`]).
+    pub fn reads_attitude(&self) -> bool {
+        matches!(
+            self,
+            Effect::Restoring { .. } | Effect::Current | Effect::TetherPull
+        )
+    }
+
     /// Adds the term's force Σ_p θ_p φ_p (left-hand side) to `out`, every
     /// row at once: the same as summing [`Self::regressor`] row by row, with
     /// C(ν)ν and the current's rotation computed once per state (the
@@ -109,9 +164,10 @@ impl Effect {
                 }
             }
             _ => {
+                let trig = self.reads_attitude().then(|| Trig::of(eta));
                 for (row, o) in out.iter_mut().enumerate().take(ctx.dofs.len()) {
                     for (p, th) in theta.iter().enumerate() {
-                        *o += th * self.regressor(p, row, ctx, nu, eta);
+                        *o += th * self.regressor_at(p, row, ctx, nu, eta, trig.as_ref());
                     }
                 }
             }

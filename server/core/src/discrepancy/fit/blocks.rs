@@ -121,6 +121,78 @@ impl Prepared<'_> {
     }
 }
 
+/// A weighted regression column that depends on the data alone: its
+/// identity, under which it and its products with other such columns are
+/// kept (a product of two columns is the same in every fit that has both).
+/// Weights by their bits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(super) enum Column {
+    /// w·[sλν_j] of a run (an M entry).
+    Inertia { run: usize, w: u64, j: usize },
+    /// w·[λν_j] of a run (a D̄ entry).
+    Damping { run: usize, w: u64, j: usize },
+    /// w·[λφ_p,r] of a term whose regressor is data alone.
+    Term {
+        effect: Effect,
+        pi: usize,
+        r: usize,
+        run: usize,
+        w: u64,
+    },
+    /// w·[λ1] (a constant load).
+    Load { run: usize, w: u64 },
+}
+
+impl Column {
+    /// The columns of a baseline block freeing M columns `mf` and D̄
+    /// columns `df` (M's first, as [`BaseBlock::cols`]).
+    pub fn base(run: usize, w: f64, mf: &[usize], df: &[usize]) -> Vec<Option<Column>> {
+        let w = w.to_bits();
+        mf.iter()
+            .map(|&j| Some(Column::Inertia { run, w, j }))
+            .chain(df.iter().map(|&j| Some(Column::Damping { run, w, j })))
+            .collect()
+    }
+}
+
+/// Kept weighted columns, and the products of pairs of them.
+#[derive(Default)]
+pub(super) struct ColumnCache {
+    columns: RefCell<HashMap<Column, Rc<Vec<f64>>>>,
+    products: RefCell<HashMap<(Column, Column), f64>>,
+}
+
+impl Prepared<'_> {
+    /// w·`data` from sample `skip` on, kept under `key`.
+    pub(super) fn weighted_column(&self, key: Column, data: &[f64], w: f64) -> Rc<Vec<f64>> {
+        let cache = &self.columns.columns;
+        if let Some(c) = cache.borrow().get(&key) {
+            return Rc::clone(c);
+        }
+        let c = Rc::new(weighted(&data[self.skip..], w));
+        cache.borrow_mut().insert(key, Rc::clone(&c));
+        c
+    }
+
+    /// The kept product of two kept columns (either order: each product
+    /// is the same sum bit for bit).
+    pub(super) fn kept_product(&self, a: Option<Column>, b: Option<Column>) -> Option<f64> {
+        let (a, b) = (a?, b?);
+        let products = self.columns.products.borrow();
+        products
+            .get(&(a, b))
+            .or_else(|| products.get(&(b, a)))
+            .copied()
+    }
+
+    /// Keeps the product of two columns when both are kept ones.
+    pub(super) fn keep_product(&self, a: Option<Column>, b: Option<Column>, v: f64) {
+        if let (Some(a), Some(b)) = (a, b) {
+            self.columns.products.borrow_mut().insert((a, b), v);
+        }
+    }
+}
+
 /// `cᵀy` for every column c.
 pub(super) fn products(y: &[f64], cols: &[Rc<Vec<f64>>]) -> Vec<f64> {
     let ys: Vec<&[f64]> = cols.iter().map(|c| c.as_slice()).collect();

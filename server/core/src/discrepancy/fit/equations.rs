@@ -3,6 +3,8 @@
 //! runs, solved with Jacobi scaling, with HAC covariances.
 
 use super::*;
+use blocks::Column;
+use regressors::depends_on_data_alone;
 
 impl Prepared<'_> {
     #[allow(clippy::too_many_arguments)]
@@ -124,6 +126,9 @@ impl Prepared<'_> {
                 let y = Rc::clone(&bb.y);
                 let mut idx: Vec<usize> = (base_index[ri]..base_index[ri] + nb).collect();
                 let mut cols: Vec<Rc<Vec<f64>>> = bb.cols.clone();
+                // Columns that depend on the data alone are kept with their
+                // products (see `blocks::Column`).
+                let mut keys: Vec<Option<Column>> = Column::base(run, w, mf, df);
                 for (si, s) in specs.iter().enumerate() {
                     let nl = s.effect.n_linear();
                     if nl == 0
@@ -134,10 +139,31 @@ impl Prepared<'_> {
                     }
                     if let Effect::Coupling { from, .. } = s.effect {
                         let j = dofs.iter().position(|&d| d == from)?;
-                        idx.push(theta_index[si]);
-                        cols.push(Rc::new(weighted(&pr.dlam_nu[j][self.skip..], w)));
-                        idx.push(theta_index[si] + 1);
-                        cols.push(Rc::new(weighted(&pr.lam_nu[j][self.skip..], w)));
+                        for (q, (key, data)) in [
+                            (
+                                Column::Inertia {
+                                    run,
+                                    w: w.to_bits(),
+                                    j,
+                                },
+                                &pr.dlam_nu[j],
+                            ),
+                            (
+                                Column::Damping {
+                                    run,
+                                    w: w.to_bits(),
+                                    j,
+                                },
+                                &pr.lam_nu[j],
+                            ),
+                        ]
+                        .into_iter()
+                        .enumerate()
+                        {
+                            idx.push(theta_index[si] + q);
+                            cols.push(self.weighted_column(key, data, w));
+                            keys.push(Some(key));
+                        }
                         continue;
                     }
                     for pi in 0..nl {
@@ -147,42 +173,86 @@ impl Prepared<'_> {
                             .as_ref()
                             .filter(|_| s.effect == Effect::Current)
                             .and_then(|tw| tw.jacobian.as_ref());
-                        cols.push(Rc::new(match jac {
+                        match jac {
                             Some(j) => {
                                 let sum: Vec<f64> =
                                     f.iter().zip(&j[pi]).map(|(a, b)| a + b).collect();
-                                weighted(&sum[self.skip..], w)
+                                cols.push(Rc::new(weighted(&sum[self.skip..], w)));
+                                keys.push(None);
                             }
-                            None => weighted(&f[self.skip..], w),
-                        }));
+                            None if depends_on_data_alone(s.effect) => {
+                                let key = Column::Term {
+                                    effect: s.effect,
+                                    pi,
+                                    r,
+                                    run,
+                                    w: w.to_bits(),
+                                };
+                                cols.push(self.weighted_column(key, &f, w));
+                                keys.push(Some(key));
+                            }
+                            None => {
+                                cols.push(Rc::new(weighted(&f[self.skip..], w)));
+                                keys.push(None);
+                            }
+                        }
                     }
                 }
                 if let Some(li) = load_index[ri] {
                     idx.push(li);
-                    cols.push(Rc::new(weighted(&pr.lam_one[self.skip..], w)));
+                    let key = Column::Load {
+                        run,
+                        w: w.to_bits(),
+                    };
+                    cols.push(self.weighted_column(key, &pr.lam_one, w));
+                    keys.push(Some(key));
                 }
                 // The baseline block's products come from the cache; the
                 // terms' columns are multiplied with every column.
+                // A baseline column's product with the target is cached
+                // too (`bb.by`): out[0] is the target's only for a term.
                 let mut prods = vec![0.0; idx.len() + 1];
                 for a in 0..idx.len() {
-                    if a < nb {
-                        bvec[idx[a]] += bb.by[a];
-                    }
                     let from = a.max(nb);
-                    let ys: Vec<&[f64]> = std::iter::once(y.as_slice())
-                        .chain(cols[from..].iter().map(|c| c.as_slice()))
+                    // Products of two kept columns come from the cache.
+                    let known: Vec<Option<f64>> = (from..idx.len())
+                        .map(|b| self.kept_product(keys[a], keys[b]))
                         .collect();
-                    let out = &mut prods[..ys.len()];
-                    out.fill(0.0);
-                    crate::kernels::dots(&cols[a], &ys, out);
-                    if a >= nb {
-                        bvec[idx[a]] += out[0];
+                    let ys: Vec<&[f64]> = (a >= nb)
+                        .then_some(y.as_slice())
+                        .into_iter()
+                        .chain(
+                            cols[from..]
+                                .iter()
+                                .zip(&known)
+                                .filter(|(_, k)| k.is_none())
+                                .map(|(c, _)| c.as_slice()),
+                        )
+                        .collect();
+                    let shift = usize::from(a < nb);
+                    let mut out = vec![0.0; ys.len()];
+                    crate::kernels::dots(&cols[a], &ys, &mut out);
+                    let mut fresh = out.iter().skip(1 - shift);
+                    for (q, k) in known.iter().enumerate() {
+                        let b = from + q;
+                        prods[1 + q] = match k {
+                            Some(v) => *v,
+                            None => {
+                                let v = *fresh.next().expect("one product per unknown");
+                                self.keep_product(keys[a], keys[b], v);
+                                v
+                            }
+                        };
                     }
+                    if a >= nb {
+                        prods[0] = out[0];
+                    }
+                    bvec[idx[a]] += if a < nb { bb.by[a] } else { prods[0] };
                     for b in a..idx.len() {
                         let v = if b < nb {
                             bb.gram[a * nb + b]
                         } else {
-                            out[1 + b - from]
+                            prods[1 + b - from]
                         };
                         hmat[(idx[a], idx[b])] += v;
                         if a != b {
@@ -228,8 +298,8 @@ impl Prepared<'_> {
                     for (ti, hv) in h.iter_mut().enumerate() {
                         let c = h_inv[(t0 + ti, ia)];
                         if c != 0.0 {
-                            for k in 0..len {
-                                hv[k] += c * cols[a][k] * e[k];
+                            for ((hk, ck), ek) in hv.iter_mut().zip(&cols[a][..len]).zip(e) {
+                                *hk += c * ck * ek;
                             }
                         }
                     }

@@ -2,6 +2,7 @@
 //! profiles and the refit choice minimise.
 
 use super::*;
+use crate::discrepancy::candidates::Trig;
 
 impl Prepared<'_> {
     /// [`Self::kstep_row`] over several rows: each row's errors scaled by
@@ -116,7 +117,13 @@ impl Prepared<'_> {
                 .collect();
             let d_rr = d_row[r];
             let mut nu_buf = vec![0.0; n];
-            let mut force = |k0: usize, frac: f64, nu_r: f64, tau_a: f64| -> f64 {
+            let trig = terms
+                .iter()
+                .any(|(e, _)| e.reads_attitude())
+                .then(|| self.stage_trig(run));
+            // `stage` 0, 1, 2: the start, middle and end of interval k0.
+            let mut force = |k0: usize, stage: usize, nu_r: f64, tau_a: f64| -> f64 {
+                let frac = STAGE_FRACTIONS[stage];
                 let k1 = (k0 + 1).min(len - 1);
                 let mut fr = tau_a + ext[k0] + frac * (ext[k1] - ext[k0]) - d_rr * nu_r;
                 if !terms.is_empty() {
@@ -124,12 +131,11 @@ impl Prepared<'_> {
                         *v = rec.nu[(k0, j)] + frac * (rec.nu[(k1, j)] - rec.nu[(k0, j)]);
                     }
                     nu_buf[r] = nu_r;
-                    let eta: [f64; 6] = std::array::from_fn(|j| {
-                        rec.eta[(k0, j)] + frac * (rec.eta[(k1, j)] - rec.eta[(k0, j)])
-                    });
+                    let eta = stage_eta(rec, k0, frac);
+                    let t = trig.as_ref().map(|t| &t[k0][stage]);
                     for (e, th) in &terms {
                         for (p, c) in th.iter().enumerate() {
-                            fr -= c * e.regressor(p, r, &ctx, &nu_buf, &eta);
+                            fr -= c * e.regressor_at(p, r, &ctx, &nu_buf, &eta, t);
                         }
                     }
                 }
@@ -146,13 +152,13 @@ impl Prepared<'_> {
                     let ta = lag.unwrap_or(1.0);
                     let da = |a: f64| if lag.is_some() { (u - a) / ta } else { 0.0 };
                     let tau = |a: f64| if lag.is_some() { a } else { u };
-                    let k1x = force(step, 0.0, x, tau(a));
+                    let k1x = force(step, 0, x, tau(a));
                     let k1a = da(a);
-                    let k2x = force(step, 0.5, x + 0.5 * h * k1x, tau(a + 0.5 * h * k1a));
+                    let k2x = force(step, 1, x + 0.5 * h * k1x, tau(a + 0.5 * h * k1a));
                     let k2a = da(a + 0.5 * h * k1a);
-                    let k3x = force(step, 0.5, x + 0.5 * h * k2x, tau(a + 0.5 * h * k2a));
+                    let k3x = force(step, 1, x + 0.5 * h * k2x, tau(a + 0.5 * h * k2a));
                     let k3a = da(a + 0.5 * h * k2a);
-                    let k4x = force(step, 1.0, x + h * k3x, tau(a + h * k3a));
+                    let k4x = force(step, 2, x + h * k3x, tau(a + h * k3a));
                     let k4a = da(a + h * k3a);
                     x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
                     a += h / 6.0 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a);
@@ -167,5 +173,40 @@ impl Prepared<'_> {
             resid.push(e);
         }
         Some((sse, resid))
+    }
+}
+
+/// Where in a sample interval RK4 evaluates the force: start, middle, end.
+const STAGE_FRACTIONS: [f64; 3] = [0.0, 0.5, 1.0];
+
+/// η at fraction `frac` of interval `k0` of `rec`, linear between samples.
+fn stage_eta(rec: &Record, k0: usize, frac: f64) -> [f64; 6] {
+    let k1 = (k0 + 1).min(rec.len() - 1);
+    std::array::from_fn(|j| rec.eta[(k0, j)] + frac * (rec.eta[(k1, j)] - rec.eta[(k0, j)]))
+}
+
+impl Prepared<'_> {
+    /// [`Trig`] of η at the RK4 stages of every interval of `run`
+    /// ([`STAGE_FRACTIONS`]; the first at the sample itself), computed once
+    /// per run and kept: the k-step predictions of the profiles visit every
+    /// stage many times, and every fit with a current reads the heading's.
+    pub(super) fn stage_trig(&self, run: usize) -> Rc<Vec<[Trig; 3]>> {
+        if let Some(t) = self.stage_trig.borrow().get(&run) {
+            return Rc::clone(t);
+        }
+        let rec = &self.records[run];
+        let table: Rc<Vec<[Trig; 3]>> = Rc::new(
+            (0..rec.len())
+                .map(|k0| {
+                    [
+                        Trig::of(&rec.eta_at(k0)),
+                        Trig::of(&stage_eta(rec, k0, STAGE_FRACTIONS[1])),
+                        Trig::of(&stage_eta(rec, k0, STAGE_FRACTIONS[2])),
+                    ]
+                })
+                .collect(),
+        );
+        self.stage_trig.borrow_mut().insert(run, Rc::clone(&table));
+        table
     }
 }

@@ -115,8 +115,12 @@ pub(crate) fn profile(
                 fd = sse(d.exp());
             }
         }
-        let cand = if fc < fd { c.exp() } else { d.exp() };
-        if sse(cand) < values[ib] {
+        let (cand, f_cand) = if fc < fd {
+            (c.exp(), fc)
+        } else {
+            (d.exp(), fd)
+        };
+        if f_cand < values[ib] {
             best = cand;
         }
     }

@@ -2,6 +2,7 @@
 //! do not depend on the model being fitted, and the size of a term's force.
 
 use super::*;
+use crate::models::coriolis::coriolis_force6;
 
 impl Prepared<'_> {
     /// [λφ_p,r] of term `effect`, coefficient `pi`, row `r` on run `run`.
@@ -33,7 +34,10 @@ impl Prepared<'_> {
             return self.current_regressor(pi, r, run, ctx);
         }
         if effect == Effect::CoriolisFromM {
-            return compute();
+            let forces = self.coriolis_forces(run, ctx);
+            let i = ctx.dofs[r].index();
+            let raw: Vec<f64> = forces.iter().map(|f| f[i]).collect();
+            return Rc::new(self.svf.foh(&raw));
         }
         let key = (effect, pi, r, run);
         if let Some(f) = self.regressors.borrow().get(&key) {
@@ -42,6 +46,33 @@ impl Prepared<'_> {
         let f = compute();
         self.regressors.borrow_mut().insert(key, Rc::clone(&f));
         f
+    }
+
+    /// C(ν)ν from `ctx`'s M at every sample of `run` (six DOFs' order):
+    /// kept for the last M per run, since a fit reads it once per row.
+    fn coriolis_forces(&self, run: usize, ctx: &TermContext<'_>) -> Rc<Vec<[f64; 6]>> {
+        let key: Vec<u64> = ctx.m_ref.iter().map(|x| x.to_bits()).collect();
+        if let Some((k, f)) = self.coriolis.borrow().get(&run)
+            && *k == key
+        {
+            return Rc::clone(f);
+        }
+        let rec = &self.records[run];
+        let mut nu = vec![0.0; rec.nu.ncols()];
+        let forces: Rc<Vec<[f64; 6]>> = Rc::new(
+            (0..rec.len())
+                .map(|k| {
+                    for (j, v) in nu.iter_mut().enumerate() {
+                        *v = rec.nu[(k, j)];
+                    }
+                    coriolis_force6(ctx.dofs, ctx.m_ref, &nu)
+                })
+                .collect(),
+        );
+        self.coriolis
+            .borrow_mut()
+            .insert(run, (key, Rc::clone(&forces)));
+        forces
     }
 
     /// The current's filtered regressor for coefficient `p` in row `r`.
@@ -147,4 +178,11 @@ impl Prepared<'_> {
         }
         Some(share)
     }
+}
+
+/// Whether a term's regressor depends on the data alone, not on the M and
+/// D̄ being fitted (all but C(ν)ν from M and the current): such regressors,
+/// their weighted columns and their products are kept.
+pub(super) fn depends_on_data_alone(effect: Effect) -> bool {
+    !matches!(effect, Effect::Current | Effect::CoriolisFromM)
 }

@@ -10,7 +10,6 @@
 //! Only surge and sway feel ν_c; D_q is diagonal, so only their rows move.
 
 use super::*;
-use crate::models::current::body_current;
 use crate::models::quadratic_damping::surge_remainder;
 
 /// How the baseline's D_q|δ|δ moves one row's equation on one run.
@@ -60,10 +59,11 @@ impl Prepared<'_> {
         let len = rec.len();
         let mut shift = Vec::with_capacity(len);
         let (mut jn, mut je) = (Vec::with_capacity(len), Vec::with_capacity(len));
-        for k in 0..len {
-            let psi = rec.eta[(k, 5)];
-            let (s, c) = psi.sin_cos();
-            let (uc, vc) = body_current(at, psi);
+        let trig = self.stage_trig(run);
+        for (k, t) in trig.iter().enumerate().take(len) {
+            let (s, c) = t[0].psi;
+            // `body_current(at, ψ)` with the sine and cosine in hand.
+            let (uc, vc) = (at[0] * c + at[1] * s, -at[0] * s + at[1] * c);
             let v = rec.nu[(k, r)];
             let rel = v - if is_surge { uc } else { vc };
             // ∂ν_c,r/∂(V_N, V_E).
