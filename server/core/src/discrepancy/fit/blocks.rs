@@ -147,11 +147,43 @@ impl Column {
     /// The columns of a baseline block freeing M columns `mf` and D̄
     /// columns `df` (M's first, as [`BaseBlock::cols`]).
     pub fn base(run: usize, w: f64, mf: &[usize], df: &[usize]) -> Vec<Option<Column>> {
-        let w = w.to_bits();
         mf.iter()
-            .map(|&j| Some(Column::Inertia { run, w, j }))
-            .chain(df.iter().map(|&j| Some(Column::Damping { run, w, j })))
+            .map(|&j| Some(Column::inertia(run, w, j)))
+            .chain(df.iter().map(|&j| Some(Column::damping(run, w, j))))
             .collect()
+    }
+
+    pub fn inertia(run: usize, w: f64, j: usize) -> Column {
+        Column::Inertia {
+            run,
+            w: w.to_bits(),
+            j,
+        }
+    }
+
+    pub fn damping(run: usize, w: f64, j: usize) -> Column {
+        Column::Damping {
+            run,
+            w: w.to_bits(),
+            j,
+        }
+    }
+
+    pub fn term(effect: Effect, pi: usize, r: usize, run: usize, w: f64) -> Column {
+        Column::Term {
+            effect,
+            pi,
+            r,
+            run,
+            w: w.to_bits(),
+        }
+    }
+
+    pub fn load(run: usize, w: f64) -> Column {
+        Column::Load {
+            run,
+            w: w.to_bits(),
+        }
     }
 }
 

@@ -140,22 +140,8 @@ impl Prepared<'_> {
                     if let Effect::Coupling { from, .. } = s.effect {
                         let j = dofs.iter().position(|&d| d == from)?;
                         for (q, (key, data)) in [
-                            (
-                                Column::Inertia {
-                                    run,
-                                    w: w.to_bits(),
-                                    j,
-                                },
-                                &pr.dlam_nu[j],
-                            ),
-                            (
-                                Column::Damping {
-                                    run,
-                                    w: w.to_bits(),
-                                    j,
-                                },
-                                &pr.lam_nu[j],
-                            ),
+                            (Column::inertia(run, w, j), &pr.dlam_nu[j]),
+                            (Column::damping(run, w, j), &pr.lam_nu[j]),
                         ]
                         .into_iter()
                         .enumerate()
@@ -173,52 +159,38 @@ impl Prepared<'_> {
                             .as_ref()
                             .filter(|_| s.effect == Effect::Current)
                             .and_then(|tw| tw.jacobian.as_ref());
-                        match jac {
+                        let (col, key) = match jac {
                             Some(j) => {
                                 let sum: Vec<f64> =
                                     f.iter().zip(&j[pi]).map(|(a, b)| a + b).collect();
-                                cols.push(Rc::new(weighted(&sum[self.skip..], w)));
-                                keys.push(None);
+                                (Rc::new(weighted(&sum[self.skip..], w)), None)
                             }
                             None if depends_on_data_alone(s.effect) => {
-                                let key = Column::Term {
-                                    effect: s.effect,
-                                    pi,
-                                    r,
-                                    run,
-                                    w: w.to_bits(),
-                                };
-                                cols.push(self.weighted_column(key, &f, w));
-                                keys.push(Some(key));
+                                let key = Column::term(s.effect, pi, r, run, w);
+                                (self.weighted_column(key, &f, w), Some(key))
                             }
-                            None => {
-                                cols.push(Rc::new(weighted(&f[self.skip..], w)));
-                                keys.push(None);
-                            }
-                        }
+                            None => (Rc::new(weighted(&f[self.skip..], w)), None),
+                        };
+                        cols.push(col);
+                        keys.push(key);
                     }
                 }
                 if let Some(li) = load_index[ri] {
                     idx.push(li);
-                    let key = Column::Load {
-                        run,
-                        w: w.to_bits(),
-                    };
+                    let key = Column::load(run, w);
                     cols.push(self.weighted_column(key, &pr.lam_one, w));
                     keys.push(Some(key));
                 }
-                // The baseline block's products come from the cache; the
-                // terms' columns are multiplied with every column.
-                // A baseline column's product with the target is cached
-                // too (`bb.by`): out[0] is the target's only for a term.
-                let mut prods = vec![0.0; idx.len() + 1];
+                // The baseline block's products (with each other and with
+                // the target) come from its cache, products of two kept
+                // columns from theirs; the rest are computed here.
                 for a in 0..idx.len() {
                     let from = a.max(nb);
-                    // Products of two kept columns come from the cache.
                     let known: Vec<Option<f64>> = (from..idx.len())
                         .map(|b| self.kept_product(keys[a], keys[b]))
                         .collect();
-                    let ys: Vec<&[f64]> = (a >= nb)
+                    let with_target = a >= nb;
+                    let ys: Vec<&[f64]> = with_target
                         .then_some(y.as_slice())
                         .into_iter()
                         .chain(
@@ -229,30 +201,30 @@ impl Prepared<'_> {
                                 .map(|(c, _)| c.as_slice()),
                         )
                         .collect();
-                    let shift = usize::from(a < nb);
                     let mut out = vec![0.0; ys.len()];
                     crate::kernels::dots(&cols[a], &ys, &mut out);
-                    let mut fresh = out.iter().skip(1 - shift);
-                    for (q, k) in known.iter().enumerate() {
-                        let b = from + q;
-                        prods[1 + q] = match k {
-                            Some(v) => *v,
-                            None => {
+                    let (target, mut fresh) = if with_target {
+                        (out[0], out[1..].iter())
+                    } else {
+                        (bb.by[a], out.iter())
+                    };
+                    bvec[idx[a]] += target;
+                    let prods: Vec<f64> = known
+                        .iter()
+                        .zip(from..)
+                        .map(|(k, b)| {
+                            k.unwrap_or_else(|| {
                                 let v = *fresh.next().expect("one product per unknown");
                                 self.keep_product(keys[a], keys[b], v);
                                 v
-                            }
-                        };
-                    }
-                    if a >= nb {
-                        prods[0] = out[0];
-                    }
-                    bvec[idx[a]] += if a < nb { bb.by[a] } else { prods[0] };
+                            })
+                        })
+                        .collect();
                     for b in a..idx.len() {
                         let v = if b < nb {
                             bb.gram[a * nb + b]
                         } else {
-                            prods[1 + b - from]
+                            prods[b - from]
                         };
                         hmat[(idx[a], idx[b])] += v;
                         if a != b {
