@@ -157,10 +157,11 @@ fn the_current_regressor_from_kept_signals_is_the_filtered_direct_one() {
     }
 }
 
-/// The baseline blocks kept between fits (`fit/blocks.rs`) change no
-/// result: a fit whose actuator hypothesis reshapes the target, then one
-/// on the logged τ, give bit for bit what each gives on a fresh
-/// preparation, and a repeated fit gives the same again.
+/// The baseline blocks, term columns and their products kept between fits
+/// (`fit/blocks.rs`) change no result: a fit whose actuator hypothesis
+/// reshapes the target, then one on the logged τ, give bit for bit what
+/// each gives on a fresh preparation, and a repeated fit (its products now
+/// all kept) gives the same again.
 #[test]
 fn fits_from_kept_baseline_blocks_equal_fresh_ones() {
     let nu = |t: f64| {
@@ -197,6 +198,10 @@ fn fits_from_kept_baseline_blocks_equal_fresh_ones() {
     same(
         &prep.fit(&[lag], &[], &[0], true).expect("lag again"),
         &lagged,
+    );
+    same(
+        &prep.fit(&[quad], &[], &[0], true).expect("quad again"),
+        &plain,
     );
     // The lag reshapes the target: its fit is not the plain one's.
     assert_ne!(lagged.sse.to_bits(), plain.sse.to_bits());
