@@ -70,6 +70,19 @@ fn cases(seed: u64) -> Vec<(&'static str, Effects)> {
     ]
 }
 
+/// The Otter's campaign under `effects`, its turns flown at one
+/// amplitude (the identification proof flies two). With two, seed 1's
+/// concealed current is named at 0.30 m/s but taken for a pull fixed in
+/// NED at 0.55 m/s, and no campaign estimate is pooled: the look-alikes
+/// are not yet told apart there.
+fn otter_trial(effects: Effects) -> UsvTrial {
+    UsvTrial {
+        effects,
+        yaw_second_half: 1.0,
+        ..UsvTrial::default()
+    }
+}
+
 /// Discovery on the λ model `base` of `runs`, printed as a table row.
 /// Discovery as the service runs it: with the model's own identification
 /// settings (`identified_with`).
@@ -188,12 +201,9 @@ fn otter_discovered() -> &'static [Case] {
                     },
                 ),
             ] {
+                let trial = otter_trial(effects);
                 let (report, base) =
-                    otter_case(label, &vessel, effects, seed, &[0.3, 0.55, 0.8], &settings);
-                let trial = UsvTrial {
-                    effects,
-                    ..UsvTrial::default()
-                };
+                    otter_case(label, &vessel, &trial, seed, &[0.3, 0.55, 0.8], &settings);
                 let profile = otter_profile(&vessel);
                 let runs = inputs(&profile, &fly_usv_campaign(&vessel, &trial, seed));
                 out.push(examine(report, base, &profile, &runs, &settings));
@@ -221,18 +231,15 @@ fn otter_concealed_current() -> &'static [Case] {
                 let vessel = usv::otter().draw(seed);
                 let effects = Effects::all(Current::random_constant(seed + 100, 0.05, 0.3));
                 let grid = otter_grid(&vessel, &effects);
+                let trial = otter_trial(effects);
                 let (report, base) = otter_case(
                     "Otter all, current concealed",
                     &vessel,
-                    effects,
+                    &trial,
                     seed,
                     &grid,
                     &settings,
                 );
-                let trial = UsvTrial {
-                    effects,
-                    ..UsvTrial::default()
-                };
                 let profile = otter_profile(&vessel);
                 let runs = inputs(&profile, &fly_usv_campaign(&vessel, &trial, seed));
                 examine(report, base, &profile, &runs, &settings)

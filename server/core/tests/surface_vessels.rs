@@ -15,7 +15,7 @@
 mod support;
 
 use seatrial_core::identification::LambdaCampaignSettings;
-use seatrial_truth::usv::{self, Current, Effects};
+use seatrial_truth::usv::{self, Current, Effects, UsvTrial};
 use support::surface::{SurfaceReport, otter_case, otter_grid, supply_case};
 
 const SEEDS: [u64; 5] = [1, 2, 3, 4, 5];
@@ -175,7 +175,11 @@ fn otter_reports() -> &'static [SurfaceReport] {
             let vessel = usv::otter().draw(seed);
             for (label, effects) in otter_cases(seed) {
                 let grid = otter_grid(&vessel, &effects);
-                let (r, _) = otter_case(label, &vessel, effects, seed, &grid, &settings);
+                let trial = UsvTrial {
+                    effects,
+                    ..UsvTrial::default()
+                };
+                let (r, _) = otter_case(label, &vessel, &trial, seed, &grid, &settings);
                 println!("{} gap {:.3}", r.line(), r.worst_gap().unwrap_or(f64::NAN));
                 out.push(r);
             }
@@ -210,11 +214,15 @@ fn the_otter_without_a_current_comes_within_five_hundredths() {
     }
 }
 
-/// The Otter in a current: the current within 5 % and 3° on every seed;
-/// the free runs, whose heading (and with it the current's push in the
+/// The Otter in a current: the current within 5 % and 3° on every seed,
+/// and the free runs, whose heading (and with it the current's push in the
 /// body frame) the model integrates over 180 s, within 0.05 of the true
-/// model's on 4 of 6 seeds and within 0.1 on all (measured: 0.013–0.072;
-/// seed 4's 0.29 m/s current, near its slowest level, 0.072).
+/// model's on every seed (measured: 0.006–0.048; seed 4's 0.29 m/s
+/// current, near its slowest level, 0.048). Two things carry it: turns
+/// flown at two amplitudes (at one, the model fitted there damped smaller
+/// turns too much and its heading drifted: seeds 2 and 4 0.051 and
+/// 0.072), and C(δ)δ, which acts through the never-forced sway mass, kept
+/// only where it earns its place on the held-out runs.
 #[test]
 fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
     let current: Vec<&SurfaceReport> = otter_reports()
@@ -222,7 +230,6 @@ fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
         .filter(|r| r.current_true.is_some())
         .collect();
     assert_eq!(current.len(), OTTER_SEEDS.len());
-    let mut close = 0;
     for r in &current {
         let (speed, dir) = r.current_true.expect("flown");
         let est = r.current_est.as_ref().unwrap_or_else(|| {
@@ -248,16 +255,14 @@ fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
         );
         let gap = r.worst_gap().expect("every channel has a free run");
         assert!(
-            gap <= 0.1,
+            gap <= 0.05,
             "seed {}: {}\n{}",
             r.seed,
             r.line(),
             r.notes.join("\n")
         );
-        close += usize::from(gap <= 0.05);
         below_grid_note_is_true(r);
     }
-    assert!(close >= 4, "{close} of {} seeds within 0.05", current.len());
 }
 
 /// The note on how much of the held-out run lies below the grid speaks of

@@ -526,8 +526,14 @@ fn identify(
     }
     let validate_with = |lpv: &LpvModel| held_out.validate(lpv);
     let requested = second_order;
-    let (lpv, validation, second_order) =
-        choose_second_order(lpv, validation, second_order, &validate_with, &mut notes)?;
+    let (lpv, validation, second_order) = choose_second_order(
+        lpv,
+        validation,
+        second_order,
+        &unforced,
+        &validate_with,
+        &mut notes,
+    )?;
     // Left out, C(δ)δ had still been known in the sub-models' fits (its
     // force moved to the known side): refitted without it, they absorb
     // what it explained. The better of the two on the held-out runs stays.

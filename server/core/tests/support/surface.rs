@@ -22,7 +22,8 @@ use seatrial_core::planning::vessel::{
 };
 use seatrial_core::validation::nrmse_fit;
 use seatrial_truth::usv::{
-    Current, Effects, Noise, SupplyTrial, SurfaceCampaign, SurfaceVessel, fly_supply_campaign,
+    Current, Effects, Noise, SupplyTrial, SurfaceCampaign, SurfaceVessel, UsvTrial,
+    fly_supply_campaign, fly_usv_campaign,
 };
 
 /// One graded identification.
@@ -318,27 +319,22 @@ pub fn otter_profile(vessel: &SurfaceVessel) -> VesselProfile {
     }
 }
 
-/// Identifies the Otter campaign of `vessel` under `effects` on `grid`
+/// Identifies the Otter campaign of `vessel` flown as `trial` on `grid`
 /// and grades it.
 pub fn otter_case(
     label: &str,
     vessel: &SurfaceVessel,
-    effects: Effects,
+    trial: &UsvTrial,
     seed: u64,
     grid: &[f64],
     settings: &LambdaCampaignSettings,
 ) -> (SurfaceReport, Identified) {
-    use seatrial_truth::usv::{UsvTrial, fly_usv_campaign};
-    let trial = UsvTrial {
-        effects,
-        ..UsvTrial::default()
-    };
-    let campaign = fly_usv_campaign(vessel, &trial, seed);
+    let campaign = fly_usv_campaign(vessel, trial, seed);
     let exact = fly_usv_campaign(
         vessel,
         &UsvTrial {
             noise: Noise::NONE,
-            ..trial
+            ..*trial
         },
         seed,
     );
@@ -346,7 +342,7 @@ pub fn otter_case(
     grade(
         label,
         seed,
-        &effects,
+        &trial.effects,
         &profile,
         grid,
         (&campaign, &exact),

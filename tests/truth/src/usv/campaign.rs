@@ -17,7 +17,8 @@
 //!   both propellers on one command, a level (three speed levels) plus a
 //!   PRBS; `turn-1…3` (`dynamic`): the same levels held in common with a
 //!   differential PRBS — a yaw-moment PRBS at a mean forward thrust, since
-//!   the Otter turns only with speed and sways only through yaw; `VAL`
+//!   the Otter turns only with speed and sways only through yaw — at two
+//!   amplitudes, the second half at [`UsvTrial::yaw_second_half`]; `VAL`
 //!   (`validation`): common and differential commands at independent random
 //!   held levels.
 //! - Supply vessel ([`fly_supply_campaign`], 1 Hz): `SI1-r` (`dp_surge`):
@@ -101,9 +102,16 @@ pub struct UsvTrial {
     pub levels: [f64; 3],
     /// PRBS amplitude on the common command in surge runs.
     pub surge_amplitude: f64,
-    /// PRBS amplitude of the differential command in turn runs (±0.1:
-    /// τ_N = ±9.5 N·m, r up to ≈ 0.2 rad/s).
+    /// PRBS amplitude of the differential command in the turn runs' first
+    /// half and the validation run's range (±0.1: τ_N = ±9.5 N·m, r up to
+    /// ≈ 0.2 rad/s).
     pub yaw_amplitude: f64,
+    /// The differential amplitude of each turn run's second half, as a
+    /// fraction of [`UsvTrial::yaw_amplitude`] (1: one amplitude). Crews
+    /// fly turns at two sizes (zig-zag 20/20 then 10/10): one amplitude
+    /// makes a damping that grows with |r| indistinguishable from a
+    /// linear one (|r|v ≈ a·v).
+    pub yaw_second_half: f64,
     /// PRBS chip (s).
     pub chip_s: f64,
     /// Length of each surge and turn run (s).
@@ -121,6 +129,7 @@ impl Default for UsvTrial {
             levels: [0.10, 0.18, 0.26],
             surge_amplitude: 0.04,
             yaw_amplitude: 0.1,
+            yaw_second_half: 0.5,
             chip_s: 1.5,
             run_s: 120.0,
             validation_s: 180.0,
@@ -325,8 +334,19 @@ pub fn fly_usv_campaign(vessel: &SurfaceVessel, trial: &UsvTrial, seed: u64) -> 
             h,
             trial.chip_s,
         );
-        let a = trial.yaw_amplitude;
-        let c = p.iter().map(|&p| [level + a * p, level - a * p]).collect();
+        let c = p
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| {
+                let a = trial.yaw_amplitude
+                    * if 2 * k < n {
+                        1.0
+                    } else {
+                        trial.yaw_second_half
+                    };
+                [level + a * p, level - a * p]
+            })
+            .collect();
         runs.push(fly_run(
             &sim,
             ctx,
