@@ -8,6 +8,7 @@ pub mod auth;
 pub mod finite;
 pub mod flights;
 pub mod jobs;
+pub mod manage;
 pub mod sim;
 
 use std::sync::Arc;

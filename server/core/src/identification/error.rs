@@ -51,3 +51,13 @@ impl From<Cancelled> for IdentifyError {
         IdentifyError::Cancelled
     }
 }
+
+/// A λ-filter estimation's failure, naming its field.
+impl From<crate::estimation::lambda::LambdaError> for IdentifyError {
+    fn from(e: crate::estimation::lambda::LambdaError) -> Self {
+        match e {
+            crate::estimation::lambda::LambdaError::Cancelled => IdentifyError::Cancelled,
+            e => IdentifyError::invalid(e.field().to_string(), e.to_string()),
+        }
+    }
+}

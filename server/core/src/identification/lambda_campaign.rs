@@ -39,13 +39,6 @@ use crate::validation::ValidationSettings;
 
 pub use super::lambda_settings::{LambdaCampaignSettings, SchedulingChoice, StructureChoice};
 
-fn lambda_error(e: crate::estimation::lambda::LambdaError) -> IdentifyError {
-    match e {
-        crate::estimation::lambda::LambdaError::Cancelled => IdentifyError::Cancelled,
-        e => IdentifyError::invalid(e.field().to_string(), e.to_string()),
-    }
-}
-
 /// Runs the λ-filter identification of a campaign.
 ///
 /// `inputs` are the generalized-force columns in the order of
@@ -292,8 +285,7 @@ fn identify(
             coriolis_from_m,
             &mut sub,
             &mut notes,
-        )
-        .map_err(lambda_error)?;
+        )?;
         lambda_settings.second_order_coriolis = second;
         joint
     } else {
@@ -386,8 +378,7 @@ fn identify(
             coriolis_from_m,
             &mut sub,
             &mut fit_notes,
-        )
-        .map_err(lambda_error)?
+        )?
     };
     // Surge's X_|u|u from the drag curve over the grid, then the
     // sub-models refitted with the remainder beyond each tangent known.
@@ -410,8 +401,7 @@ fn identify(
             coriolis_from_m,
             &mut sub,
             &mut fit_notes,
-        )
-        .map_err(lambda_error)?;
+        )?;
         notes.push(format!(
             "surge's quadratic drag X_|u|u = {} ± {} N·s²/m² from the drag curve over the grid speeds (half the slope of D̄[surge,surge] over u₀: each sub-model's tangent of X_u·u + X_|u|u·|u|u); the sub-models were refitted with the rest of it beyond each tangent, X_|u|u(u − u₀)², which their load would otherwise absorb as X_|u|u times the surge runs' mean square excursion",
             sig3(x),
