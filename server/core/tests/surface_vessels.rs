@@ -153,8 +153,9 @@ fn quadratic_surge_drag_is_named_in_dp_where_it_acts() {
 const OTTER_SEEDS: [u64; 6] = [1, 2, 3, 4, 5, 6];
 
 /// The Otter's cases: the clean hull, every effect but a current (Munk
-/// moment, quadratic surge, cross-flow drag), and every effect in the
-/// seed's constant current of 0.05–0.3 m/s (up to its slowest level).
+/// moment, quadratic surge, cross-flow drag), every effect in the seed's
+/// constant current of 0.05–0.3 m/s (up to its slowest level), and in one
+/// of 0.3–0.5 m/s (up to 1.6 times its slowest level).
 fn otter_cases(seed: u64) -> Vec<(&'static str, Effects)> {
     vec![
         ("Otter clean", Effects::CLEAN),
@@ -162,6 +163,10 @@ fn otter_cases(seed: u64) -> Vec<(&'static str, Effects)> {
         (
             "Otter all",
             Effects::all(Current::random_constant(seed + 100, 0.05, 0.3)),
+        ),
+        (
+            "Otter strong current",
+            Effects::all(Current::random_constant(seed + 100, 0.3, 0.5)),
         ),
     ]
 }
@@ -227,32 +232,11 @@ fn the_otter_without_a_current_comes_within_five_hundredths() {
 fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
     let current: Vec<&SurfaceReport> = otter_reports()
         .iter()
-        .filter(|r| r.current_true.is_some())
+        .filter(|r| r.label == "Otter all")
         .collect();
     assert_eq!(current.len(), OTTER_SEEDS.len());
     for r in &current {
-        let (speed, dir) = r.current_true.expect("flown");
-        let est = r.current_est.as_ref().unwrap_or_else(|| {
-            panic!(
-                "{} seed {}: no current\n{}",
-                r.label,
-                r.seed,
-                r.notes.join("\n")
-            )
-        });
-        let err = r.current_error().expect("both");
-        assert!(
-            err.abs() <= 0.05,
-            "seed {}: {:.3} m/s against {speed:.3}",
-            r.seed,
-            est.speed_mps
-        );
-        let d = (est.direction_deg - dir.to_degrees()).rem_euclid(360.0);
-        assert!(
-            d.min(360.0 - d) <= 3.0,
-            "seed {}: direction off by {d:.1}°",
-            r.seed
-        );
+        assert_current_within_five_percent_and_three_degrees(r);
         let gap = r.worst_gap().expect("every channel has a free run");
         assert!(
             gap <= 0.05,
@@ -263,6 +247,62 @@ fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
         );
         below_grid_note_is_true(r);
     }
+}
+
+/// The Otter in a current of 0.3–0.5 m/s, as strong as its slowest level
+/// or stronger: the current is still found within 5 % and 3° on every
+/// seed (measured: within 0.6 % and 1°) and every channel has a finite
+/// free run. The whole-run free runs are not yet within 0.05 of the true
+/// model's (measured gaps 0.023–0.396; seeds 3 and 6 0.225 and 0.396):
+/// with the current as fast as the hull, a small error in the model's own
+/// heading turns a push as large as its speed through the water.
+#[test]
+fn the_otter_in_a_strong_current_finds_it() {
+    let strong: Vec<&SurfaceReport> = otter_reports()
+        .iter()
+        .filter(|r| r.label == "Otter strong current")
+        .collect();
+    assert_eq!(strong.len(), OTTER_SEEDS.len());
+    for r in &strong {
+        assert_current_within_five_percent_and_three_degrees(r);
+        assert!(
+            r.free_run
+                .iter()
+                .all(|(_, m, _)| m.is_some_and(f64::is_finite)),
+            "seed {}: {}",
+            r.seed,
+            r.line()
+        );
+    }
+}
+
+/// The Otter's current named once for the campaign, its speed within 5 %
+/// and its direction within 3° of the truth.
+fn assert_current_within_five_percent_and_three_degrees(r: &SurfaceReport) {
+    let (speed, dir) = r.current_true.expect("flown");
+    let est = r.current_est.as_ref().unwrap_or_else(|| {
+        panic!(
+            "{} seed {}: no current\n{}",
+            r.label,
+            r.seed,
+            r.notes.join("\n")
+        )
+    });
+    let err = r.current_error().expect("both");
+    assert!(
+        err.abs() <= 0.05,
+        "{} seed {}: {:.3} m/s against {speed:.3}",
+        r.label,
+        r.seed,
+        est.speed_mps
+    );
+    let d = (est.direction_deg - dir.to_degrees()).rem_euclid(360.0);
+    assert!(
+        d.min(360.0 - d) <= 3.0,
+        "{} seed {}: direction off by {d:.1}°",
+        r.label,
+        r.seed
+    );
 }
 
 /// The note on how much of the held-out run lies below the grid speaks of
