@@ -355,7 +355,7 @@ pub fn otter_case(
 /// (both propellers at the level), to the nearest 0.05 m/s — what the
 /// surge runs' mean speeds show in still water.
 pub fn otter_grid(vessel: &SurfaceVessel, effects: &Effects) -> Vec<f64> {
-    use seatrial_truth::usv::{OTTER_THRUST_N, UsvTrial};
+    use seatrial_truth::usv::OTTER_THRUST_N;
     UsvTrial::default()
         .levels
         .iter()
