@@ -222,12 +222,14 @@ fn the_otter_without_a_current_comes_within_five_hundredths() {
 /// The Otter in a current: the current within 5 % and 3° on every seed,
 /// and the free runs, whose heading (and with it the current's push in the
 /// body frame) the model integrates over 180 s, within 0.05 of the true
-/// model's on every seed (measured: 0.006–0.048; seed 4's 0.29 m/s
-/// current, near its slowest level, 0.048). Two things carry it: turns
+/// model's on every seed (measured: 0.003–0.049; seed 4's 0.29 m/s
+/// current, near its slowest level, 0.049). Three things carry it: turns
 /// flown at two amplitudes (at one, the model fitted there damped smaller
 /// turns too much and its heading drifted: seeds 2 and 4 0.051 and
-/// 0.072), and C(δ)δ, which acts through the never-forced sway mass, kept
-/// only where it earns its place on the held-out runs.
+/// 0.072), C(δ)δ, which acts through the never-forced sway mass, kept
+/// only where it earns its place on the held-out runs, and the sub-models
+/// fitted and stepped on the velocity through the water, so that the
+/// current's rotation ν̇_c does not act through that mass either.
 #[test]
 fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
     let current: Vec<&SurfaceReport> = otter_reports()
@@ -251,11 +253,14 @@ fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
 
 /// The Otter in a current of 0.3–0.5 m/s, as strong as its slowest level
 /// or stronger: the current is still found within 5 % and 3° on every
-/// seed (measured: within 0.6 % and 1°) and every channel has a finite
-/// free run. The whole-run free runs are not yet within 0.05 of the true
-/// model's (measured gaps 0.023–0.396; seeds 3 and 6 0.225 and 0.396):
-/// with the current as fast as the hull, a small error in the model's own
-/// heading turns a push as large as its speed through the water.
+/// seed (measured: within 0.6 % and 1°), and the whole-run free runs come
+/// within 0.05 of the true model's on 5 of 6 seeds and within 0.1 on all
+/// (measured gaps 0.015 0.003 0.010 0.062 0.018 0.044; seed 4, a 0.495 m/s
+/// current, 0.062). With the current as fast as the hull, a small error in
+/// the model's own heading turns a push as large as its speed through the
+/// water. Before the sub-models were fitted and stepped on ν_r the gaps
+/// were 0.023–0.396: the current's rotation M ν̇_c acted through the sway
+/// mass no run forced, which the grid points then estimated at 45–105 kg.
 #[test]
 fn the_otter_in_a_strong_current_finds_it() {
     let strong: Vec<&SurfaceReport> = otter_reports()
@@ -263,17 +268,24 @@ fn the_otter_in_a_strong_current_finds_it() {
         .filter(|r| r.label == "Otter strong current")
         .collect();
     assert_eq!(strong.len(), OTTER_SEEDS.len());
+    let mut within = 0;
     for r in &strong {
         assert_current_within_five_percent_and_three_degrees(r);
+        let gap = r.worst_gap().expect("every channel has a free run");
         assert!(
-            r.free_run
-                .iter()
-                .all(|(_, m, _)| m.is_some_and(f64::is_finite)),
-            "seed {}: {}",
+            gap <= 0.1,
+            "seed {}: {}\n{}",
             r.seed,
-            r.line()
+            r.line(),
+            r.notes.join("\n")
         );
+        within += usize::from(gap <= 0.05);
     }
+    assert!(
+        within + 1 >= strong.len(),
+        "{within} of {} within 0.05",
+        strong.len()
+    );
 }
 
 /// The Otter's current named once for the campaign, its speed within 5 %

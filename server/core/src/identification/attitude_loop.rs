@@ -57,16 +57,14 @@ impl AttitudeLoop {
         })
     }
 
-    /// The model in a current fixed in NED, V = [V_N, V_E] (m/s), with F
-    /// (6 × 2) per grid point ([`super::ned_current`]); `None` as for
-    /// [`AttitudeLoop::new`] or when the forces do not fit the grid.
+    /// The model in a current fixed in NED, V = [V_N, V_E] (m/s)
+    /// ([`super::ned_current`]); `None` as for [`AttitudeLoop::new`].
     pub fn with_current(
         lpv: LpvModel,
         restoring: RestoringParams,
-        forces: Vec<DMatrix<f64>>,
         v: nalgebra::Vector2<f64>,
     ) -> Option<Self> {
-        let current = Some(HeadingLoop::new(lpv.clone(), forces, v)?);
+        let current = Some(HeadingLoop::new(lpv.clone(), v)?);
         Some(AttitudeLoop {
             current,
             ..Self::new(lpv, restoring)?
@@ -88,26 +86,18 @@ impl AttitudeLoop {
         DVector::from_column_slice(&self.restoring.g(&[0.0, 0.0, 0.0, phi, theta, 0.0]))
     }
 
-    /// The forces besides τ at ν and the attitude: −g(η), and the current's
-    /// force of the heading when there is one.
-    fn load(&self, nu: &DVector<f64>, (phi, theta, psi): Euler) -> DVector<f64> {
-        let g = -self.g((phi, theta));
+    /// ν_c of the current at the attitude, zero without one.
+    fn nu_c(&self, (phi, theta, psi): Euler) -> DVector<f64> {
         match &self.current {
-            Some(c) => g + c.drive(nu, psi),
-            None => g,
+            Some(c) => c.nu_c_tilted(phi, theta, psi),
+            None => DVector::zeros(6),
         }
     }
 
-    /// The speed the sub-models are scheduled on: through the water in a
-    /// current, else u.
-    fn speed(&self, nu: &DVector<f64>, psi: f64) -> f64 {
-        match &self.current {
-            Some(c) => c.speed(nu, psi),
-            None => nu[0],
-        }
-    }
-
-    /// ν(k+1) and the attitude at k+1 from ν(k), the attitude at k and τ(k).
+    /// ν(k+1) and the attitude at k+1 from ν(k), the attitude at k and τ(k):
+    /// the LPV model steps the velocity through the water ν_r = ν − ν_c(ψ)
+    /// (as it was fitted, scheduled on u_r) with −g(η) of the attitude
+    /// (Heun over the step), then ν(k+1) = ν_r(k+1) + ν_c(ψ(k+1)).
     fn step(
         &self,
         lpv: &DiscreteLpv,
@@ -117,7 +107,8 @@ impl AttitudeLoop {
         tau: &DVector<f64>,
     ) -> (DVector<f64>, Euler) {
         let scheduling = self.lpv.scheduling();
-        let speed = Some(self.speed(nu, att.2));
+        let nu_r = nu - self.nu_c(att);
+        let speed = Some(nu_r[0]);
         let advance = |a: Euler, r0: Euler, r1: Euler| {
             (
                 a.0 + 0.5 * h * (r0.0 + r1.0),
@@ -125,19 +116,21 @@ impl AttitudeLoop {
                 a.2 + 0.5 * h * (r0.2 + r1.2),
             )
         };
-        let f0 = self.load(nu, att);
+        // The body rates of ν_r are those of ν: the attitude follows either.
+        let f0 = -self.g((att.0, att.1));
         let rate0 = euler_rate(att, nu);
-        let nu_p = lpv.step_at(nu, &(tau + &f0), scheduling, speed);
+        let nu_p = lpv.step_at(&nu_r, &(tau + &f0), scheduling, speed);
         let att_p = (
             att.0 + h * rate0.0,
             att.1 + h * rate0.1,
             att.2 + h * rate0.2,
         );
         let att_end = advance(att, rate0, euler_rate(att_p, &nu_p));
-        let f1 = self.load(&nu_p, att_end);
-        let next = lpv.step_at(nu, &(tau + (&f0 + &f1) * 0.5), scheduling, speed);
-        let rate1 = euler_rate(att_end, &next);
-        (next, advance(att, rate0, rate1))
+        let f1 = -self.g((att_end.0, att_end.1));
+        let next_r = lpv.step_at(&nu_r, &(tau + (&f0 + &f1) * 0.5), scheduling, speed);
+        let rate1 = euler_rate(att_end, &next_r);
+        let att_next = advance(att, rate0, rate1);
+        (next_r + self.nu_c(att_next), att_next)
     }
 
     /// The record's τ (first six columns) and measured attitude, or `None`
@@ -371,14 +364,7 @@ mod tests {
             }
         }
         let base = model();
-        let d_bar = DMatrix::from_diagonal(&DVector::from_column_slice(&D));
-        let forces = vec![crate::identification::ned_current::force(
-            &d_bar,
-            &Dof::ALL,
-            &v,
-        )];
-        let drifting =
-            AttitudeLoop::with_current(base.lpv.clone(), base.restoring, forces, v).unwrap();
+        let drifting = AttitudeLoop::with_current(base.lpv.clone(), base.restoring, v).unwrap();
         let y = DMatrix::from_fn(n, 6, |k, j| truth[k][j]);
         let u = DMatrix::from_fn(n, 12, |k, j| match j {
             5 => tau_n,

@@ -1,19 +1,19 @@
 //! A horizontal LPV model in a current fixed in NED, with the heading in the
 //! loop: M ν̇_r + C(ν_r)ν_r + D̄ ν_r + b = τ, ψ̇ = r, ν_r = ν − ν_c(ψ)
-//! ([`super::ned_current`]: D̄ ν_c = −F(u)·e(ψ), e(ψ) = [cos ψ, sin ψ]ᵀ,
-//! F = −D̄_{:,uv}·Q(V); C only when the model carries C(δ)δ).
+//! (C only when the model carries C(δ)δ).
 //!
-//! The current's force turns with the vessel, so a free run integrates ψ
-//! from the model's own yaw rate; the measured ψ only starts a prediction.
-//! One step holds τ (ZOH) and averages F·e(ψ) over the step (trapezoid, the
-//! identification's held shapes): a Heun predictor–corrector on ψ. The
-//! sub-models and F are scheduled on the forward speed through the water
-//! u_r = u − u_c(ψ), about which each sub-model is linearized, with the LPV
-//! model's own weights.
+//! The current turns with the vessel in the body frame, so a free run
+//! integrates ψ from the model's own yaw rate; the measured ψ only starts a
+//! prediction. One step holds τ (ZOH) and steps the velocity through the
+//! water with the LPV model, scheduled on its forward component u_r; ν is
+//! ν_r plus ν_c at the new heading (trapezoid on r). The model was fitted
+//! on ν_r ([`super::ned_current::Relative::apply`]), so nothing in the loop
+//! depends on M: a mass no run forced (a USV's sway) cannot turn the
+//! current's rotation ν̇_c into a wrong force.
 
 use nalgebra::{DMatrix, DVector, Vector2};
 
-use super::ned_current::{Relative, surge_component};
+use super::ned_current::nu_c_tilted;
 use crate::models::predict::no_prediction;
 use crate::models::{DiscreteLpv, LpvModel};
 use crate::planning::dof::Dof;
@@ -23,8 +23,6 @@ use crate::validation::{Predictor, ValidationRecord};
 #[derive(Debug, Clone)]
 pub struct HeadingLoop {
     lpv: LpvModel,
-    /// F (n × 2) per grid point, in the LPV model's order.
-    forces: Vec<DMatrix<f64>>,
     /// V = [V_N, V_E] (m/s).
     v: Vector2<f64>,
     surge: usize,
@@ -32,22 +30,12 @@ pub struct HeadingLoop {
 }
 
 impl HeadingLoop {
-    /// `None` unless the model has surge and yaw and one n × 2 F per grid
-    /// point.
-    pub fn new(lpv: LpvModel, forces: Vec<DMatrix<f64>>, v: Vector2<f64>) -> Option<Self> {
+    /// `None` unless the model has surge and yaw.
+    pub fn new(lpv: LpvModel, v: Vector2<f64>) -> Option<Self> {
         let dofs = lpv.dofs();
-        let n = dofs.len();
         let surge = dofs.iter().position(|d| *d == Dof::Surge)?;
         let yaw = dofs.iter().position(|d| *d == Dof::Yaw)?;
-        let fits =
-            forces.len() == lpv.grid_speeds().len() && forces.iter().all(|f| f.shape() == (n, 2));
-        fits.then_some(HeadingLoop {
-            lpv,
-            forces,
-            v,
-            surge,
-            yaw,
-        })
+        Some(HeadingLoop { lpv, v, surge, yaw })
     }
 
     /// Names of the record's input columns: the force columns, then ψ.
@@ -61,44 +49,20 @@ impl HeadingLoop {
         self.lpv.dofs().len()
     }
 
-    /// γ_eff − τ at ν, ψ ([`Relative::drive`]), with F, M and the
-    /// linearization speed u₀ of the grid points serving ν's forward speed
-    /// (blended like the sub-models: the u-products then cancel as in
-    /// C(δ)δ).
-    pub(crate) fn drive(&self, nu: &DVector<f64>, psi: f64) -> DVector<f64> {
-        let g = self.lpv.grid_speeds();
-        let (lo, hi, w) = match self.lpv.weights(self.speed(nu, psi), self.lpv.scheduling()) {
-            Ok(w) => (w.lower, w.upper, w.w_lower),
-            Err(_) => (0, 0, 1.0),
-        };
-        let f = &self.forces[lo] * w + &self.forces[hi] * (1.0 - w);
-        let u0 = g[lo] * w + g[hi] * (1.0 - w);
-        let (m, coriolis) = match self.lpv.second_order_coriolis() {
-            Some(ms) => (ms[lo].clone(), true),
-            None => (self.lpv.points()[lo].m().clone(), false),
-        };
-        let quadratic = self
-            .lpv
-            .quadratic_damping()
-            .map(|d| &d[lo] * w + &d[hi] * (1.0 - w));
-        Relative {
-            dofs: self.lpv.dofs().to_vec(),
-            v: self.v,
-            m,
-            coriolis,
-            quadratic,
-        }
-        .drive(nu, psi, u0, &f)
+    /// ν_c(ψ) in the model's DOF order.
+    pub(crate) fn nu_c(&self, psi: f64) -> DVector<f64> {
+        self.nu_c_tilted(0.0, 0.0, psi)
     }
 
-    /// The forward speed through the water u_r = u − u_c(ψ) (m/s), which
-    /// schedules the sub-models: each is linearized about its speed
-    /// through the water.
-    pub(crate) fn speed(&self, nu: &DVector<f64>, psi: f64) -> f64 {
-        nu[self.surge] - surge_component([self.v[0], self.v[1]], psi)
+    /// ν_c of a hull at roll φ, pitch θ and heading ψ (rad).
+    pub(crate) fn nu_c_tilted(&self, phi: f64, theta: f64, psi: f64) -> DVector<f64> {
+        nu_c_tilted(self.lpv.dofs(), [self.v[0], self.v[1]], phi, theta, psi)
     }
 
-    /// ν(k+1) and ψ(k+1) from ν(k), ψ(k) and τ(k).
+    /// ν(k+1) and ψ(k+1) from ν(k), ψ(k) and τ(k): the LPV model steps the
+    /// velocity through the water ν_r = ν − ν_c(ψ) (the form it was fitted
+    /// in, exact for a current constant in NED whatever M is), then
+    /// ν(k+1) = ν_r(k+1) + ν_c(ψ(k+1)) with ψ by the trapezoid on r.
     fn step(
         &self,
         lpv: &DiscreteLpv,
@@ -107,14 +71,11 @@ impl HeadingLoop {
         psi: f64,
         tau: &DVector<f64>,
     ) -> (DVector<f64>, f64) {
-        let scheduling = self.lpv.scheduling();
-        let speed = Some(self.speed(nu, psi));
-        let f0 = self.drive(nu, psi);
-        let predicted = lpv.step_at(nu, &(tau + &f0), scheduling, speed);
-        let psi_p = psi + 0.5 * h * (nu[self.yaw] + predicted[self.yaw]);
-        let f1 = self.drive(&predicted, psi_p);
-        let next = lpv.step_at(nu, &(tau + (&f0 + &f1) * 0.5), scheduling, speed);
-        let psi_next = psi + 0.5 * h * (nu[self.yaw] + next[self.yaw]);
+        let nu_r = nu - self.nu_c(psi);
+        let speed = Some(nu_r[self.surge]);
+        let next_r = lpv.step_at(&nu_r, tau, self.lpv.scheduling(), speed);
+        let psi_next = psi + 0.5 * h * (nu[self.yaw] + next_r[self.yaw]);
+        let next = next_r + self.nu_c(psi_next);
         (next, psi_next)
     }
 
@@ -183,7 +144,6 @@ impl Predictor for HeadingLoop {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identification::ned_current::force;
     use crate::models::LinearVesselModel;
     use crate::simulation::integrate::rk4_step;
 
@@ -235,7 +195,7 @@ mod tests {
         )
         .unwrap();
         let lpv = LpvModel::new(vec![0.0], vec![point]).unwrap();
-        let model = HeadingLoop::new(lpv, vec![force(&d, &dofs, &v)], v).unwrap();
+        let model = HeadingLoop::new(lpv, v).unwrap();
         let rows = states.len();
         let y = DMatrix::from_fn(rows, 3, |k, j| states[k][j]);
         let u = DMatrix::from_fn(rows, 4, |k, j| match j {
@@ -280,7 +240,6 @@ mod tests {
                 ],
             )
             .unwrap(),
-            vec![DMatrix::zeros(3, 2)],
             Vector2::zeros(),
         )
         .unwrap();
@@ -297,8 +256,15 @@ mod tests {
         let point =
             LinearVesselModel::new(dofs, DMatrix::identity(3, 3), DMatrix::identity(3, 3)).unwrap();
         let lpv = LpvModel::new(vec![0.0], vec![point]).unwrap();
-        assert!(HeadingLoop::new(lpv.clone(), vec![], Vector2::zeros()).is_none());
-        let model = HeadingLoop::new(lpv, vec![DMatrix::zeros(3, 2)], Vector2::zeros()).unwrap();
+        let no_yaw = LinearVesselModel::new(
+            vec![Dof::Surge, Dof::Sway],
+            DMatrix::identity(2, 2),
+            DMatrix::identity(2, 2),
+        )
+        .unwrap();
+        let no_yaw = LpvModel::new(vec![0.0], vec![no_yaw]).unwrap();
+        assert!(HeadingLoop::new(no_yaw, Vector2::zeros()).is_none());
+        let model = HeadingLoop::new(lpv, Vector2::zeros()).unwrap();
         let y = DMatrix::zeros(10, 3);
         let u = DMatrix::zeros(10, 3);
         let sim = model.simulate(&ValidationRecord {

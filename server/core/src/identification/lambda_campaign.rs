@@ -347,10 +347,10 @@ fn identify(
     let relative = current.as_ref().map(|c| ned_current::Relative {
         dofs: dofs.clone(),
         v: c.estimate.v,
-        m: c.m.clone(),
-        coriolis: lambda_settings.second_order_coriolis,
-        // D_q is moved onto ν_r where it is subtracted.
-        quadratic: None,
+        tilt: cols
+            .iter()
+            .position(|c| c == pose_column(Dof::Roll))
+            .zip(cols.iter().position(|c| c == pose_column(Dof::Pitch))),
     });
     let current_forces = |speed: f64| -> Option<DMatrix<f64>> {
         current
@@ -439,7 +439,12 @@ fn identify(
         coriolis_from_m,
         constant_loads: settings.constant_loads,
     };
-    let mut subs = sub_models(&at, &estimates, &current_forces, logged_controller.as_ref())?;
+    let mut subs = sub_models(
+        &at,
+        &estimates,
+        current.as_ref().map(|c| &c.estimate.v),
+        logged_controller.as_ref(),
+    )?;
     let mut parameters = std::mem::take(&mut subs.parameters);
     if let Some((_, doc)) = &restoring {
         parameters.extend(doc.parameters.iter().cloned());
@@ -490,13 +495,7 @@ fn identify(
         n,
         psi_col,
         restoring: g,
-        current: current.as_ref().map(|c| {
-            let forces = estimates
-                .iter()
-                .map(|&(s, _)| current_forces(s).unwrap_or_else(|| DMatrix::zeros(n, 2)))
-                .collect();
-            (forces, c.estimate.v)
-        }),
+        current: current.as_ref().map(|c| c.estimate.v),
         settings: &vsettings,
     };
     let mut validation = held_out.validate(&lpv)?;

@@ -302,21 +302,17 @@ pub(crate) fn pool(
 /// `exp` (at grid speed `u0`, m/s) with the known D_q|δ|δ moved to the
 /// force side, γ' = γ − F, F over step k as it was estimated ([`append`]):
 /// D_q,i |δ_i(k)| δ_i(k+½), surge's remainder beyond its tangent at u₀.
-/// In a known current (`nu_c`: ν_c(ψ) per row of `exp`) the drag acts on
-/// the velocity through the water, δ = ν − ν_c − u₀ (Fossen 2011, eq.
-/// 10.1: D(ν_r)ν_r).
+/// In a known current `exp` holds the velocity through the water
+/// ([`super::ned_current::Relative::apply`]), which the drag acts on
+/// (Fossen 2011, eq. 10.1: D(ν_r)ν_r).
 pub(crate) fn subtract(
     exp: Experiment,
     d_q: &DVector<f64>,
     surge: Option<usize>,
     u0: f64,
-    nu_c: Option<&DMatrix<f64>>,
 ) -> Experiment {
     let rows = exp.nu.nrows();
-    let nu_r = nu_c
-        .filter(|c| c.shape() == exp.nu.shape())
-        .map(|c| &exp.nu - c);
-    let nu = nu_r.as_ref().unwrap_or(&exp.nu);
+    let nu = &exp.nu;
     let mut gamma = exp.gamma.clone();
     for k in 0..rows {
         for i in 0..gamma.ncols().min(d_q.len()) {
@@ -326,27 +322,6 @@ pub(crate) fn subtract(
         }
     }
     Experiment { gamma, ..exp }
-}
-
-/// D_q,i times DOF i's quadratic function at the velocity `nu` (surge's
-/// remainder beyond its tangent at `u0`), as the model applies it: the
-/// drag force one sample sees.
-pub(crate) fn force_at(
-    d_q: &DVector<f64>,
-    nu: &DVector<f64>,
-    surge: Option<usize>,
-    u0: f64,
-) -> DVector<f64> {
-    DVector::from_fn(nu.len(), |i, _| {
-        let q = d_q.get(i).copied().unwrap_or(0.0);
-        if q == 0.0 {
-            0.0
-        } else if Some(i) == surge {
-            q * surge_remainder(nu[i], u0)
-        } else {
-            q * nu[i].abs() * nu[i]
-        }
-    })
 }
 
 /// σ of a sub-model fitted with D_q known (`est`, from `exps` at grid speed
@@ -451,20 +426,12 @@ mod tests {
         // about u₀ = 1: row 0 (1 − 1)² = 0; row 1 with u(k+½) = 1.6:
         // |u(k)|u(k+½) − |u₀|u₀ − 2|u₀|(u(k+½) − u₀) = 1.4·1.6 − 1 − 2·0.6.
         let d_q = DVector::from_vec(vec![30.0, 50.0, 7.0]);
-        let g = subtract(exp.clone(), &d_q, Some(0), 1.0, None).gamma;
+        let g = subtract(exp, &d_q, Some(0), 1.0).gamma;
         let want = [[0.0, -0.04, 0.16], [0.04, 0.08, 0.0]];
         for k in 0..2 {
             for i in 0..3 {
                 assert!((g[(k, i)] + d_q[i] * want[k][i]).abs() < 1e-12, "{k} {i}");
             }
-        }
-        // In a current the same functions of ν − ν_c: ν_c = ν leaves only
-        // surge's remainder of u_r = 0 about u₀ = 1, |0|0 − 1 − 2(0 − 1) = 1.
-        let nu_c = exp.nu.clone();
-        let g = subtract(exp, &d_q, Some(0), 1.0, Some(&nu_c)).gamma;
-        for k in 0..2 {
-            assert!((g[(k, 0)] + d_q[0]).abs() < 1e-12, "{k}");
-            assert!(g[(k, 1)] == 0.0 && g[(k, 2)] == 0.0, "{k}");
         }
     }
 

@@ -3,7 +3,7 @@
 //! parameter rows, the pooled M of C(δ)δ, D_q, and the extension beyond
 //! the grid.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DVector, Vector2};
 
 use super::document::{LoggedController, LpvPoint, ParameterRow, to_rows};
 use super::error::IdentifyError;
@@ -13,6 +13,7 @@ use super::lambda_coriolis::pooled_inertia;
 use super::lambda_extension::{Sides, choose_extension};
 use super::lambda_physical::{enforce, unresolved_mode};
 use super::lambda_quadratic;
+use super::ned_current;
 use crate::estimation::lambda::{Experiment, LambdaEstimate};
 use crate::estimation::restoring::RestoringParams;
 use crate::models::{Extension, LinearVesselModel, LpvModel, Scheduling};
@@ -70,11 +71,13 @@ pub(crate) struct SubModels {
 
 /// Each estimate projected onto the physical set (M symmetric positive
 /// definite, D̄ dissipative), with its parameter rows and document point;
-/// `current_force(u₀)` is the known current's force shapes at a grid speed.
+/// with a known current V = [V_N, V_E] each point's force shapes F of its
+/// own D̄ (D̄ ν_c = −F e(ψ), [`ned_current::force`]), so that a loop driving
+/// the model in ground velocities gives the D̄ ν_r it was fitted on.
 pub(crate) fn sub_models(
     at: &SubModelInputs,
     estimates: &[(f64, LambdaEstimate)],
-    current_force: &dyn Fn(f64) -> Option<DMatrix<f64>>,
+    current: Option<&Vector2<f64>>,
     logged_controller: Option<&LoggedController>,
 ) -> Result<SubModels, IdentifyError> {
     let dofs = at.dofs;
@@ -139,7 +142,7 @@ pub(crate) fn sub_models(
                 .then(|| load_std.iter().copied().collect()),
             n_samples: est.n_samples,
             run_ids: at.run_ids[idx].clone(),
-            current_force: current_force(*speed).map(|f| to_rows(&f)),
+            current_force: current.map(|v| to_rows(&ned_current::force(model.d_bar(), dofs, v))),
             augmentation: None,
         });
         out.vehicle.push(model.clone());

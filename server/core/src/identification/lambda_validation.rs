@@ -34,9 +34,9 @@ pub(crate) struct HeldOut<'a> {
     pub psi_col: usize,
     /// g(η), when estimated: validated with the attitude in the loop.
     pub restoring: Option<&'a RestoringParams>,
-    /// A current fixed in NED: F (n × 2) per grid point of the model,
-    /// validated with the heading in the loop.
-    pub current: Option<(Vec<DMatrix<f64>>, nalgebra::Vector2<f64>)>,
+    /// A current fixed in NED, V = [V_N, V_E] (m/s): validated with the
+    /// heading in the loop.
+    pub current: Option<nalgebra::Vector2<f64>>,
     pub settings: &'a ValidationSettings,
 }
 
@@ -52,7 +52,7 @@ impl HeldOut<'_> {
             if let Ok(segs) = segments(r, self.cols, self.outputs, 50)
                 && let Some(longest) = segs.iter().max_by_key(|s| s.y.nrows())
             {
-                let v = self.current.as_ref().map(|(_, v)| *v);
+                let v = self.current;
                 let u = speed_through_water(longest, surge, self.psi_col, v);
                 notes.extend(speed_coverage_notes(&r.name, &u, grid, lpv.extension()));
             }
@@ -65,18 +65,15 @@ impl HeldOut<'_> {
     /// on γ = τ − g(η) otherwise.
     pub fn validate(&self, lpv: &LpvModel) -> Result<Vec<RunValidation>, IdentifyError> {
         let (n, g) = (self.n, self.restoring);
-        let attitude_loop = g.and_then(|g| match &self.current {
-            Some((f, v)) => AttitudeLoop::with_current(lpv.clone(), *g, f.clone(), *v),
+        let attitude_loop = g.and_then(|g| match self.current {
+            Some(v) => AttitudeLoop::with_current(lpv.clone(), *g, v),
             None => AttitudeLoop::new(lpv.clone(), *g),
         });
         let loop_settings = ValidationSettings {
             input_names: AttitudeLoop::input_names(&self.cols[..n]),
             ..self.settings.clone()
         };
-        let heading_loop = self
-            .current
-            .as_ref()
-            .and_then(|(f, v)| HeadingLoop::new(lpv.clone(), f.clone(), *v));
+        let heading_loop = self.current.and_then(|v| HeadingLoop::new(lpv.clone(), v));
         let heading_settings = ValidationSettings {
             input_names: HeadingLoop::input_names(&self.cols[..n]),
             ..self.settings.clone()

@@ -26,12 +26,10 @@ use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
 
 use super::dataset::Segment;
 use super::document::{NedCurrentDoc, ParameterRow};
-use super::lambda_quadratic::force_at;
 use super::roles::Roles;
 use crate::estimation::lambda::{Exogenous, Experiment, LambdaEstimate};
 use crate::logs::schema::pose_column;
-use crate::models::coriolis::second_order_force_about;
-use crate::models::current::body_current;
+use crate::models::current::{body_current, body_current_tilted};
 use crate::numbers::sig3;
 use crate::planning::dof::Dof;
 use crate::planning::vessel::VesselProfile;
@@ -275,100 +273,63 @@ pub(crate) fn surge_component(v: [f64; 2], psi: f64) -> f64 {
     body_current(v, psi).0
 }
 
-/// What a known current adds to the forces that drive a horizontal
-/// sub-model M ν̇ + D̄ ν + b = γ_eff at grid speed u₀ (see [`Relative::drive`]).
+/// ν_c = R(φ, θ, ψ)ᵀ[V_N V_E 0]ᵀ in the order of `dofs` (its linear
+/// components; the rates are the vehicle's own).
+pub(crate) fn nu_c_tilted(
+    dofs: &[Dof],
+    v: [f64; 2],
+    phi: f64,
+    theta: f64,
+    psi: f64,
+) -> DVector<f64> {
+    let (u_c, v_c, w_c) = body_current_tilted(v, phi, theta, psi);
+    DVector::from_iterator(
+        dofs.len(),
+        dofs.iter().map(|d| match d {
+            Dof::Surge => u_c,
+            Dof::Sway => v_c,
+            Dof::Heave => w_c,
+            _ => 0.0,
+        }),
+    )
+}
+
+/// A known current, for the sub-models' fits on the velocity through the
+/// water ([`Relative::apply`]).
 #[derive(Debug, Clone)]
 pub(crate) struct Relative {
     pub dofs: Vec<Dof>,
     /// V = [V_N, V_E] (m/s).
     pub v: Vector2<f64>,
-    /// The vehicle's M: for M ν̇_c, and for C(·) when `coriolis`.
-    pub m: DMatrix<f64>,
-    /// The model carries the second-order C(δ)δ.
-    pub coriolis: bool,
-    /// The model's D_q (surge: X_|u|u), when it applies D_q|δ|δ of ν
-    /// itself: [`Relative::drive`] moves it onto ν_r.
-    pub quadratic: Option<DVector<f64>>,
+    /// The columns of φ and θ in the segments, when the attitude is logged
+    /// (a 6-DOF vehicle): ν_c then comes from the whole rotation.
+    pub tilt: Option<(usize, usize)>,
 }
 
 impl Relative {
-    /// ν_c(ψ) in the model's DOF order.
-    pub fn nu_c(&self, psi: f64) -> DVector<f64> {
-        let (u_c, v_c) = body_current([self.v[0], self.v[1]], psi);
-        DVector::from_iterator(
-            self.dofs.len(),
-            self.dofs.iter().map(|d| match d {
-                Dof::Surge => u_c,
-                Dof::Sway => v_c,
-                _ => 0.0,
-            }),
-        )
-    }
-
-    /// γ_eff − τ at ν, ψ for the sub-model at u₀ with current force F:
-    /// −F e(ψ) (the damping of −ν_c), + M ν̇_c (ν̇_c = r·[v_c, −u_c, 0]
-    /// for a current constant in NED), and, when the model carries C(δ)δ
-    /// of ν, + C(δ)δ − C(δ_r)δ_r so that it acts on the relative velocity
-    /// δ_r = ν − ν_c − u₀ instead (and likewise D_q|δ|δ, when
-    /// `quadratic`): for a current constant in NED,
-    /// M_RB ν̇ + C_RB(ν)ν = M_RB ν̇_r + C_RB(ν_r)ν_r (Fossen 2011,
-    /// Property 8.1), and the added mass's C_A acts on ν_r, so the whole
-    /// model reads M ν̇_r + C(ν_r)ν_r + D̄ ν_r + b = τ.
-    pub fn drive(&self, nu: &DVector<f64>, psi: f64, u0: f64, f: &DMatrix<f64>) -> DVector<f64> {
-        let (sn, cs) = psi.sin_cos();
-        let mut out = -(f * Vector2::new(cs, sn));
-        let nu_c = self.nu_c(psi);
-        let (Some(surge), Some(sway), Some(yaw)) = (
-            self.dofs.iter().position(|d| *d == Dof::Surge),
-            self.dofs.iter().position(|d| *d == Dof::Sway),
-            self.dofs.iter().position(|d| *d == Dof::Yaw),
-        ) else {
-            return out;
-        };
-        let mut nu_c_dot = DVector::zeros(self.dofs.len());
-        nu_c_dot[surge] = nu[yaw] * nu_c[sway];
-        nu_c_dot[sway] = -nu[yaw] * nu_c[surge];
-        out += &self.m * nu_c_dot;
-        let nu_r = nu - &nu_c;
-        if self.coriolis {
-            let c = second_order_force_about(&self.dofs, &self.m, nu.as_slice(), surge, u0);
-            let c_r = second_order_force_about(&self.dofs, &self.m, nu_r.as_slice(), surge, u0);
-            for i in 0..out.len() {
-                out[i] += c[i] - c_r[i];
-            }
-        }
-        if let Some(d_q) = &self.quadratic {
-            out += force_at(d_q, nu, Some(surge), u0) - force_at(d_q, &nu_r, Some(surge), u0);
-        }
-        out
-    }
-
-    /// `exp` of `seg` (at grid speed `u0`, ψ its input column `psi_col`)
-    /// driven by γ + [`Relative::drive`] over each step (at the step means
-    /// of ν and ψ): the current known.
-    pub fn apply(
-        &self,
-        exp: Experiment,
-        seg: &Segment,
-        psi_col: usize,
-        u0: f64,
-        f: &DMatrix<f64>,
-    ) -> Experiment {
-        let n = self.dofs.len();
+    /// `exp` of `seg` (ψ its input column `psi_col`) on the velocity
+    /// through the water: ν_r = ν − ν_c(ψ) per sample in place of ν, γ
+    /// unchanged. For a current constant in NED the whole model reads
+    /// M ν̇_r + C(ν_r)ν_r + D̄ ν_r + b = τ: M_RB ν̇ + C_RB(ν)ν =
+    /// M_RB ν̇_r + C_RB(ν_r)ν_r (Fossen 2011, Property 8.1), and the added
+    /// mass's M_A and C_A act on ν_r, as the damping does. So
+    /// fitted on ν_r it needs no M on the known side: M ν̇_c through a mass
+    /// the runs never forced (the Otter's sway) would otherwise make a row
+    /// that τ leaves homogeneous depend on that mass.
+    pub fn apply(&self, exp: Experiment, seg: &Segment, psi_col: usize) -> Experiment {
         let psi = heading(seg, psi_col);
-        let rows = exp.gamma.nrows().min(psi.len());
-        let mut gamma = exp.gamma.clone();
-        for k in 0..rows {
-            let next = if k + 1 < rows { k + 1 } else { k };
-            let nu = (exp.nu.row(k) + exp.nu.row(next)).transpose() * 0.5;
-            let step = psi[next] - psi[k];
-            let step = step - std::f64::consts::TAU * (step / std::f64::consts::TAU).round();
-            let extra = self.drive(&nu, psi[k] + 0.5 * step, u0, f);
-            for i in 0..n {
-                gamma[(k, i)] += extra[i];
+        let mut nu = exp.nu.clone();
+        let v = [self.v[0], self.v[1]];
+        for (k, &p) in psi.iter().enumerate().take(nu.nrows()) {
+            let (phi, theta) = self
+                .tilt
+                .map_or((0.0, 0.0), |(i, j)| (seg.u[(k, i)], seg.u[(k, j)]));
+            let c = nu_c_tilted(&self.dofs, v, phi, theta, p);
+            for i in 0..nu.ncols() {
+                nu[(k, i)] -= c[i];
             }
         }
-        Experiment { gamma, ..exp }
+        Experiment { nu, ..exp }
     }
 }
 
@@ -398,9 +359,6 @@ pub(crate) fn heading_logged(roles: &Roles<'_>, notes: &mut Vec<String>) -> bool
 #[derive(Debug, Clone)]
 pub(crate) struct CampaignCurrent {
     pub estimate: CurrentEstimate,
-    /// The first pass's M (pooled over the grid by inverse variance, else
-    /// the first point's): what M ν̇_c and C(ν_r) are built from.
-    pub m: DMatrix<f64>,
     /// (grid speed, F n × 2).
     pub forces: Vec<(f64, DMatrix<f64>)>,
 }
@@ -461,12 +419,8 @@ pub(crate) fn campaign_current(
     };
     let kept = pooled.significant();
     notes.push(note(&pooled, kept));
-    let ms: Vec<DMatrix<f64>> = joint.iter().map(|(_, e)| e.m.clone()).collect();
-    let stds: Vec<DMatrix<f64>> = joint.iter().map(|(_, e)| e.std_m.clone()).collect();
-    let m = super::lambda_coriolis::pooled_inertia(&ms, &stds).or_else(|| ms.first().cloned())?;
     kept.then(|| CampaignCurrent {
         estimate: pooled,
-        m,
         forces: joint
             .iter()
             .map(|(u0, e)| (*u0, force(&e.d_bar, dofs, &pooled.v)))

@@ -38,24 +38,15 @@ fn attitude_in_loop(doc: &ModelDocument) -> Option<RestoringParams> {
         .map(|r| r.params)
 }
 
-/// F (n × 2) per grid point when a stored LPV model carries a current
-/// fixed in NED (and no discovered terms): validated with ψ in the loop.
-fn current_in_loop(doc: &ModelDocument) -> Option<(Vec<DMatrix<f64>>, nalgebra::Vector2<f64>)> {
+/// V = [V_N, V_E] (m/s) when a stored LPV model carries a current fixed
+/// in NED (and no discovered terms): validated with ψ in the loop.
+fn current_in_loop(doc: &ModelDocument) -> Option<nalgebra::Vector2<f64>> {
     let lpv = doc.lpv.as_ref()?;
     if doc.kind != ModelKind::Lpv || is_augmented(doc) {
         return None;
     }
     let v = lpv.current.as_ref()?.ned_mps;
-    let n = doc.dofs.len();
-    let forces = lpv
-        .points
-        .iter()
-        .map(|p| match &p.current_force {
-            Some(f) => from_rows(f).filter(|f| f.shape() == (n, 2)),
-            None => Some(DMatrix::zeros(n, 2)),
-        })
-        .collect::<Option<Vec<_>>>()?;
-    Some((forces, nalgebra::Vector2::new(v[0], v[1])))
+    Some(nalgebra::Vector2::new(v[0], v[1]))
 }
 
 /// The predictor of a stored model.
@@ -64,23 +55,23 @@ pub fn predictor(doc: &ModelDocument) -> Result<Box<dyn Predictor>, IdentifyErro
         ModelKind::Lpv if is_augmented(doc) => Ok(Box::new(AugmentedLpv::from_doc(doc)?)),
         ModelKind::Lpv => {
             let model = baseline_lpv(doc)?;
-            if let (Some(g), Some((forces, v))) = (attitude_in_loop(doc), current_in_loop(doc)) {
-                return AttitudeLoop::with_current(model, g, forces, v)
+            if let (Some(g), Some(v)) = (attitude_in_loop(doc), current_in_loop(doc)) {
+                return AttitudeLoop::with_current(model, g, v)
                     .map(|m| Box::new(m) as Box<dyn Predictor>)
                     .ok_or_else(|| {
                         IdentifyError::invalid(
                             "document.lpv.current",
-                            "a current needs one 6 × 2 F per grid point",
+                            "a current needs the six DOFs with g(η)",
                         )
                     });
             }
-            if let Some((forces, v)) = current_in_loop(doc) {
-                return HeadingLoop::new(model, forces, v)
+            if let Some(v) = current_in_loop(doc) {
+                return HeadingLoop::new(model, v)
                     .map(|m| Box::new(m) as Box<dyn Predictor>)
                     .ok_or_else(|| {
                         IdentifyError::invalid(
                             "document.lpv.current",
-                            "a current needs surge and yaw and one F per grid point",
+                            "a current needs surge and yaw",
                         )
                     });
             }

@@ -62,33 +62,64 @@ fn the_current_seen_in_the_body_frame_is_damped_as_relative_velocity() {
     }
 }
 
-/// With D_q the model applies to ν, `drive` adds D_q(f(ν) − f(ν_r)):
-/// the drag then acts on the velocity through the water. A current of
-/// 0.2 m/s towards north seen at ψ = 90° is v_c = −0.2 m/s; at
-/// ν = (0.5, 0.1, 0) and u₀ = 0.5: sway 20·(0.1² − 0.3²) = −1.6 N, surge
-/// 0 (u_c = 0). At ψ = 0: u_r = 0.3, surge 10·(0 − (0.3 − 0.5)²) = −0.4 N.
+/// `apply` puts the velocity through the water in place of ν and leaves γ:
+/// a current of 0.2 m/s towards north seen at ψ = 90° is v_c = −0.2 m/s
+/// (ν = (0.5, 0.1, 0.05) → ν_r = (0.5, 0.3, 0.05)), at ψ = 0 u_c = 0.2
+/// (→ (0.3, 0.1, 0.05)). With the attitude logged (a 6-DOF vehicle) ν_c is
+/// R(φ, θ, ψ)ᵀ V: pitched 0.3 rad at ψ = 0, u_c = 0.2 cos 0.3 and the heave
+/// w_c = 0.2 sin 0.3.
 #[test]
-fn the_quadratic_drag_is_moved_onto_the_relative_velocity() {
+fn apply_fits_the_velocity_through_the_water() {
     let r = Relative {
         dofs: Dof::HORIZONTAL.to_vec(),
         v: Vector2::new(0.2, 0.0),
-        m: DMatrix::identity(3, 3),
-        coriolis: false,
-        quadratic: Some(DVector::from_vec(vec![10.0, 20.0, 0.0])),
+        tilt: None,
     };
-    let nu = DVector::from_vec(vec![0.5, 0.1, 0.0]);
-    let f = DMatrix::zeros(3, 2);
-    let east = r.drive(&nu, std::f64::consts::FRAC_PI_2, 0.5, &f);
-    let north = r.drive(&nu, 0.0, 0.5, &f);
-    for (got, want) in [
-        (east[0], 0.0),
-        (east[1], -1.6),
-        (north[0], -0.4),
-        (north[1], 0.0),
-    ] {
-        assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+    let psi = [std::f64::consts::FRAC_PI_2, 0.0];
+    let seg = Segment {
+        run_id: "a".into(),
+        h: 0.1,
+        t0: 0.0,
+        u: DMatrix::from_fn(2, 4, |k, j| if j == 3 { psi[k] } else { 1.0 }),
+        y: DMatrix::zeros(2, 3),
+    };
+    let nu = DMatrix::from_row_slice(2, 3, &[0.5, 0.1, 0.05, 0.5, 0.1, 0.05]);
+    let gamma = DMatrix::from_fn(2, 3, |k, j| (k * 3 + j) as f64);
+    let out = r.apply(Experiment::new(0.1, nu, gamma.clone()), &seg, 3);
+    let want = [0.5, 0.3, 0.05, 0.3, 0.1, 0.05];
+    for (k, w) in want.chunks(3).enumerate() {
+        for (j, w) in w.iter().enumerate() {
+            assert!((out.nu[(k, j)] - w).abs() < 1e-15, "{k},{j}");
+        }
     }
-    assert_eq!(east[2], 0.0);
+    assert_eq!(out.gamma, gamma);
+
+    let r6 = Relative {
+        dofs: Dof::ALL.to_vec(),
+        v: Vector2::new(0.2, 0.0),
+        tilt: Some((1, 2)),
+    };
+    let seg6 = Segment {
+        run_id: "b".into(),
+        h: 0.1,
+        t0: 0.0,
+        // [τ_X, φ, θ, ψ]
+        u: DMatrix::from_row_slice(1, 4, &[1.0, 0.0, 0.3, 0.0]),
+        y: DMatrix::zeros(1, 6),
+    };
+    let out = r6.apply(
+        Experiment::new(0.1, DMatrix::zeros(1, 6), DMatrix::zeros(1, 6)),
+        &seg6,
+        3,
+    );
+    let (u_c, w_c) = (0.2 * 0.3f64.cos(), 0.2 * 0.3f64.sin());
+    for (j, want) in [-u_c, 0.0, -w_c, 0.0, 0.0, 0.0].into_iter().enumerate() {
+        assert!(
+            (out.nu[(0, j)] - want).abs() < 1e-15,
+            "{j}: {}",
+            out.nu[(0, j)]
+        );
+    }
 }
 
 #[test]
