@@ -135,8 +135,10 @@ pub struct LpvPoint {
     /// Runs used.
     pub run_ids: Vec<String>,
     /// F (n × 2, N or N·m per unit) of a current fixed in NED on the
-    /// heading shapes [cos ψ, sin ψ]: M ν̇ + D̄ ν + F·[cos ψ, sin ψ]ᵀ = γ,
-    /// F = −D̄_{:,uv}·Q(V) (see `LpvDoc::current`). Absent without one.
+    /// heading shapes [cos ψ, sin ψ]: the force D̄ ν_c = −F·[cos ψ, sin ψ]ᵀ
+    /// the current puts on this point's damping, F = −D̄_{:,uv}·Q(V) of its
+    /// own D̄ (see `LpvDoc::current`; the model itself steps ν_r). Absent
+    /// without one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub current_force: Option<Matrix>,
     /// Physics added at this speed by missing-physics discovery; the point's
