@@ -3,7 +3,7 @@
 //! γ = τ − g(η) and g(η) estimated jointly from the runs themselves;
 //! physical structure enforced; validated on the held-out runs.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 use super::attitude_fusion::attitude_noise_std;
 use super::dataset::{RunInput, Segment};
@@ -324,7 +324,7 @@ fn identify(
         _ => None,
     };
     let mut current = if with_current {
-        ned_current::campaign_current(&joint, &dofs, &mut notes)
+        ned_current::campaign_current(&joint, &mut notes)
     } else {
         None
     };
@@ -352,12 +352,6 @@ fn identify(
             .position(|c| c == pose_column(Dof::Roll))
             .zip(cols.iter().position(|c| c == pose_column(Dof::Pitch))),
     });
-    let current_forces = |speed: f64| -> Option<DMatrix<f64>> {
-        current
-            .as_ref()
-            .and_then(|c| c.forces.iter().find(|(s, _)| *s == speed))
-            .map(|(_, f)| f.clone())
-    };
     let known = KnownSide::new(
         build(g, loads)?,
         &data.segments,
@@ -365,7 +359,6 @@ fn identify(
         psi_col,
         surge,
         relative.as_ref(),
-        &current_forces,
     );
     let mut exps = known.with_drag(quadratic.as_ref().map(|(d, _)| d));
     let from = if joint.is_empty() { 0.1 } else { 0.4 };

@@ -3,7 +3,7 @@
 //! through the water ν_r = ν − ν_c(ψ) ([`super::ned_current::Relative`]),
 //! and the pooled quadratic drag D_q|ν_r|ν_r moved to the known side.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 use super::dataset::Segment;
 use super::lambda_quadratic;
@@ -19,10 +19,10 @@ pub(crate) struct KnownSide {
 }
 
 impl KnownSide {
-    /// `plain` and `segments` per speed of `grid` (ψ their input column
-    /// `psi_col`); `current_force(u₀)`: the current's force shapes
-    /// where the current is known (its grid points then fit ν_r, see
-    /// [`Relative::apply`]); `surge`: the index of surge.
+    /// `plain` and `segments` per grid speed (ψ their input column
+    /// `psi_col`); with a campaign current (`relative`) every point fits
+    /// ν_r ([`Relative::apply`]): the current is fixed in NED, the same at
+    /// every speed; `surge`: the index of surge.
     pub fn new(
         plain: Vec<Vec<Experiment>>,
         segments: &[Vec<Segment>],
@@ -30,11 +30,10 @@ impl KnownSide {
         psi_col: usize,
         surge: Option<usize>,
         relative: Option<&Relative>,
-        current_force: &dyn Fn(f64) -> Option<DMatrix<f64>>,
     ) -> Self {
         let mut exps = Vec::with_capacity(plain.len());
-        for ((point, segs), &u0) in plain.into_iter().zip(segments).zip(grid) {
-            let point: Vec<Experiment> = match relative.filter(|_| current_force(u0).is_some()) {
+        for (point, segs) in plain.into_iter().zip(segments) {
+            let point: Vec<Experiment> = match relative {
                 Some(r) => point
                     .into_iter()
                     .zip(segs)

@@ -354,13 +354,10 @@ pub(crate) fn heading_logged(roles: &Roles<'_>, notes: &mut Vec<String>) -> bool
     }
 }
 
-/// The campaign's current and the force F = −D̄₁·Q(V) it puts on each grid
-/// point's heading shapes.
+/// The campaign's current, pooled over the grid points of the first pass.
 #[derive(Debug, Clone)]
 pub(crate) struct CampaignCurrent {
     pub estimate: CurrentEstimate,
-    /// (grid speed, F n × 2).
-    pub forces: Vec<(f64, DMatrix<f64>)>,
 }
 
 impl CampaignCurrent {
@@ -407,7 +404,6 @@ impl CampaignCurrent {
 /// when no point carries one or it is within the noise.
 pub(crate) fn campaign_current(
     joint: &[(f64, LambdaEstimate)],
-    dofs: &[Dof],
     notes: &mut Vec<String>,
 ) -> Option<CampaignCurrent> {
     let per_point: Vec<CurrentEstimate> = joint.iter().filter_map(|(_, e)| current_of(e)).collect();
@@ -419,13 +415,7 @@ pub(crate) fn campaign_current(
     };
     let kept = pooled.significant();
     notes.push(note(&pooled, kept));
-    kept.then(|| CampaignCurrent {
-        estimate: pooled,
-        forces: joint
-            .iter()
-            .map(|(u0, e)| (*u0, force(&e.d_bar, dofs, &pooled.v)))
-            .collect(),
-    })
+    kept.then_some(CampaignCurrent { estimate: pooled })
 }
 
 /// The note on the pooled current.
