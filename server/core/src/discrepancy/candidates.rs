@@ -97,13 +97,16 @@ pub enum Effect {
         /// The DOF.
         dof: Dof,
     },
-    /// Pure delay τ_a(t) = τ_c(t − d·h) of d whole samples.
+    /// Pure delay τ_a(t) = τ_c(t − d·h) of d log samples, a fraction of a
+    /// sample included (over each held interval the mean of the commands
+    /// it straddles).
     InputDelay {
         /// The DOF.
         dof: Dof,
     },
-    /// One pure delay of d whole samples on every DOF's command: a
-    /// transport delay of the command link or the logger's time stamps.
+    /// One pure delay of d log samples (a fraction included) on every
+    /// DOF's command: a transport delay of the command link or the
+    /// logger's time stamps.
     CommonInputDelay,
     /// One first-order lag τ_a = τ_c/(1 + s·T_a) on every DOF's command:
     /// thrusters of one kind answering alike.

@@ -111,18 +111,15 @@ pub(crate) fn actuate(tau: &[f64], dof: Dof, shapes: &[(Effect, f64)]) -> (Vec<f
     let mut dz = None;
     for (e, v) in mine {
         match e.shape() {
-            Some(ShapeKind::DelaySamples) => delay = Some(v.round().max(0.0) as usize),
+            Some(ShapeKind::DelaySamples) => delay = Some(v.max(0.0)),
             Some(ShapeKind::SaturationLevel) => sat = Some(v.abs()),
             Some(ShapeKind::DeadZoneWidth) => dz = Some(v.abs()),
             Some(ShapeKind::LagTime) => lag = Some(v.max(1e-6)),
             None => {}
         }
     }
-    if let Some(d) = delay.filter(|&d| d > 0) {
-        let first = x.first().copied().unwrap_or(0.0);
-        x = (0..tau.len())
-            .map(|k| if k >= d { tau[k - d] } else { first })
-            .collect();
+    if let Some(d) = delay.filter(|&d| d > 0.0) {
+        x = delayed(tau, d);
     }
     if let Some(l) = sat {
         x.iter_mut().for_each(|v| *v = v.clamp(-l, l));
@@ -137,6 +134,29 @@ pub(crate) fn actuate(tau: &[f64], dof: Dof, shapes: &[(Effect, f64)]) -> (Vec<f
         });
     }
     (x, lag)
+}
+
+/// The held command `tau` delayed by `d` ≥ 0 samples, a fraction of a
+/// sample included: over interval k the thrust is τ(k − n) for the part
+/// 1 − f and τ(k − n − 1) for the part f of it (d = n + f), and the model,
+/// which holds its input over each interval, gets their mean
+/// (1 − f)·τ(k − n) + f·τ(k − n − 1) — the same impulse into the hull.
+/// Before the log's start the first command holds.
+pub(crate) fn delayed(tau: &[f64], d: f64) -> Vec<f64> {
+    let n = d.floor() as usize;
+    let f = d - n as f64;
+    let first = tau.first().copied().unwrap_or(0.0);
+    let at = |k: usize, back: usize| k.checked_sub(back).map_or(first, |i| tau[i]);
+    (0..tau.len())
+        .map(|k| {
+            let now = at(k, n);
+            if f == 0.0 {
+                now
+            } else {
+                (1.0 - f) * now + f * at(k, n + 1)
+            }
+        })
+        .collect()
 }
 
 impl AugmentedModel {

@@ -35,6 +35,14 @@ pub(crate) struct Criteria {
     pub k_step: usize,
 }
 
+/// Ten values from `lo` to `hi`, evenly spaced in log.
+fn log_grid(lo: f64, hi: f64) -> Vec<f64> {
+    let k = 10;
+    (0..k)
+        .map(|i| lo * (hi / lo).powf(i as f64 / (k - 1) as f64))
+        .collect()
+}
+
 /// A candidate fitted on top of the chosen terms.
 #[derive(Debug, Clone)]
 pub(crate) struct Scored {
@@ -85,14 +93,11 @@ fn shape_grid(prep: &Prepared<'_>, effect: Effect, runs: &[usize], c: &Criteria)
         g
     };
     match effect.shape() {
-        Some(ShapeKind::LagTime) => {
-            let (lo, hi) = (0.5 * h, c.max_lag_s.max(h));
-            let k = 9;
-            (0..k)
-                .map(|i| lo * (hi / lo).powf(i as f64 / (k - 1) as f64))
-                .collect()
-        }
-        Some(ShapeKind::DelaySamples) => (1..=c.max_delay_samples).map(|d| d as f64).collect(),
+        // Both from a fifth of a log sample (a 0.04 s lag or delay at
+        // 10 Hz is 0.4 of one) to the longest, refined between neighbours:
+        // a delay need not be whole samples.
+        Some(ShapeKind::LagTime) => log_grid(0.2 * h, c.max_lag_s.max(h)),
+        Some(ShapeKind::DelaySamples) => log_grid(0.2, (c.max_delay_samples as f64).max(1.0)),
         Some(ShapeKind::SaturationLevel) => {
             // Quantiles of the command, and a log grid down to 2 % of its
             // largest value: under closed-loop control a hull that gets far
@@ -187,9 +192,8 @@ pub(crate) fn score_against(
         if grid.is_empty() {
             return None;
         }
-        let continuous = effect.shape() != Some(ShapeKind::DelaySamples);
         let k = c.k_step.min(4);
-        let p = profile(prep, chosen, effect, &rows, runs, &grid, continuous, k)?;
+        let p = profile(prep, chosen, effect, &rows, runs, &grid, k)?;
         // Output-error statistics against the chosen terms alone.
         let null_kstep = nulls.kstep(prep, chosen, &null, &rows, runs, k)?;
         let (s0, r0) = (null_kstep.0, &null_kstep.1);
@@ -198,11 +202,8 @@ pub(crate) fn score_against(
         let lr = n_eff * (s0 / p.sse.max(f64::MIN_POSITIVE)).ln();
         // An optimum on the edge of the search range is a bound, not an
         // estimate (a saturation level at the smallest level tried, a delay
-        // at the longest): such a hypothesis is not significant. A delay of
-        // one sample is a real value, so only its upper edge counts.
-        let (lo, hi) = (grid[0], grid[grid.len() - 1]);
-        let at_edge = p.value >= hi * (1.0 - 1e-9) || (continuous && p.value <= lo * (1.0 + 1e-9));
-        let lr = if at_edge { 0.0 } else { lr };
+        // at the longest): such a hypothesis is not significant.
+        let lr = if p.at_edge { 0.0 } else { lr };
         let spec = Spec {
             effect,
             shape: Some(p.value),

@@ -30,7 +30,8 @@ pub(crate) fn long_run_inflation(blocks: &[Vec<f64>], lags: usize) -> f64 {
 
 /// A profile search over a shape parameter on the k-step prediction error
 /// of its row ([`Prepared::kstep_row`]): the grid minimum, refined by
-/// golden section between its neighbours when `continuous`, with a standard
+/// golden section between its neighbours (every shape, a delay's fraction
+/// of a sample included, is continuous), with a standard
 /// deviation from the curvature of the SSE (Δχ² = 1 at ΔSSE = κσ²).
 pub(crate) struct Profile {
     pub value: f64,
@@ -40,6 +41,9 @@ pub(crate) struct Profile {
     pub sse: f64,
     /// Predicted samples.
     pub n: usize,
+    /// The optimum lies at an end of the grid, as close to it as the
+    /// refinement resolves: a bound, not an estimate.
+    pub at_edge: bool,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -50,7 +54,6 @@ pub(crate) fn profile(
     extra: &[usize],
     runs: &[usize],
     grid: &[f64],
-    continuous: bool,
     k: usize,
 ) -> Option<Profile> {
     extra.first()?;
@@ -91,7 +94,9 @@ pub(crate) fn profile(
         .enumerate()
         .min_by(|a, b| a.1.total_cmp(b.1))?;
     let mut best = grid[ib];
-    if continuous && grid.len() >= 3 {
+    let end = ib == 0 || ib + 1 == grid.len();
+    let mut at_edge = end;
+    if grid.len() >= 3 {
         // Golden section in log space (parameters are positive scales).
         let lo = grid[ib.saturating_sub(1)].ln();
         let hi = grid[(ib + 1).min(grid.len() - 1)].ln();
@@ -122,15 +127,14 @@ pub(crate) fn profile(
         };
         if f_cand < values[ib] {
             best = cand;
+            // Refined away from an end by more than the final bracket:
+            // the minimum is inside the range after all.
+            at_edge = end && (best.ln() - grid[ib].ln()).abs() <= (b - a).abs();
         }
     }
     let fit = eval(best)?;
     let (s0, resid) = prep.kstep_rows(&specs_at(best), &fit, extra, runs, k)?;
-    let delta = if continuous {
-        0.03 * best.abs().max(1e-9)
-    } else {
-        1.0
-    };
+    let delta = 0.03 * best.abs().max(1e-9);
     let (sm, sp) = (sse(best - delta), sse(best + delta));
     let curv = (sp - 2.0 * s0 + sm) / (delta * delta);
     let n: usize = resid.iter().map(Vec::len).sum();
@@ -144,5 +148,6 @@ pub(crate) fn profile(
         std,
         sse: s0,
         n,
+        at_edge,
     })
 }

@@ -15,6 +15,47 @@ fn actuator_chain_delays_clips_and_kills_small_commands() {
     assert!(lag.is_none(), "a surge lag must not act on sway");
 }
 
+/// A delay of 0.4 samples on a held command: over each interval the thrust
+/// is the previous command for 0.4 of it and the new one after, so the
+/// interval's mean is 0.4·τ(k − 1) + 0.6·τ(k); 1.25 samples likewise one
+/// interval further back. The step response of m u̇ + d u = X through the
+/// mean matches the exactly delayed step's to within the hull's change
+/// over one interval.
+#[test]
+fn a_delay_of_a_fraction_of_a_sample_holds_the_interval_mean() {
+    let tau = [0.0, 1.0, 3.0, -3.0, 0.5];
+    let x = delayed(&tau, 0.4);
+    let want = [0.0, 0.6, 2.2, -0.6, -0.9];
+    for (a, b) in x.iter().zip(want) {
+        assert!((a - b).abs() < 1e-12, "{x:?}");
+    }
+    let x = delayed(&tau, 1.25);
+    let want = [0.0, 0.0, 0.75, 2.5, -1.5];
+    for (a, b) in x.iter().zip(want) {
+        assert!((a - b).abs() < 1e-12, "{x:?}");
+    }
+    assert_eq!(delayed(&tau, 2.0), vec![0.0, 0.0, 0.0, 1.0, 3.0]);
+
+    // m u̇ + d u = X(t − 0.04 s) from rest, X a unit step at t = 0.1 s held
+    // at 10 Hz: exactly, u(t) = (1 − e^{−(t − 0.14) d/m})/d after 0.14 s.
+    let (m, d, h) = (50.0, 20.0, 0.1);
+    let steps: Vec<f64> = (0..40).map(|k| if k >= 1 { 1.0 } else { 0.0 }).collect();
+    let held = delayed(&steps, 0.04 / h);
+    let a = (-d / m * h).exp();
+    let mut u = 0.0;
+    for (k, x) in held.iter().enumerate().take(39) {
+        u = a * u + (1.0 - a) * x / d;
+        let t = (k + 1) as f64 * h;
+        let exact = if t > 0.14 {
+            (1.0 - (-(t - 0.14) * d / m).exp()) / d
+        } else {
+            0.0
+        };
+        // 1e-5 m/s against the 8e-4 m/s the delay itself makes at 0.2 s.
+        assert!((u - exact).abs() < 2e-5, "t {t}: {u} vs {exact}");
+    }
+}
+
 /// m u̇ + d u = X from rest with a step X: the surge-only baseline and
 /// the exact record u = X/d (1 − e^{−t d/m}) of `n` samples every `h`.
 fn step_response(m: f64, d: f64, x: f64, n: usize, h: f64) -> (Baseline, Record) {

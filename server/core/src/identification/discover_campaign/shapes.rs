@@ -11,7 +11,6 @@
 
 use super::shared::{CampaignEstimate, chi2_95};
 use super::{PointDiscovery, speeds_text};
-use crate::discrepancy::candidates::ShapeKind;
 use crate::discrepancy::locate::capital;
 use crate::discrepancy::report::{Estimate, ModelReport};
 use crate::discrepancy::{
@@ -85,11 +84,7 @@ fn pool(effect: Effect, terms: &[(f64, &ModelTerm)]) -> Option<PooledShape> {
     let dof = ests.len() - 1;
     let disagree = chi2 > chi2_95(dof);
     let var = 1.0 / w_sum;
-    let value = match kind {
-        // A delay is a whole number of log samples.
-        ShapeKind::DelaySamples => mean.round().max(1.0),
-        _ => mean,
-    };
+    let value = mean;
     let std = var.sqrt();
     if !(value.is_finite() && std.is_finite()) {
         return None;
@@ -241,11 +236,12 @@ mod tests {
     }
 
     #[test]
-    fn a_delay_pools_to_whole_samples_and_one_estimate_is_not_pooled() {
+    fn a_delay_pools_to_its_fraction_of_a_sample_and_one_estimate_is_not_pooled() {
         let e = Effect::InputDelay { dof: Dof::Sway };
-        let (a, b) = (term(e, 2.4, 0.5), term(e, 2.8, 0.5));
+        // 2.4 ± 0.5 and 2.8 ± 0.25 samples: weights 4 and 16.
+        let (a, b) = (term(e, 2.4, 0.5), term(e, 2.8, 0.25));
         let p = pool(e, &[(0.5, &a), (1.0, &b)]).unwrap();
-        assert_eq!(p.value, 3.0);
+        assert!((p.value - 2.72).abs() < 1e-12, "{}", p.value);
         assert!(pool(e, &[(0.5, &a)]).is_none());
     }
 }
