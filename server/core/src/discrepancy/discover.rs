@@ -176,7 +176,7 @@ pub fn discover_from(
         min_force_share: settings.min_force_share,
         cv_candidates: settings.cv_candidates,
         max_lag_s: settings.max_lag_s,
-        max_delay_samples: ((settings.max_delay_s / h).round() as usize).max(1),
+        max_delay_samples: (settings.max_delay_s / h).max(1.0),
         k_step: k,
     };
     let runs: Vec<usize> = (0..est.len()).collect();

@@ -31,7 +31,8 @@ pub(crate) struct Criteria {
     pub min_force_share: f64,
     pub cv_candidates: usize,
     pub max_lag_s: f64,
-    pub max_delay_samples: usize,
+    /// The longest delay searched, in log samples (at least one).
+    pub max_delay_samples: f64,
     pub k_step: usize,
 }
 
@@ -97,7 +98,7 @@ fn shape_grid(prep: &Prepared<'_>, effect: Effect, runs: &[usize], c: &Criteria)
         // 10 Hz is 0.4 of one) to the longest, refined between neighbours:
         // a delay need not be whole samples.
         Some(ShapeKind::LagTime) => log_grid(0.2 * h, c.max_lag_s.max(h)),
-        Some(ShapeKind::DelaySamples) => log_grid(0.2, (c.max_delay_samples as f64).max(1.0)),
+        Some(ShapeKind::DelaySamples) => log_grid(0.2, c.max_delay_samples),
         Some(ShapeKind::SaturationLevel) => {
             // Quantiles of the command, and a log grid down to 2 % of its
             // largest value: under closed-loop control a hull that gets far

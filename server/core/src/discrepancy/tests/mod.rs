@@ -66,7 +66,7 @@ fn a_damping_term_that_would_inject_energy_is_not_significant() {
         min_force_share: 0.02,
         cv_candidates: 5,
         max_lag_s: 3.0,
-        max_delay_samples: 10,
+        max_delay_samples: 10.0,
         k_step: 10,
     };
     let effect = Effect::QuadraticDamping { dof: Dof::Surge };
