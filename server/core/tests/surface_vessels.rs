@@ -222,8 +222,9 @@ fn the_otter_without_a_current_comes_within_five_hundredths() {
 /// The Otter in a current: the current within 5 % and 3° on every seed,
 /// and the free runs, whose heading (and with it the current's push in the
 /// body frame) the model integrates over 180 s, within 0.05 of the true
-/// model's on every seed (measured: 0.003–0.049; seed 4's 0.29 m/s
-/// current, near its slowest level, 0.049). Three things carry it: turns
+/// model's on every seed (measured: 0.002–0.020; seed 4's 0.29 m/s
+/// current, near its slowest level, 0.020, 0.049 before the velocities'
+/// noise was discounted in the regression). Three things carry it: turns
 /// flown at two amplitudes (at one, the model fitted there damped smaller
 /// turns too much and its heading drifted: seeds 2 and 4 0.051 and
 /// 0.072), C(δ)δ, which acts through the never-forced sway mass, kept
@@ -254,13 +255,17 @@ fn the_otter_in_a_current_finds_it_and_follows_the_held_out_run() {
 /// The Otter in a current of 0.3–0.5 m/s, as strong as its slowest level
 /// or stronger: the current is still found within 5 % and 3° on every
 /// seed (measured: within 0.6 % and 1°), and the whole-run free runs come
-/// within 0.05 of the true model's on 5 of 6 seeds and within 0.1 on all
-/// (measured gaps 0.015 0.003 0.010 0.062 0.018 0.044; seed 4, a 0.495 m/s
-/// current, 0.062). With the current as fast as the hull, a small error in
-/// the model's own heading turns a push as large as its speed through the
-/// water. Before the sub-models were fitted and stepped on ν_r the gaps
-/// were 0.023–0.396: the current's rotation M ν̇_c acted through the sway
-/// mass no run forced, which the grid points then estimated at 45–105 kg.
+/// within 0.05 of the true model's on every seed (measured gaps 0.009
+/// 0.004 0.008 0.028 0.016 0.047). With the current as fast as the hull, a
+/// small error in the model's own heading turns a push as large as its
+/// speed through the water. Two things carry it: the sub-models fitted and
+/// stepped on ν_r (before, the gaps were 0.023–0.396: the current's
+/// rotation M ν̇_c acted through the sway mass no run forced, which the
+/// grid points then estimated at 45–105 kg), and the velocities' noise
+/// discounted in the regression (before, 0.015 0.003 0.010 0.062 0.018
+/// 0.044: 1 cm/s of GNSS noise on an unforced sway of a few cm/s shrank
+/// N_v, the Munk moment's way into yaw, and seed 4's heading drifted 7° in
+/// 160 s under a 0.495 m/s current).
 #[test]
 fn the_otter_in_a_strong_current_finds_it() {
     let strong: Vec<&SurfaceReport> = otter_reports()
@@ -268,24 +273,17 @@ fn the_otter_in_a_strong_current_finds_it() {
         .filter(|r| r.label == "Otter strong current")
         .collect();
     assert_eq!(strong.len(), OTTER_SEEDS.len());
-    let mut within = 0;
     for r in &strong {
         assert_current_within_five_percent_and_three_degrees(r);
         let gap = r.worst_gap().expect("every channel has a free run");
         assert!(
-            gap <= 0.1,
+            gap <= 0.05,
             "seed {}: {}\n{}",
             r.seed,
             r.line(),
             r.notes.join("\n")
         );
-        within += usize::from(gap <= 0.05);
     }
-    assert!(
-        within + 1 >= strong.len(),
-        "{within} of {} within 0.05",
-        strong.len()
-    );
 }
 
 /// The Otter's current named once for the campaign, its speed within 5 %

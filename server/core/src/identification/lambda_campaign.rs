@@ -27,6 +27,7 @@ use super::ned_current;
 use super::outcome::Identified;
 use super::roles::assign_roles;
 use super::through_water;
+use super::velocity_noise::{add_velocity_noise, velocity_noise_std};
 use crate::estimation::lambda::{Experiment, LambdaSettings, MIN_T_OVER_H, Prior};
 use crate::estimation::restoring::RestoringParams;
 use crate::estimation::{Progress, SubProgress};
@@ -219,6 +220,31 @@ fn identify(
         ));
     }
 
+    // The noise of the velocities no run forced, a regressor error of
+    // [λν] (discounted likewise). A forced DOF's is left: behind a
+    // feedback controller the same noise is in τ too, which the white-
+    // noise excess alone does not describe.
+    let velocity_std = velocity_noise_std(&logged)
+        .filter(|_| !unforced.is_empty())
+        .map(|sd| {
+            sd.iter()
+                .zip(&dofs)
+                .map(|(s, d)| if unforced.contains(d) { *s } else { 0.0 })
+                .collect::<Vec<f64>>()
+        });
+    if let Some(sd) = &velocity_std {
+        let each: Vec<String> = dofs
+            .iter()
+            .zip(sd)
+            .filter(|(d, _)| unforced.contains(d))
+            .map(|(d, s)| format!("{} {} {}", d.velocity_symbol(), sig3(*s), d.velocity_unit()))
+            .collect();
+        notes.push(format!(
+            "the velocity of the DOF no run forced carries white noise of {} (from each sample against the cubic through its neighbours); it moves little against that noise, which in the sub-models' regression is an error in the filtered velocity that would shrink its coefficients (an unforced sway's N_v, the Munk moment's way into yaw); it is discounted (bias-compensated least squares) as far as each coefficient stays determined by the data",
+            each.join(", ")
+        ));
+    }
+
     let second_order = settings.coriolis_second_order && dofs.contains(&Dof::Surge);
     let quad_cols = if settings.quadratic_damping {
         lambda_quadratic::columns(&dofs, grid)
@@ -272,6 +298,9 @@ fn identify(
                         .as_ref()
                         .map(|x| attitude_shape_noise(n, &x.names, sd))
                 });
+        if quad_cols.is_empty() {
+            add_velocity_noise(&mut lambda_settings, velocity_std.as_deref());
+        }
         let mut sub = SubProgress::new(progress, 0.05, 0.4);
         let first = build(None, joint_functions)?;
         let first = if with_current { heading(first) } else { first };
@@ -323,6 +352,7 @@ fn identify(
         )),
         _ => None,
     };
+    add_velocity_noise(&mut lambda_settings, velocity_std.as_deref());
     let mut current = if with_current {
         ned_current::campaign_current(&joint, &mut notes)
     } else {

@@ -76,6 +76,7 @@ pub mod predictor;
 pub mod roles;
 pub mod state_space;
 mod through_water;
+mod velocity_noise;
 
 pub use dataset::{DatasetError, RunInput, Segment, segments};
 pub use describe::{DescribeError, DofActivity, InferredDescription, infer_description};

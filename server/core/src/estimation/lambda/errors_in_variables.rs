@@ -73,28 +73,59 @@ pub(crate) fn expected_excess(
 }
 
 /// Subtracts `excess` from the Gram matrix of `stats`, scaled down (halved
-/// up to six times, then not at all) where the whole would leave it not
-/// positive definite: a sample that shows less regressor variance than the
-/// noise alone would give is not corrected past it. Returns the share
-/// applied (0 … 1).
+/// up to six times, then not at all) where the whole would take more than
+/// [`KEPT_INFORMATION`]'s complement of any column's information: a
+/// regressor that moves little against its noise (an unforced sway's few
+/// cm/s under 1 cm/s of GNSS noise) is corrected only as far as the data
+/// still determine its coefficient; past that, the correction trades a
+/// small bias for an undetermined estimate. Returns the share applied
+/// (0 … 1).
 pub(crate) fn compensate(stats: &mut RegressionStats, excess: &DMatrix<f64>) -> f64 {
     if excess.shape() != stats.gram.shape() || excess.iter().any(|v| !v.is_finite()) {
         return 0.0;
     }
-    // Keep a margin: what remains must hold a tenth of each column's own
-    // scale, so that a regressor of pure noise is left to the prior rather
-    // than to a Gram entry near zero.
+    // Over the columns that carry anything: a regressor identically zero
+    // (a DOF no run forced, τ_Y ≡ 0) is the prior's either way.
+    let live: Vec<usize> = (0..stats.gram.nrows())
+        .filter(|&j| stats.gram[(j, j)] > 0.0)
+        .collect();
+    let Some(before) = information(&stats.gram, &live) else {
+        return 0.0;
+    };
     let mut share = 1.0;
     for _ in 0..7 {
         let g = &stats.gram - excess * share;
-        let diag_ok = (0..g.nrows()).all(|j| g[(j, j)] >= 0.1 * stats.gram[(j, j)]);
-        if diag_ok && g.clone().cholesky().is_some() {
+        let kept = information(&g, &live).is_some_and(|after| {
+            after
+                .iter()
+                .zip(&before)
+                .all(|(a, b)| *a >= KEPT_INFORMATION * b)
+        });
+        if kept {
             stats.gram = g;
             return share;
         }
         share *= 0.5;
     }
     0.0
+}
+
+/// Least share of each column's information (1/[G⁻¹]_jj, its variance not
+/// explained by the other columns) the correction leaves.
+const KEPT_INFORMATION: f64 = 0.5;
+
+/// 1/[G⁻¹]_jj of the `live` columns of `g`, `None` unless that block is
+/// positive definite.
+fn information(g: &DMatrix<f64>, live: &[usize]) -> Option<Vec<f64>> {
+    let inv = g
+        .select_rows(live)
+        .select_columns(live)
+        .cholesky()?
+        .inverse();
+    let info: Vec<f64> = inv.diagonal().iter().map(|v| 1.0 / v).collect();
+    info.iter()
+        .all(|v| v.is_finite() && *v > 0.0)
+        .then_some(info)
 }
 
 #[cfg(test)]
