@@ -240,7 +240,7 @@ fn identify(
             .map(|(d, s)| format!("{} {} {}", d.velocity_symbol(), sig3(*s), d.velocity_unit()))
             .collect();
         notes.push(format!(
-            "the velocity of the DOF no run forced carries white noise of {} (from each sample against the cubic through its neighbours); it moves little against that noise, which in the sub-models' regression is an error in the filtered velocity that would shrink its coefficients (an unforced sway's N_v, the Munk moment's way into yaw); it is discounted (bias-compensated least squares) as far as each coefficient stays determined by the data",
+            "the velocities no run forced carry white noise of {} (from each sample against the cubic through its neighbours); they move little against it, and in the sub-models' regression it is an error in the filtered velocities that would shrink their coefficients (an unforced sway's N_v, the Munk moment's way into yaw); it is discounted (bias-compensated least squares) as far as each coefficient stays determined by the data",
             each.join(", ")
         ));
     }

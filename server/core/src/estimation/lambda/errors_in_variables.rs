@@ -171,4 +171,25 @@ mod tests {
         let bad = DMatrix::from_element(2, 2, f64::NAN);
         assert_eq!(compensate(&mut stats, &bad), 0.0);
     }
+
+    /// A regressor identically zero (τ_Y of an unforced sway) leaves the
+    /// correction in force over the others; a column nearly explained by
+    /// another (information 1 − 1.9²/4 = 0.0975 of its 1) is corrected
+    /// only as far as half its information stays: the whole 0.05 would
+    /// leave 0.0475, half of it 0.0725.
+    #[test]
+    fn a_zero_column_does_not_void_the_correction_and_collinear_ones_keep_half() {
+        let mut stats = RegressionStats::new(1, 3);
+        stats.gram = DMatrix::from_row_slice(3, 3, &[4.0, 1.9, 0.0, 1.9, 1.0, 0.0, 0.0, 0.0, 0.0]);
+        let mut excess = DMatrix::zeros(3, 3);
+        excess[(1, 1)] = 0.05;
+        assert_eq!(compensate(&mut stats, &excess), 0.5);
+        assert!((stats.gram[(1, 1)] - 0.975).abs() < 1e-15);
+        assert_eq!(stats.gram[(2, 2)], 0.0);
+        assert_eq!(stats.gram[(0, 0)], 4.0);
+        // Away from collinearity the whole excess is taken.
+        stats.gram = DMatrix::from_row_slice(3, 3, &[4.0, 0.2, 0.0, 0.2, 1.0, 0.0, 0.0, 0.0, 0.0]);
+        assert_eq!(compensate(&mut stats, &excess), 1.0);
+        assert!((stats.gram[(1, 1)] - 0.95).abs() < 1e-15);
+    }
 }
