@@ -224,8 +224,9 @@ fn identify(
     // [λν] (discounted likewise). A forced DOF's is left: behind a
     // feedback controller the same noise is in τ too, which the white-
     // noise excess alone does not describe.
-    let velocity_std = velocity_noise_std(&logged)
-        .filter(|_| !unforced.is_empty())
+    let velocity_std = (!unforced.is_empty())
+        .then(|| velocity_noise_std(&logged))
+        .flatten()
         .map(|sd| {
             sd.iter()
                 .zip(&dofs)
