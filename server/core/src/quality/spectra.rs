@@ -125,7 +125,7 @@ pub(crate) fn compute(prep: &Prepared<'_>) -> Result<SpectralPart, QualityError>
 fn pair_spectra(
     input: &str,
     output: &str,
-    planes: (Vec<&[f64]>, &[f64]),
+    sums: (Vec<&[f64]>, &[f64]),
     pxx: (&[f64], &[f64]),
     inv_pyy: &[f64],
     scratch: &mut Scratch,
@@ -133,9 +133,9 @@ fn pair_spectra(
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has the feature the function is compiled for.
-        return unsafe { pair_spectra_avx2(input, output, planes, pxx, inv_pyy, scratch) };
+        return unsafe { pair_spectra_avx2(input, output, sums, pxx, inv_pyy, scratch) };
     }
-    pair_spectra_body(input, output, planes, pxx, inv_pyy, scratch)
+    pair_spectra_body(input, output, sums, pxx, inv_pyy, scratch)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -143,12 +143,12 @@ fn pair_spectra(
 fn pair_spectra_avx2(
     input: &str,
     output: &str,
-    planes: (Vec<&[f64]>, &[f64]),
+    sums: (Vec<&[f64]>, &[f64]),
     pxx: (&[f64], &[f64]),
     inv_pyy: &[f64],
     scratch: &mut Scratch,
 ) -> PairSpectra {
-    pair_spectra_body(input, output, planes, pxx, inv_pyy, scratch)
+    pair_spectra_body(input, output, sums, pxx, inv_pyy, scratch)
 }
 
 #[inline(always)]
@@ -163,31 +163,37 @@ fn pair_spectra_body(
     let Scratch {
         re,
         im,
-        norm_sqr,
+        log10,
         phase,
     } = scratch;
     cross_from_parts(&parts, factors, re, im);
-    let (re, im) = (&re[..], &im[..]);
-    let nf = re.len();
-    // |Pxy|² as `Complex::norm_sqr`: re² + im².
-    norm_sqr.clear();
-    norm_sqr.extend(re.iter().zip(im).map(|(r, i)| r * r + i * i));
-    let csd_magnitude: Vec<f64> = norm_sqr.iter().map(|v| v.sqrt()).collect();
-    let coherence = norm_sqr
+    let (re_all, im_all) = (&re[..], &im[..]);
+    let nf = re_all.len();
+    // |Pxy|² as `Complex::norm_sqr` (re² + im²); collected, not zeroed
+    // and then written.
+    let n = nf.min(inv_pxx.len()).min(inv_pyy.len());
+    let (re, im) = (&re_all[..n], &im_all[..n]);
+    let csd_magnitude: Vec<f64> = re
         .iter()
+        .zip(im)
+        .map(|(r, i)| (r * r + i * i).sqrt())
+        .collect();
+    let coherence: Vec<f64> = re
+        .iter()
+        .zip(im)
         .zip(inv_pxx.iter().zip(inv_pyy))
-        .map(|(v, (&a, &b))| v * a * b)
+        .map(|((r, i), (&a, &b))| (r * r + i * i) * a * b)
         .collect();
     let h1_magnitude: Vec<f64> = csd_magnitude
         .iter()
         .zip(inv_pxx)
         .map(|(m, &a)| m * a)
         .collect();
-    let mut h1_magnitude_db = vec![0.0; nf];
-    log10_into(&h1_magnitude, &mut h1_magnitude_db);
-    h1_magnitude_db.iter_mut().for_each(|d| *d *= 20.0);
+    log10.resize(n, 0.0);
+    log10_into(&h1_magnitude, log10);
+    let h1_magnitude_db: Vec<f64> = log10.iter().map(|d| d * 20.0).collect();
     phase.resize(nf, 0.0);
-    atan2_into(im, re, phase);
+    atan2_into(im_all, re_all, phase);
     for (p, &a) in phase.iter_mut().zip(pxx) {
         if a == 0.0 {
             *p = 0.0;
@@ -212,6 +218,6 @@ struct Scratch {
     /// `Re P_xy`, `Im P_xy`.
     re: Vec<f64>,
     im: Vec<f64>,
-    norm_sqr: Vec<f64>,
+    log10: Vec<f64>,
     phase: Vec<f64>,
 }

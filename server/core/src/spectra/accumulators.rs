@@ -1,13 +1,16 @@
 //! The sums of a multichannel Welch estimate: `Σ |X_c|²` per channel and
 //! `Σ conj(X_i)·X_j` per requested pair, over segments.
 //!
-//! The spectra of up to [`BATCH`] segments are held split into real and
-//! imaginary planes, so that the per-pair loops are plain element-wise
-//! multiply–adds the compiler vectorises, then added to the cross sums in
-//! one pass over them (the sums of a 6 × 6 report outgrow a core's L2
-//! cache). Every sum still runs over the segments in order. (Adding pairs
-//! that share a channel together, to load its values once, was slower:
-//! the compiler spilled the wider kernel's registers.)
+//! The FFT writes each segment's spectrum straight into a slot held here
+//! (up to [`BATCH`] segments of every channel), and its PSD term is added
+//! at once, while the spectrum is still in L1. The held segments are then
+//! added to every pair's cross sum in one pass over bins in blocks of
+//! [`BIN_BLOCK`]: a block of every channel's held spectra (~100 KB for a
+//! 6 × 6 report) stays in L2 while the pairs read it, and each pair's sums
+//! are read and written once per batch (the 36 sums of a 6 × 6 report at
+//! `nperseg = 4096` take 1.2 MB, more than a core's L2). The first batch
+//! stores its sums rather than adding them to zeros. Every sum runs over
+//! the segments in order.
 
 use realfft::num_complex::Complex;
 
@@ -15,19 +18,25 @@ use super::multichannel::MultiSpectra;
 use crate::kernels::{has_avx2_fma, madd};
 
 /// Segments whose spectra are held before they are added to the cross
-/// spectra: the 36 cross sums of a 6 × 6 report at `nperseg = 4096` take
-/// 1.2 MB, so each pass over them is paid by four segments, not one.
+/// spectra: each pass over the cross sums is paid by this many segments.
 pub(super) const BATCH: usize = 4;
+
+/// Bins per block of the cross-sum pass (even: a block's bins go in pairs
+/// of two complex values per 4-lane register).
+const BIN_BLOCK: usize = 128;
 
 /// See the [module documentation](self).
 pub(super) struct Accumulators {
     nf: usize,
-    /// Held spectra, `[channel][slot][re | im][bin]`: channel c, slot s at
-    /// `(c·BATCH + s)·2nf`, its imaginary plane `nf` further.
-    planes: Vec<f64>,
+    /// Held spectra, `[channel][slot][bin]`: channel c, slot s at
+    /// `(c·BATCH + s)·nf`. Without pairs, one spectrum reused by every
+    /// channel and segment.
+    slots: Vec<Complex<f64>>,
     auto: Vec<f64>,
-    /// Cross sums, `[pair][re | im][bin]`.
+    /// Cross sums, `[pair][bin][re, im]`; unspecified until the first
+    /// batch stores them (`summed`).
     cross: Vec<f64>,
+    summed: bool,
     /// Absorbed parts' cross sums, still to be added (see `absorb`).
     held: Vec<Vec<f64>>,
     pairs: Vec<(usize, usize)>,
@@ -46,63 +55,73 @@ impl Accumulators {
     /// calling thread's kept ones; the zeroing can run on the thread that
     /// adds.
     pub(super) fn unzeroed(n_channels: usize, pairs: &[(usize, usize)], nf: usize) -> Self {
-        let slots = if pairs.is_empty() { 0 } else { BATCH };
+        let held_spectra = if pairs.is_empty() {
+            nf
+        } else {
+            n_channels * BATCH * nf
+        };
         Accumulators {
             nf,
-            // Every held value is written (`add_channel`) before it is read
-            // (`add_segments`): never zeroed (1.6 MB for a 6 × 6 report).
-            planes: scratch::reused(n_channels * slots * 2 * nf),
+            // Every held value is written (by the FFT) before it is read.
+            slots: scratch::reused_complex(held_spectra),
             auto: scratch::reused(n_channels * nf),
             cross: scratch::reused(pairs.len() * 2 * nf),
+            summed: false,
             held: Vec::new(),
             pairs: pairs.to_vec(),
         }
     }
 
-    /// Sets every sum to zero.
     /// Unzeroed sums of the same shape (see [`Self::unzeroed`]).
     pub(super) fn sibling(&self) -> Self {
         let n_channels = self.auto.len() / self.nf.max(1);
         Self::unzeroed(n_channels, &self.pairs, self.nf)
     }
 
+    /// Sets every sum to zero (the cross sums by storing the first batch).
     pub(super) fn zero(&mut self) {
         self.auto.fill(0.0);
-        self.cross.fill(0.0);
+        self.summed = false;
     }
 
-    /// Adds `|X|²` of channel `c`'s spectrum to its PSD and, when there are
-    /// pairs, holds the spectrum in slot `slot < BATCH`.
-    pub(super) fn add_channel(&mut self, slot: usize, c: usize, spec: &[Complex<f64>]) {
+    /// The slot for channel `c`'s spectrum of the batch's `slot`-th segment
+    /// (`slot < BATCH`): written by the FFT, then [`Self::add_channel`].
+    pub(super) fn slot_mut(&mut self, slot: usize, c: usize) -> &mut [Complex<f64>] {
+        let off = if self.pairs.is_empty() {
+            0
+        } else {
+            (c * BATCH + slot) * self.nf
+        };
+        &mut self.slots[off..off + self.nf]
+    }
+
+    /// Adds `|X|²` of the spectrum in channel `c`'s `slot` to its PSD.
+    pub(super) fn add_channel(&mut self, slot: usize, c: usize) {
         #[cfg(target_arch = "x86_64")]
         if has_avx2_fma() {
             // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { self.add_channel_fma(slot, c, spec) };
+            return unsafe { self.add_channel_fma(slot, c) };
         }
-        self.add_channel_body::<false>(slot, c, spec)
+        self.add_channel_body::<false>(slot, c)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    fn add_channel_fma(&mut self, slot: usize, c: usize, spec: &[Complex<f64>]) {
-        self.add_channel_body::<true>(slot, c, spec)
+    fn add_channel_fma(&mut self, slot: usize, c: usize) {
+        self.add_channel_body::<true>(slot, c)
     }
 
     #[inline(always)]
-    fn add_channel_body<const FMA: bool>(&mut self, slot: usize, c: usize, spec: &[Complex<f64>]) {
+    fn add_channel_body<const FMA: bool>(&mut self, slot: usize, c: usize) {
         let nf = self.nf;
+        let off = if self.pairs.is_empty() {
+            0
+        } else {
+            (c * BATCH + slot) * nf
+        };
+        let spec = &self.slots[off..off + nf];
         let auto = &mut self.auto[c * nf..(c + 1) * nf];
-        if self.planes.is_empty() {
-            for (s, a) in spec.iter().zip(auto) {
-                *a += madd::<FMA>(s.re, s.re, s.im * s.im);
-            }
-            return;
-        }
-        let off = (c * BATCH + slot) * 2 * nf;
-        let (re, im) = self.planes[off..off + 2 * nf].split_at_mut(nf);
-        for (((s, r), i), a) in spec.iter().zip(re).zip(im).zip(auto) {
-            *r = s.re;
-            *i = s.im;
+        for (s, a) in spec.iter().zip(auto) {
             // Without FMA the same expression as `Complex::norm_sqr`
             // (bit-identical to `welch`).
             *a += madd::<FMA>(s.re, s.re, s.im * s.im);
@@ -112,76 +131,149 @@ impl Accumulators {
     /// Adds the cross products of the segments held in slots `0..count`
     /// (in slot order) to every pair.
     pub(super) fn add_segments(&mut self, count: usize) {
+        if self.pairs.is_empty() || count == 0 {
+            return;
+        }
         match count {
-            0 => {}
             1 => self.add::<1>(),
             2 => self.add::<2>(),
             3 => self.add::<3>(),
             _ => self.add::<BATCH>(),
         }
+        self.summed = true;
     }
 
     fn add<const S: usize>(&mut self) {
         #[cfg(target_arch = "x86_64")]
         if has_avx2_fma() {
             // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { self.add_fma::<S>() };
+            return unsafe { self.add_avx2::<S>() };
         }
-        self.add_body::<false, S>()
+        self.add_body::<S>()
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn add_fma<const S: usize>(&mut self) {
-        self.add_body::<true, S>()
-    }
-
-    #[inline(always)]
-    fn add_body<const FMA: bool, const S: usize>(&mut self) {
+    /// [`Self::add`] in plain arithmetic: the sums in the order of
+    /// `csd`'s (bit-identical to one running sum over the segments).
+    fn add_body<const S: usize>(&mut self) {
         let nf = self.nf;
-        let planes = &self.planes[..];
-        let plane = |c: usize, s: usize| {
-            let off = (c * BATCH + s) * 2 * nf;
-            planes[off..off + 2 * nf].split_at(nf)
-        };
+        let slots = &self.slots[..];
+        let store = !self.summed;
+        let spec = |c: usize, s: usize| &slots[(c * BATCH + s) * nf..(c * BATCH + s + 1) * nf];
         for (sums, &(i, j)) in self.cross.chunks_exact_mut(2 * nf).zip(&self.pairs) {
-            let x: [_; S] = std::array::from_fn(|s| plane(i, s));
-            let y: [_; S] = std::array::from_fn(|s| plane(j, s));
-            let (acc_re, acc_im) = sums.split_at_mut(nf);
-            for k in 0..nf {
-                let (mut re, mut im) = (acc_re[k], acc_im[k]);
+            let x: [_; S] = std::array::from_fn(|s| spec(i, s));
+            let y: [_; S] = std::array::from_fn(|s| spec(j, s));
+            for (k, acc) in sums.chunks_exact_mut(2).enumerate() {
+                let (mut re, mut im) = if store { (0.0, 0.0) } else { (acc[0], acc[1]) };
                 for s in 0..S {
-                    let ((xr, xi), (yr, yi)) = (x[s], y[s]);
-                    (re, im) = term::<FMA>(xr[k], xi[k], yr[k], yi[k], re, im);
+                    let (a, b) = (x[s][k], y[s][k]);
+                    re += a.re * b.re + a.im * b.im;
+                    im += a.re * b.im + -(a.im * b.re);
                 }
-                acc_re[k] = re;
-                acc_im[k] = im;
+                acc[0] = re;
+                acc[1] = im;
             }
         }
+    }
+
+    /// [`Self::add`] in 4-lane registers, two bins per register as the FFT
+    /// leaves them (re, im, re, im), for runs of up to [`GROUP`]
+    /// consecutive pairs that share their first channel x (a 6 × 6
+    /// report's pairs are input-major): x is loaded once for the run, and
+    /// per pair `p = Σ_s x ⊙ y` and `q = Σ_s (−x_im, x_re) ⊙ y` over the
+    /// segments, then `hadd(p, q) = (Re conj(x)y, Im conj(x)y)` of both
+    /// bins is added to the sums. Bins in blocks of [`BIN_BLOCK`] (see the
+    /// module documentation).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn add_avx2<const S: usize>(&mut self) {
+        let nf = self.nf;
+        let store = !self.summed;
+        let pairs_len = nf / 2 * 2;
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        for (p, &(i, _)) in self.pairs.iter().enumerate() {
+            match runs.last_mut() {
+                Some((first, len)) if *len < GROUP && self.pairs[*first].0 == i => *len += 1,
+                _ => runs.push((p, 1)),
+            }
+        }
+        let held = Held {
+            slots: &self.slots,
+            nf,
+            even: pairs_len,
+        };
+        for b0 in (0..pairs_len).step_by(BIN_BLOCK) {
+            let bins = b0..(b0 + BIN_BLOCK).min(pairs_len);
+            for &(first, len) in &runs {
+                let sums = &mut self.cross[first * 2 * nf..(first + len) * 2 * nf];
+                let pairs = &self.pairs[first..first + len];
+                let i = pairs[0].0;
+                let j = |g: usize| pairs[g.min(len - 1)].1;
+                let bins = bins.clone();
+                match len {
+                    1 => cross_run::<S, 1>(&held, i, [j(0)], sums, bins, store),
+                    2 => cross_run::<S, 2>(&held, i, [j(0), j(1)], sums, bins, store),
+                    3 => cross_run::<S, 3>(&held, i, [j(0), j(1), j(2)], sums, bins, store),
+                    _ => cross_run::<S, 4>(&held, i, [j(0), j(1), j(2), j(3)], sums, bins, store),
+                }
+            }
+        }
+        let spec = |c: usize, s: usize| held.spec(c, s);
+        if pairs_len < nf {
+            // The last bin of an odd count, in plain arithmetic.
+            let k = nf - 1;
+            for (sums, &(i, j)) in self.cross.chunks_exact_mut(2 * nf).zip(&self.pairs) {
+                let (mut re, mut im) = if store {
+                    (0.0, 0.0)
+                } else {
+                    (sums[2 * k], sums[2 * k + 1])
+                };
+                for s in 0..S {
+                    let (a, b) = (spec(i, s)[k], spec(j, s)[k]);
+                    re = a.im.mul_add(b.im, a.re.mul_add(b.re, re));
+                    im = (-a.im).mul_add(b.re, a.re.mul_add(b.im, im));
+                }
+                sums[2 * k] = re;
+                sums[2 * k + 1] = im;
+            }
+        }
+    }
+
+    /// The cross sums, zeros when no batch was added.
+    fn cross_sums(&mut self) -> &mut Vec<f64> {
+        if !self.summed {
+            self.cross.fill(0.0);
+            self.summed = true;
+        }
+        &mut self.cross
     }
 
     /// Adds the sums of `other` (same channels, pairs and bins) to these,
     /// and keeps its buffers for the next call on this thread. The PSD
     /// sums are added at once; `other`'s cross sums (with what it absorbed
     /// added to them) are held apart and added where they are read
-    /// ([`PlaneSpectra::pair_sums`], [`Accumulators::finish`]): the pairs'
+    /// ([`SummedSpectra::pair_sums`], [`Accumulators::finish`]): the pairs'
     /// own pass then does it on every thread, not one pass on one thread.
     pub(super) fn absorb(&mut self, mut other: Accumulators) {
         for (a, b) in self.auto.iter_mut().zip(&other.auto) {
             *a += b;
         }
         other.fold_held();
-        self.held.push(other.cross);
-        for buffer in [other.planes, other.auto] {
-            scratch::give_back(buffer);
-        }
+        other.cross_sums();
+        self.held.push(std::mem::take(&mut other.cross));
+        scratch::give_back(std::mem::take(&mut other.auto));
+        scratch::give_back_complex(std::mem::take(&mut other.slots));
     }
 
     /// Adds the held cross sums to the cross sums, in the order they were
     /// absorbed.
     fn fold_held(&mut self) {
-        for held in std::mem::take(&mut self.held) {
-            par_zip(&mut self.cross, &held, PARALLEL_VALUES / 2, |a, b| {
+        let held = std::mem::take(&mut self.held);
+        if held.is_empty() {
+            return;
+        }
+        let cross = self.cross_sums();
+        for held in held {
+            par_zip(cross, &held, PARALLEL_VALUES / 2, |a, b| {
                 for (a, b) in a.iter_mut().zip(b) {
                     *a += b;
                 }
@@ -198,25 +290,25 @@ impl Accumulators {
             .collect()
     }
 
-    /// [`Accumulators::finish`] with the cross sums left in their planes,
-    /// with the parts they are still to be added to and the density
-    /// factors: see [`PlaneSpectra::pair_sums`].
-    pub(super) fn finish_planes(
-        self,
+    /// [`Accumulators::finish`] with the cross sums left as they were
+    /// summed, with the parts they are still to be added to and the
+    /// density factors: see [`SummedSpectra::pair_sums`].
+    pub(super) fn finish_sums(
+        mut self,
         factors: &[f64],
         freqs: Vec<f64>,
         n_segments: usize,
-    ) -> PlaneSpectra {
+    ) -> SummedSpectra {
         let auto = self.scaled_auto(factors);
-        for buffer in [self.planes, self.auto] {
-            scratch::give_back(buffer);
-        }
-        PlaneSpectra {
+        self.cross_sums();
+        scratch::give_back(std::mem::take(&mut self.auto));
+        scratch::give_back_complex(std::mem::take(&mut self.slots));
+        SummedSpectra {
             freqs,
             auto,
             n_segments,
-            cross: self.cross,
-            held: self.held,
+            cross: std::mem::take(&mut self.cross),
+            held: std::mem::take(&mut self.held),
             factors: factors.to_vec(),
             nf: self.nf,
         }
@@ -234,20 +326,18 @@ impl Accumulators {
         let nf = self.nf;
         let auto = self.scaled_auto(factors);
         let cross = self
-            .cross
+            .cross_sums()
             .chunks_exact(2 * nf.max(1))
             .map(|sums| {
-                let (r, i) = sums.split_at(nf.max(1));
-                r.iter()
-                    .zip(i)
+                sums.chunks_exact(2)
                     .zip(factors)
-                    .map(|((r, i), f)| Complex::new(r * f, i * f))
+                    .map(|(c, f)| Complex::new(c[0] * f, c[1] * f))
                     .collect()
             })
             .collect();
-        for buffer in [self.planes, self.auto, self.cross] {
-            scratch::give_back(buffer);
-        }
+        scratch::give_back(std::mem::take(&mut self.auto));
+        scratch::give_back(std::mem::take(&mut self.cross));
+        scratch::give_back_complex(std::mem::take(&mut self.slots));
         MultiSpectra {
             freqs,
             auto,
@@ -255,6 +345,82 @@ impl Accumulators {
             cross,
             n_segments,
         }
+    }
+}
+
+/// Pairs of one run of the cross-sum pass (see `Accumulators::add_avx2`):
+/// x loaded once for this many.
+const GROUP: usize = 4;
+
+/// The held spectra as the cross-sum pass reads them.
+struct Held<'a> {
+    slots: &'a [Complex<f64>],
+    nf: usize,
+    /// Bins read in pairs: the even count below `nf`.
+    even: usize,
+}
+
+impl Held<'_> {
+    /// Channel `c`'s spectrum in slot `s`, all `nf` bins.
+    fn spec(&self, c: usize, s: usize) -> &[Complex<f64>] {
+        let off = (c * BATCH + s) * self.nf;
+        &self.slots[off..off + self.nf]
+    }
+}
+
+/// Adds `Σ_s conj(X_i)·X_j` over the `S` held segments, at `bins` (even
+/// bounds within `held.even`), to the sums of the `G` pairs `(i, js[g])`
+/// (`sums`: G × `[bin][re, im]` of `nf` bins), or stores it (`store`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn cross_run<const S: usize, const G: usize>(
+    held: &Held<'_>,
+    i: usize,
+    js: [usize; G],
+    sums: &mut [f64],
+    bins: std::ops::Range<usize>,
+    store: bool,
+) {
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_fmadd_pd, _mm256_hadd_pd, _mm256_loadu_pd, _mm256_permute_pd,
+        _mm256_set_pd, _mm256_setzero_pd, _mm256_storeu_pd, _mm256_xor_pd,
+    };
+    let (nf, even) = (held.nf, held.even);
+    assert!(bins.end <= even && sums.len() >= G * 2 * nf);
+    let x: [&[Complex<f64>]; S] = std::array::from_fn(|s| &held.spec(i, s)[..even]);
+    let y: [[&[Complex<f64>]; S]; G] =
+        std::array::from_fn(|g| std::array::from_fn(|s| &held.spec(js[g], s)[..even]));
+    // The sign bit of the even lanes: (x_im, x_re) → (−x_im, x_re).
+    let negate_even = _mm256_set_pd(0.0, -0.0, 0.0, -0.0);
+    let mut k = bins.start;
+    while k + 1 < bins.end {
+        // SAFETY: `k + 1 < bins.end ≤ even`, the length of every `x[s]` and
+        // `y[g][s]` (complex values: two doubles each, `repr(C)`), and
+        // `2k + 3 < 2nf`, within pair g's sums at `g·2nf` (asserted above).
+        unsafe {
+            let mut p = [_mm256_setzero_pd(); G];
+            let mut q = [_mm256_setzero_pd(); G];
+            for s in 0..S {
+                let xv = _mm256_loadu_pd(x[s].as_ptr().add(k).cast::<f64>());
+                let xs = _mm256_xor_pd(_mm256_permute_pd::<0b0101>(xv), negate_even);
+                for g in 0..G {
+                    let yv = _mm256_loadu_pd(y[g][s].as_ptr().add(k).cast::<f64>());
+                    p[g] = _mm256_fmadd_pd(xv, yv, p[g]);
+                    q[g] = _mm256_fmadd_pd(xs, yv, q[g]);
+                }
+            }
+            for g in 0..G {
+                let terms = _mm256_hadd_pd(p[g], q[g]);
+                let dst = sums.as_mut_ptr().add(g * 2 * nf + 2 * k);
+                let v = if store {
+                    terms
+                } else {
+                    _mm256_add_pd(_mm256_loadu_pd(dst), terms)
+                };
+                _mm256_storeu_pd(dst, v);
+            }
+        }
+        k += 2;
     }
 }
 
@@ -275,30 +441,30 @@ fn par_zip(a: &mut [f64], b: &[f64], chunk: usize, f: impl Fn(&mut [f64], &[f64]
         .for_each(|(a, b)| f(a, b));
 }
 
-/// Welch spectra of several channels with the cross spectra in split
-/// planes, as the quality report reads them: [`MultiSpectra`] without its
-/// complex vectors. The planes' buffer is kept for the next call on the
-/// thread that drops it.
-pub(crate) struct PlaneSpectra {
+/// Welch spectra of several channels with the cross spectra left as
+/// summed, as the quality report reads them: [`MultiSpectra`] without its
+/// complex vectors. The sums' buffers are kept for the next call on the
+/// thread that drops them.
+pub(crate) struct SummedSpectra {
     /// Frequencies in Hz.
     pub freqs: Vec<f64>,
     /// One-sided PSD of each channel.
     pub auto: Vec<Vec<f64>>,
     /// Segments averaged.
     pub n_segments: usize,
-    /// Cross sums, `[pair][re | im][bin]`, and the other parts' sums of
-    /// the same shape, to be added in order, then scaled by `factors`.
+    /// Cross sums, `[pair][bin][re, im]`, and the other parts' sums of the
+    /// same shape, to be added in order, then scaled by `factors`.
     cross: Vec<f64>,
     held: Vec<Vec<f64>>,
     factors: Vec<f64>,
     nf: usize,
 }
 
-impl PlaneSpectra {
-    /// The sums of the `p`-th requested pair, `[re | im][bin]`: this
-    /// part's first, then the held parts' (empty when out of range), and
-    /// the density factors per bin. `P_ij = (Σ parts in order) · factor`,
-    /// see [`cross_from_parts`].
+impl SummedSpectra {
+    /// The sums of the `p`-th requested pair, `[bin][re, im]`: this part's
+    /// first, then the held parts' (empty when out of range), and the
+    /// density factors per bin. `P_ij = (Σ parts in order) · factor`, see
+    /// [`cross_from_parts`].
     pub(crate) fn pair_sums(&self, p: usize) -> (Vec<&[f64]>, &[f64]) {
         let span = p * 2 * self.nf..(p + 1) * 2 * self.nf;
         let parts = std::iter::once(&self.cross)
@@ -319,7 +485,7 @@ impl PlaneSpectra {
     }
 }
 
-/// `re, im` = (Σ `parts` in order) · `factors`, each part `[re | im][bin]`.
+/// `re, im` = (Σ `parts` in order) · `factors`, each part `[bin][re, im]`.
 #[inline(always)]
 pub(crate) fn cross_from_parts(
     parts: &[&[f64]],
@@ -327,20 +493,18 @@ pub(crate) fn cross_from_parts(
     re: &mut Vec<f64>,
     im: &mut Vec<f64>,
 ) {
-    let Some((first, rest)) = parts.split_first() else {
-        re.clear();
-        im.clear();
-        return;
-    };
-    let nf = first.len() / 2;
     re.clear();
     im.clear();
-    re.extend_from_slice(&first[..nf]);
-    im.extend_from_slice(&first[nf..]);
+    let Some((first, rest)) = parts.split_first() else {
+        return;
+    };
+    re.extend(first.chunks_exact(2).map(|c| c[0]));
+    im.extend(first.chunks_exact(2).map(|c| c[1]));
     for part in rest {
-        let (r, i) = part.split_at(nf);
-        re.iter_mut().zip(r).for_each(|(a, b)| *a += b);
-        im.iter_mut().zip(i).for_each(|(a, b)| *a += b);
+        for ((r, i), c) in re.iter_mut().zip(im.iter_mut()).zip(part.chunks_exact(2)) {
+            *r += c[0];
+            *i += c[1];
+        }
     }
     for ((r, i), f) in re.iter_mut().zip(im.iter_mut()).zip(factors) {
         *r *= f;
@@ -348,7 +512,7 @@ pub(crate) fn cross_from_parts(
     }
 }
 
-impl Drop for PlaneSpectra {
+impl Drop for SummedSpectra {
     fn drop(&mut self) {
         scratch::give_back(std::mem::take(&mut self.cross));
         for held in std::mem::take(&mut self.held) {
@@ -357,67 +521,69 @@ impl Drop for PlaneSpectra {
     }
 }
 
-/// `(re, im) + conj(x)·y`.
-#[inline(always)]
-fn term<const FMA: bool>(xr: f64, xi: f64, yr: f64, yi: f64, re: f64, im: f64) -> (f64, f64) {
-    if FMA {
-        (
-            madd::<true>(xi, yi, madd::<true>(xr, yr, re)),
-            madd::<true>(-xi, yr, madd::<true>(xr, yi, im)),
-        )
-    } else {
-        (re + (xr * yr + xi * yi), im + (xr * yi + -(xi * yr)))
-    }
-}
-
 /// Accumulator buffers kept per thread between calls. A report's spectra
-/// need about 2 MB of zeroed sums; allocated afresh, each call would fault
+/// need about 3 MB of buffers; allocated afresh, each call would fault
 /// those pages in from the kernel again (a third of the time of a 1-hour
-/// report), reused they are only zeroed.
+/// report).
 mod scratch {
     use std::cell::RefCell;
 
-    /// Buffers kept per thread.
+    use realfft::num_complex::Complex;
+
+    /// Buffers kept per thread, of each kind.
     const KEPT: usize = 8;
 
     thread_local! {
         static FREE: RefCell<Vec<Vec<f64>>> = const { RefCell::new(Vec::new()) };
+        static FREE_COMPLEX: RefCell<Vec<Vec<Complex<f64>>>> = const { RefCell::new(Vec::new()) };
     }
 
-    /// A buffer of `len` values, reusing a kept one when there is, with
+    /// A buffer of `len` values from `free`, reusing a kept one when there
+    /// is (the smallest that holds `len`, else the largest), with
     /// unspecified (finite or not) contents: for values written before
     /// they are read.
-    pub(super) fn reused(len: usize) -> Vec<f64> {
-        let kept = FREE.with(|f| {
-            let mut f = f.borrow_mut();
-            // The smallest kept buffer that holds `len`, else the largest.
-            let best = f
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| v.capacity() >= len)
-                .min_by_key(|(_, v)| v.capacity())
-                .or_else(|| f.iter().enumerate().max_by_key(|(_, v)| v.capacity()))
-                .map(|(i, _)| i);
-            best.map(|i| f.swap_remove(i))
-        });
-        match kept {
+    fn take<T: Copy + Default>(free: &mut Vec<Vec<T>>, len: usize) -> Vec<T> {
+        let best = free
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.capacity() >= len)
+            .min_by_key(|(_, v)| v.capacity())
+            .or_else(|| free.iter().enumerate().max_by_key(|(_, v)| v.capacity()))
+            .map(|(i, _)| i);
+        match best.map(|i| free.swap_remove(i)) {
             Some(mut v) => {
                 v.truncate(len);
-                v.resize(len, 0.0);
+                v.resize(len, T::default());
                 v
             }
-            None => vec![0.0; len],
+            None => vec![T::default(); len],
         }
+    }
+
+    fn keep<T>(free: &mut Vec<Vec<T>>, buffer: Vec<T>) {
+        if free.len() < KEPT && buffer.capacity() > 0 {
+            free.push(buffer);
+        }
+    }
+
+    /// A buffer of `len` values (see `take`).
+    pub(super) fn reused(len: usize) -> Vec<f64> {
+        FREE.with(|f| take(&mut f.borrow_mut(), len))
+    }
+
+    /// A buffer of `len` complex values (see `take`).
+    pub(super) fn reused_complex(len: usize) -> Vec<Complex<f64>> {
+        FREE_COMPLEX.with(|f| take(&mut f.borrow_mut(), len))
     }
 
     /// Keeps `buffer` for the next call on this thread.
     pub(super) fn give_back(buffer: Vec<f64>) {
-        FREE.with(|f| {
-            let mut f = f.borrow_mut();
-            if f.len() < KEPT {
-                f.push(buffer);
-            }
-        });
+        FREE.with(|f| keep(&mut f.borrow_mut(), buffer));
+    }
+
+    /// Keeps `buffer` for the next call on this thread.
+    pub(super) fn give_back_complex(buffer: Vec<Complex<f64>>) {
+        FREE_COMPLEX.with(|f| keep(&mut f.borrow_mut(), buffer));
     }
 }
 
@@ -426,43 +592,60 @@ mod tests {
     use super::*;
     use crate::rng::SplitMix64;
 
-    /// The cross sums are Σ conj(X_i)·X_j over the held segments, and the
-    /// auto sums Σ |X_c|².
+    /// The cross sums are Σ conj(X_i)·X_j over the held segments of every
+    /// batch (the first stored, the next added), and the auto sums
+    /// Σ |X_c|²: at an odd and an even bin count, over more than one bin
+    /// block.
     #[test]
     fn sums_are_the_products_of_the_held_spectra() {
         let mut rng = SplitMix64::new(4);
-        let (nf, count) = (13, 3);
-        let pairs = [(0, 1), (1, 0)];
-        let mut acc = Accumulators::new(2, &pairs, nf);
-        let specs: Vec<Vec<Vec<Complex<f64>>>> = (0..count)
-            .map(|_| {
-                (0..2)
-                    .map(|_| {
-                        (0..nf)
-                            .map(|_| Complex::new(rng.normal(), rng.normal()))
-                            .collect()
-                    })
-                    .collect()
-            })
-            .collect();
-        for (slot, chans) in specs.iter().enumerate() {
-            for (c, spec) in chans.iter().enumerate() {
-                acc.add_channel(slot, c, spec);
+        for nf in [13, 2 * BIN_BLOCK + 6, 2 * BIN_BLOCK + 7] {
+            let pairs = [(0, 1), (1, 0), (1, 1)];
+            let mut acc = Accumulators::new(2, &pairs, nf);
+            let specs: Vec<Vec<Vec<Complex<f64>>>> = (0..BATCH + 2)
+                .map(|_| {
+                    (0..2)
+                        .map(|_| {
+                            (0..nf)
+                                .map(|_| Complex::new(rng.normal(), rng.normal()))
+                                .collect()
+                        })
+                        .collect()
+                })
+                .collect();
+            for batch in specs.chunks(BATCH) {
+                for (slot, chans) in batch.iter().enumerate() {
+                    for (c, spec) in chans.iter().enumerate() {
+                        acc.slot_mut(slot, c).copy_from_slice(spec);
+                        acc.add_channel(slot, c);
+                    }
+                }
+                acc.add_segments(batch.len());
+            }
+            let got = acc.finish(&pairs, &vec![1.0; nf], vec![0.0; nf], specs.len());
+            for (p, &(i, j)) in pairs.iter().enumerate() {
+                for k in 0..nf {
+                    let want: Complex<f64> = specs.iter().map(|s| s[i][k].conj() * s[j][k]).sum();
+                    let d = got.cross[p][k] - want;
+                    assert!(d.norm() < 1e-12, "nf {nf} pair {p} bin {k}");
+                }
+            }
+            for c in 0..2 {
+                for k in 0..nf {
+                    let want: f64 = specs.iter().map(|s| s[c][k].norm_sqr()).sum();
+                    assert!((got.auto[c][k] - want).abs() < 1e-12);
+                }
             }
         }
-        acc.add_segments(count);
-        for (p, &(i, j)) in pairs.iter().enumerate() {
-            for k in 0..nf {
-                let want: Complex<f64> = specs.iter().map(|s| s[i][k].conj() * s[j][k]).sum();
-                let got = Complex::new(acc.cross[p * 2 * nf + k], acc.cross[p * 2 * nf + nf + k]);
-                assert!((got - want).norm() < 1e-12, "pair {p} bin {k}");
-            }
-        }
-        for c in 0..2 {
-            for k in 0..nf {
-                let want: f64 = specs.iter().map(|s| s[c][k].norm_sqr()).sum();
-                assert!((acc.auto[c * nf + k] - want).abs() < 1e-12);
-            }
-        }
+    }
+
+    /// With no segment added, the cross sums are zeros (never the
+    /// unspecified contents of a reused buffer).
+    #[test]
+    fn sums_without_segments_are_zero() {
+        let mut acc = Accumulators::new(2, &[(0, 1)], 5);
+        acc.cross.fill(f64::NAN);
+        let got = acc.finish(&[(0, 1)], &[1.0; 5], vec![0.0; 5], 0);
+        assert!(got.cross[0].iter().all(|c| c.re == 0.0 && c.im == 0.0));
     }
 }

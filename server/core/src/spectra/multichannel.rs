@@ -21,7 +21,7 @@ use std::ops::Range;
 
 use realfft::num_complex::Complex;
 
-use super::accumulators::{Accumulators, PlaneSpectra};
+use super::accumulators::{Accumulators, SummedSpectra};
 use super::batches::{batches, parts, run_parts};
 use super::engine::SegmentFft;
 use super::{Detrend, SpectraError, WelchConfig};
@@ -160,7 +160,7 @@ fn covered(cfg: &WelchConfig, len: usize) -> usize {
 /// finite inside the blocks (the quality report does so while computing
 /// its statistics): skips that scan, one pass over every sample. A NaN
 /// left in gives NaN spectra, never a panic. The cross spectra stay in the
-/// accumulators' split planes (no copy into complex vectors). A large
+/// accumulators as summed (no copy into complex vectors). A large
 /// estimate's first part, on the calling thread, holds `share` of the
 /// segments (a caller whose other thread starts with other work gives it
 /// more than half); with `(1, 2)` the values are those of [`multi_welch`]
@@ -171,10 +171,10 @@ pub(crate) fn multi_welch_finite(
     pairs: &[(usize, usize)],
     cfg: &WelchConfig,
     share: (usize, usize),
-) -> Result<PlaneSpectra, SpectraError> {
+) -> Result<SummedSpectra, SpectraError> {
     let n_segments = validate(channels, blocks, pairs, cfg)?;
     let (acc, factors) = compute(channels, blocks, pairs, cfg, (n_segments, share), false)?;
-    Ok(acc.finish_planes(&factors, cfg.frequencies(), n_segments))
+    Ok(acc.finish_sums(&factors, cfg.frequencies(), n_segments))
 }
 
 /// The sums of the estimate on validated inputs, over `n_segments ≥ 1`
