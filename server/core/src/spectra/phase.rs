@@ -17,46 +17,62 @@ pub fn unwrap_phase(phase: &[f64]) -> Vec<f64> {
 }
 
 /// [`unwrap_phase`] into `out` (cleared first), for callers that reuse a
-/// buffer. A jump within ±2π (every jump of phases in [−π, π]) is mapped
-/// into [−π, π) by selects, without branches: the phase of a noisy cross
-/// spectrum crosses ±π at random bins, and a branch on it mispredicted at
-/// every other one. Larger jumps and NaN take numpy's floor-modulo, as
-/// numpy does; the results are numpy's bit for bit either way.
+/// buffer. Each jump's correction is computed on its own first (the loop
+/// vectorises), then the corrections are summed in order. A jump within
+/// ±2π (every jump of phases in [−π, π]) is mapped into [−π, π) by
+/// selects, without branches: the phase of a noisy cross spectrum crosses
+/// ±π at random bins, and a branch on it mispredicted at every other one.
+/// Larger jumps and NaN take numpy's floor-modulo, as numpy does; the
+/// results are numpy's bit for bit either way.
 pub(crate) fn unwrap_into(phase: &[f64], out: &mut Vec<f64>) {
-    let period = 2.0 * PI;
-    let (high, low) = (PI, -PI);
     out.clear();
     let Some(&first) = phase.first() else {
         return;
     };
+    // out = [p₀, step₁, …, stepₙ₋₁], then the running sum in place.
     out.reserve(phase.len());
     out.push(first);
-    let mut correction = 0.0;
-    for w in phase.windows(2) {
+    out.extend(phase.windows(2).map(|w| near_step(w[1] - w[0])));
+    for (s, w) in out[1..].iter_mut().zip(phase.windows(2)) {
         let dd = w[1] - w[0];
-        let step = if dd.abs() <= period {
-            // py_mod(a, 2π) for a = dd + π in [−π, 3π]: fmod is a − 2π
-            // above 2π (exact) and a below; a negative remainder gains 2π.
-            let a = dd - low;
-            let m = if a >= period { a - period } else { a };
-            let m = if m < 0.0 { m + period } else { m };
-            let ddmod = m + low;
-            let ddmod = if ddmod == low && dd > 0.0 {
-                high
-            } else {
-                ddmod
-            };
-            if dd.abs() >= high { ddmod - dd } else { 0.0 }
-        } else {
-            let mut ddmod = py_mod(dd - low, period) + low;
-            if ddmod == low && dd > 0.0 {
-                ddmod = high;
-            }
-            ddmod - dd
-        };
-        correction += step;
-        out.push(w[1] + correction);
+        if dd.is_nan() || dd.abs() > 2.0 * PI {
+            *s = far_step(dd);
+        }
     }
+    let mut correction = 0.0;
+    for (o, p) in out[1..].iter_mut().zip(&phase[1..]) {
+        correction += *o;
+        *o = p + correction;
+    }
+}
+
+/// numpy's correction of a jump `dd` with |dd| ≤ 2π: `py_mod(dd + π, 2π)`
+/// for `dd + π` in [−π, 3π] (fmod is `a − 2π` above 2π, exact, and `a`
+/// below; a negative remainder gains 2π), ±π kept as +π for a positive
+/// jump, and no correction below π.
+#[inline(always)]
+fn near_step(dd: f64) -> f64 {
+    let (period, high, low) = (2.0 * PI, PI, -PI);
+    let a = dd - low;
+    let m = if a >= period { a - period } else { a };
+    let m = if m < 0.0 { m + period } else { m };
+    let ddmod = m + low;
+    let ddmod = if ddmod == low && dd > 0.0 {
+        high
+    } else {
+        ddmod
+    };
+    if dd.abs() >= high { ddmod - dd } else { 0.0 }
+}
+
+/// numpy's correction of any jump `dd` (NaN included).
+fn far_step(dd: f64) -> f64 {
+    let (period, high, low) = (2.0 * PI, PI, -PI);
+    let mut ddmod = py_mod(dd - low, period) + low;
+    if ddmod == low && dd > 0.0 {
+        ddmod = high;
+    }
+    ddmod - dd
 }
 
 /// `a % b` (C's `fmod`, exact), without the software division loop when
