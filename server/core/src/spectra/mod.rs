@@ -32,6 +32,8 @@ mod accumulators;
 mod batches;
 mod config;
 mod cross;
+#[cfg(target_arch = "x86_64")]
+mod cross_kernel;
 mod detrend;
 mod engine;
 pub mod multichannel;
