@@ -528,6 +528,8 @@ mod tests {
         for nf in [13, 2 * BIN_BLOCK + 6, 2 * BIN_BLOCK + 7] {
             let pairs = [(0, 1), (1, 0), (1, 1)];
             let mut acc = Accumulators::new(2, &pairs, nf);
+            // The plain-arithmetic pass (CPUs without AVX2 and FMA).
+            let mut plain = Accumulators::new(2, &pairs, nf);
             let specs: Vec<Vec<Vec<Complex<f64>>>> = (0..BATCH + 2)
                 .map(|_| {
                     (0..2)
@@ -544,16 +546,28 @@ mod tests {
                     for (c, spec) in chans.iter().enumerate() {
                         acc.slot_mut(slot, c).copy_from_slice(spec);
                         acc.add_channel(slot, c);
+                        plain.slot_mut(slot, c).copy_from_slice(spec);
+                        plain.add_channel(slot, c);
                     }
                 }
                 acc.add_segments(batch.len());
+                match batch.len() {
+                    1 => plain.add_body::<1>(),
+                    2 => plain.add_body::<2>(),
+                    3 => plain.add_body::<3>(),
+                    _ => plain.add_body::<BATCH>(),
+                }
+                plain.summed = true;
             }
+            let plain = plain.finish(&pairs, &vec![1.0; nf], vec![0.0; nf], specs.len());
             let got = acc.finish(&pairs, &vec![1.0; nf], vec![0.0; nf], specs.len());
             for (p, &(i, j)) in pairs.iter().enumerate() {
                 for k in 0..nf {
                     let want: Complex<f64> = specs.iter().map(|s| s[i][k].conj() * s[j][k]).sum();
                     let d = got.cross[p][k] - want;
                     assert!(d.norm() < 1e-12, "nf {nf} pair {p} bin {k}");
+                    let d = plain.cross[p][k] - want;
+                    assert!(d.norm() < 1e-12, "plain: nf {nf} pair {p} bin {k}");
                 }
             }
             for c in 0..2 {
