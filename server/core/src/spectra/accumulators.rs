@@ -89,12 +89,17 @@ impl Accumulators {
     /// The slot for channel `c`'s spectrum of the batch's `slot`-th segment
     /// (`slot < BATCH`): written by the FFT, then [`Self::add_channel`].
     pub(super) fn slot_mut(&mut self, slot: usize, c: usize) -> &mut [Complex<f64>] {
-        let off = if self.pairs.is_empty() {
+        let off = self.slot_offset(slot, c);
+        &mut self.slots[off..off + self.nf]
+    }
+
+    /// Where channel `c`'s spectrum in `slot` starts in `slots`.
+    fn slot_offset(&self, slot: usize, c: usize) -> usize {
+        if self.pairs.is_empty() {
             0
         } else {
             (c * BATCH + slot) * self.nf
-        };
-        &mut self.slots[off..off + self.nf]
+        }
     }
 
     /// Adds `|X|²` of the spectrum in channel `c`'s `slot` to its PSD.
@@ -116,11 +121,7 @@ impl Accumulators {
     #[inline(always)]
     fn add_channel_body<const FMA: bool>(&mut self, slot: usize, c: usize) {
         let nf = self.nf;
-        let off = if self.pairs.is_empty() {
-            0
-        } else {
-            (c * BATCH + slot) * nf
-        };
+        let off = self.slot_offset(slot, c);
         let spec = &self.slots[off..off + nf];
         let auto = &mut self.auto[c * nf..(c + 1) * nf];
         for (s, a) in spec.iter().zip(auto) {
