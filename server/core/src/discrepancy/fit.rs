@@ -92,6 +92,31 @@ use blocks::{BaseCache, dot, weighted};
 /// indices, their weighted columns, the weighted target.
 type Block = (Vec<usize>, Vec<Rc<Vec<f64>>>, Rc<Vec<f64>>);
 
+/// Effects whose fits iterate M, D̄ (and the current) to a fixed point.
+fn iterates(e: Effect) -> bool {
+    matches!(e, Effect::Current | Effect::CoriolisFromM)
+}
+
+/// A shape profile's fits ([`Prepared::shape_profile`]).
+pub(crate) struct ShapeFits<'p, 'a> {
+    prep: &'p Prepared<'a>,
+    normal: equations::Normal,
+    specs: Vec<Spec>,
+    /// θ is [`Prepared::fit`]'s at every shape, not only at the first.
+    pub exact: bool,
+}
+
+impl ShapeFits<'_, '_> {
+    /// θ with the last spec's shape at `v` (no residuals: `sse` NaN); the
+    /// same θ as [`Prepared::fit`] of those specs.
+    pub fn at(&self, v: f64) -> Option<FitOut> {
+        let mut specs = self.specs.clone();
+        let last = specs.len() - 1;
+        specs[last].shape = Some(v);
+        self.prep.reshaped(&self.normal, &specs, last)
+    }
+}
+
 /// A fitted hypothesis.
 #[derive(Debug, Clone)]
 pub(crate) struct FitOut {
@@ -303,6 +328,37 @@ impl<'a> Prepared<'a> {
         self.fit_holding(specs, &[], runs, hac, true)
     }
 
+    /// The fits of `specs` over a shape profile of its last spec: its
+    /// normal equations assembled once, each shape then changing only the
+    /// targets of the rows its actuator drives ([`Self::reshaped`]).
+    ///
+    /// A fit with a current or C(ν) from M iterates (their regressors
+    /// follow the fitted M, D̄, see [`Self::fit`]); over a profile those
+    /// stay where the full fit at `specs`' own shape left them, which
+    /// moves θ at other shapes by far less than the profile resolves.
+    pub(crate) fn shape_profile(
+        &self,
+        specs: &[Spec],
+        extra: &[usize],
+        runs: &[usize],
+    ) -> Option<ShapeFits<'_, 'a>> {
+        specs.last()?.shape?;
+        let exact = !specs.iter().any(|s| iterates(s.effect));
+        let (m, d, at) = if exact {
+            (self.baseline.m.clone(), self.baseline.d_bar.clone(), None)
+        } else {
+            let (_, m, d, at) = self.fit_iterated(specs, extra, runs, false, false)?;
+            (m, d, at)
+        };
+        let normal = self.assemble(&m, &d, specs, extra, runs, false, at)?;
+        Some(ShapeFits {
+            prep: self,
+            normal,
+            specs: specs.to_vec(),
+            exact,
+        })
+    }
+
     fn fit_holding(
         &self,
         specs: &[Spec],
@@ -311,11 +367,26 @@ impl<'a> Prepared<'a> {
         hac: bool,
         hold: bool,
     ) -> Option<FitOut> {
+        self.fit_iterated(specs, extra, runs, hac, hold)
+            .map(|(f, ..)| f)
+    }
+
+    /// [`Self::fit_holding`], with the M, D̄ and current its last pass was
+    /// assembled with.
+    #[allow(clippy::type_complexity)]
+    fn fit_iterated(
+        &self,
+        specs: &[Spec],
+        extra: &[usize],
+        runs: &[usize],
+        hac: bool,
+        hold: bool,
+    ) -> Option<(FitOut, DMatrix<f64>, DMatrix<f64>, Option<[f64; 2]>)> {
         let current = specs.iter().position(|s| s.effect == Effect::Current);
-        let coriolis = specs.iter().any(|s| s.effect == Effect::CoriolisFromM);
         let (mut m, mut d) = (self.baseline.m.clone(), self.baseline.d_bar.clone());
-        if current.is_none() && !coriolis {
-            return self.fit_with(&m, &d, specs, extra, runs, hac, hold, None);
+        if !specs.iter().any(|s| iterates(s.effect)) {
+            let f = self.fit_with(&m, &d, specs, extra, runs, hac, hold, None)?;
+            return Some((f, m, d, None));
         }
         // The current's estimate of a fit, where the next one linearizes
         // the quadratic drag on ν_r (see `through_water`).
@@ -332,16 +403,17 @@ impl<'a> Prepared<'a> {
         // the effect's linear part), so iterate to the fixed point.
         let start = current.then_some([0.0; 2]);
         let mut f = self.fit_with(&m, &d, specs, extra, runs, false, hold, start)?;
+        let mut at = start;
         for pass in 0..3 {
             let (m_new, d_new) = self.refitted(specs, &f, &m, &d);
             m = m_new;
             if current {
                 d = d_new;
             }
-            let at = estimate(&f).or(start);
+            at = estimate(&f).or(start);
             f = self.fit_with(&m, &d, specs, extra, runs, hac && pass == 2, hold, at)?;
         }
-        Some(f)
+        Some((f, m, d, at))
     }
 
     /// (M, D̄) with the rows and coupling entries of `f` written into
@@ -491,6 +563,7 @@ fn unforced_rows(runs: &[PrepRun], baseline: &Baseline) -> Vec<usize> {
 
 mod blocks;
 mod equations;
+mod hac;
 mod kstep;
 mod profile;
 mod regressors;

@@ -2,9 +2,48 @@
 //! terms' filtered regressors and the constant loads assembled over the
 //! runs, solved with Jacobi scaling, with HAC covariances.
 
+use super::hac;
 use super::*;
 use blocks::Column;
 use regressors::depends_on_data_alone;
+
+/// One fit's stacked normal equations before solving. A shape profile
+/// reuses them: a shape (lag, delay, saturation, dead zone) has no linear
+/// coefficient, so only the targets of the rows its actuator drives change
+/// with it, never the columns or H.
+pub(super) struct Normal {
+    rows: Vec<usize>,
+    freed: Vec<(Vec<usize>, Vec<usize>)>,
+    base_index: Vec<usize>,
+    theta_index: Vec<usize>,
+    load_index: Vec<Option<usize>>,
+    hmat: DMatrix<f64>,
+    blocks: Vec<Block>,
+    block_rows: Vec<usize>,
+    block_runs: Vec<usize>,
+    /// Per block: each column's product with the target, in column order
+    /// (b is their sum over blocks, in block order).
+    targets: Vec<Vec<f64>>,
+    n_tot: usize,
+    /// The M and D̄ the terms' regressors were built with.
+    m_ref: DMatrix<f64>,
+    d_ref: DMatrix<f64>,
+    /// Where the current's drag was linearized ([`Prepared::assemble`]).
+    water: Option<([f64; 2], bool)>,
+}
+
+impl Normal {
+    /// b = Σ_blocks Xᵀy, with the targets of `targets` (per block).
+    fn rhs(&self, targets: &[impl AsRef<[f64]>]) -> Vec<f64> {
+        let mut bvec = vec![0.0; self.hmat.nrows()];
+        for ((idx, _, _), t) in self.blocks.iter().zip(targets) {
+            for (&i, v) in idx.iter().zip(t.as_ref()) {
+                bvec[i] += v;
+            }
+        }
+        bvec
+    }
+}
 
 impl Prepared<'_> {
     #[allow(clippy::too_many_arguments)]
@@ -19,15 +58,138 @@ impl Prepared<'_> {
         hold: bool,
         current_at: Option<[f64; 2]>,
     ) -> Option<FitOut> {
+        let normal = self.assemble(m_ref, d_ref, specs, extra, runs, hold, current_at)?;
+        let bvec = normal.rhs(&normal.targets);
+        let (theta_all, h_inv) = solve_scaled(&normal.hmat, &bvec)?;
+        Some(self.fit_out(&normal, specs, theta_all, Some((&h_inv, hac))))
+    }
+
+    /// θ of `specs` — the specs `normal` was assembled for, but for the
+    /// shape of `specs[shaped]` — with the targets of the rows that shape's
+    /// actuator drives rebuilt. The fit has no residuals (`sse` NaN) and no
+    /// covariance: the points of a shape profile, where only θ is read.
+    pub(super) fn reshaped(
+        &self,
+        normal: &Normal,
+        specs: &[Spec],
+        shaped: usize,
+    ) -> Option<FitOut> {
+        let dofs = &self.baseline.dofs;
+        let shapes = shapes_of(specs);
+        let effect = specs[shaped].effect;
+        let ctx = TermContext {
+            dofs,
+            m_ref: &normal.m_ref,
+            d_ref: &normal.d_ref,
+        };
+        let targets: Vec<std::borrow::Cow<'_, [f64]>> = normal
+            .blocks
+            .iter()
+            .enumerate()
+            .map(|(bi, (_, cols, _))| {
+                let r = normal.block_rows[bi];
+                if !effect.acts_on(dofs[r]) {
+                    return std::borrow::Cow::Borrowed(normal.targets[bi].as_slice());
+                }
+                let run = normal.block_runs[bi];
+                let ri = normal
+                    .rows
+                    .iter()
+                    .position(|&x| x == r)
+                    .expect("a block's row");
+                let (mf, df) = &normal.freed[ri];
+                let (bb, _) = self.block_target(run, r, mf, df, specs, &shapes, normal.water, &ctx);
+                let mut t = bb.by;
+                for c in &cols[t.len()..] {
+                    let mut out = [0.0];
+                    crate::kernels::dots(c, &[bb.y.as_slice()], &mut out);
+                    t.push(out[0]);
+                }
+                std::borrow::Cow::Owned(t)
+            })
+            .collect();
+        let bvec = normal.rhs(&targets);
+        let (theta_all, _) = solve_scaled(&normal.hmat, &bvec)?;
+        Some(self.fit_out(normal, specs, theta_all, None))
+    }
+
+    /// The target of row `r` on `run` under the actuator hypotheses
+    /// `shapes` ([λτ_a] − [λg], held terms' forces and the baseline's D_q
+    /// through the water on the known side) with the baseline block's
+    /// columns and their products with it, and the current's shift.
+    #[allow(clippy::too_many_arguments)]
+    fn block_target(
+        &self,
+        run: usize,
+        r: usize,
+        mf: &[usize],
+        df: &[usize],
+        specs: &[Spec],
+        shapes: &[(Effect, f64)],
+        water: Option<([f64; 2], bool)>,
+        ctx: &TermContext<'_>,
+    ) -> (blocks::BaseBlock, Option<through_water::ThroughWater>) {
+        let rec = &self.records[run];
+        let dofs = &self.baseline.dofs;
+        let w = self.weights[r];
+        let dof = dofs[r];
+        // Target [λτ_a] − [λg]: the applied force depends on the
+        // actuator hypotheses of this DOF.
+        let lam_tau_a = shapes.iter().any(|(e, _)| e.acts_on(dof)).then(|| {
+            let (x, lag) = actuate(rec.tau.column(r).as_slice(), dof, shapes);
+            match lag {
+                Some(t) => self.svf.foh(&lag_zoh(&x, t, rec.h)),
+                None => self.svf.zoh(&x),
+            }
+        });
+        let mut bb = self.base_block(run, r, w, mf, df, lam_tau_a);
+        // Held terms' forces go to the known side.
+        let held: Vec<&ModelTerm> = specs
+            .iter()
+            .filter_map(|s| self.held_values(s.effect))
+            .filter(|t| t.effect.rows(dofs, &self.baseline.d_bar).contains(&r))
+            .collect();
+        // The baseline's D_q on the velocity through the water.
+        let water = water.and_then(|(at, held)| self.through_water(r, run, at, held));
+        if !held.is_empty() || water.is_some() {
+            let mut y = bb.y.as_ref().clone();
+            for t in &held {
+                for (pi, c) in t.coefficients.iter().enumerate() {
+                    let f = self.filtered_regressor(t.effect, pi, r, run, ctx);
+                    for (yk, fk) in y.iter_mut().zip(&f[self.skip..]) {
+                        *yk -= c * w * fk;
+                    }
+                }
+            }
+            if let Some(tw) = &water {
+                for (yk, fk) in y.iter_mut().zip(&tw.shift[self.skip..]) {
+                    *yk -= w * fk;
+                }
+            }
+            bb.by = blocks::products(&y, &bb.cols);
+            bb.y = Rc::new(y);
+        }
+        (bb, water)
+    }
+
+    /// The normal equations of `specs` on `rows` (see [`Self::fit_with`]).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn assemble(
+        &self,
+        m_ref: &DMatrix<f64>,
+        d_ref: &DMatrix<f64>,
+        specs: &[Spec],
+        extra: &[usize],
+        runs: &[usize],
+        hold: bool,
+        current_at: Option<[f64; 2]>,
+    ) -> Option<Normal> {
         let rows = self.rows_of(specs, extra);
         if rows.is_empty() {
             return None;
         }
         let dofs = &self.baseline.dofs;
-        let shapes: Vec<(Effect, f64)> = specs
-            .iter()
-            .filter_map(|s| s.shape.map(|v| (s.effect, v)))
-            .collect();
+        let shapes = shapes_of(specs);
         // Parameter layout: base entries of each row, then the specs' θ.
         let freed: Vec<(Vec<usize>, Vec<usize>)> =
             rows.iter().map(|&r| self.freed(r, &rows, hold)).collect();
@@ -71,57 +233,21 @@ impl Prepared<'_> {
                 None => current_at.map(|at| (at, false)),
             });
         let mut hmat = DMatrix::<f64>::zeros(p, p);
-        let mut bvec = vec![0.0; p];
         let mut blocks: Vec<Block> = Vec::new();
         let mut block_rows: Vec<usize> = Vec::new();
+        let mut block_runs: Vec<usize> = Vec::new();
+        let mut targets: Vec<Vec<f64>> = Vec::new();
         let mut n_tot = 0;
         for &run in runs {
-            let rec = &self.records[run];
             let pr = &self.runs[run];
-            let len = rec.len();
+            let len = self.records[run].len();
             if len <= self.skip + 1 {
                 continue;
             }
             for (ri, &r) in rows.iter().enumerate() {
                 let w = self.weights[r];
-                let dof = dofs[r];
-                // Target [λτ_a] − [λg]: the applied force depends on the
-                // actuator hypotheses of this DOF.
-                let lam_tau_a = shapes.iter().any(|(e, _)| e.acts_on(dof)).then(|| {
-                    let (x, lag) = actuate(rec.tau.column(r).as_slice(), dof, &shapes);
-                    match lag {
-                        Some(t) => self.svf.foh(&lag_zoh(&x, t, rec.h)),
-                        None => self.svf.zoh(&x),
-                    }
-                });
                 let (mf, df) = &freed[ri];
-                let mut bb = self.base_block(run, r, w, mf, df, lam_tau_a);
-                // Held terms' forces go to the known side.
-                let held: Vec<&ModelTerm> = specs
-                    .iter()
-                    .filter_map(|s| self.held_values(s.effect))
-                    .filter(|t| t.effect.rows(dofs, &self.baseline.d_bar).contains(&r))
-                    .collect();
-                // The baseline's D_q on the velocity through the water.
-                let water = water.and_then(|(at, held)| self.through_water(r, run, at, held));
-                if !held.is_empty() || water.is_some() {
-                    let mut y = bb.y.as_ref().clone();
-                    for t in &held {
-                        for (pi, c) in t.coefficients.iter().enumerate() {
-                            let f = self.filtered_regressor(t.effect, pi, r, run, &ctx);
-                            for (yk, fk) in y.iter_mut().zip(&f[self.skip..]) {
-                                *yk -= c * w * fk;
-                            }
-                        }
-                    }
-                    if let Some(tw) = &water {
-                        for (yk, fk) in y.iter_mut().zip(&tw.shift[self.skip..]) {
-                            *yk -= w * fk;
-                        }
-                    }
-                    bb.by = blocks::products(&y, &bb.cols);
-                    bb.y = Rc::new(y);
-                }
+                let (bb, water) = self.block_target(run, r, mf, df, specs, &shapes, water, &ctx);
                 let nb = bb.cols.len();
                 let y = Rc::clone(&bb.y);
                 let mut idx: Vec<usize> = (base_index[ri]..base_index[ri] + nb).collect();
@@ -184,6 +310,7 @@ impl Prepared<'_> {
                 // The baseline block's products (with each other and with
                 // the target) come from its cache, products of two kept
                 // columns from theirs; the rest are computed here.
+                let mut block_targets = Vec::with_capacity(idx.len());
                 for a in 0..idx.len() {
                     let from = a.max(nb);
                     let known: Vec<Option<f64>> = (from..idx.len())
@@ -208,7 +335,7 @@ impl Prepared<'_> {
                     } else {
                         (bb.by[a], out.iter())
                     };
-                    bvec[idx[a]] += target;
+                    block_targets.push(target);
                     let prods: Vec<f64> = known
                         .iter()
                         .zip(from..)
@@ -235,15 +362,54 @@ impl Prepared<'_> {
                 n_tot += y.len();
                 blocks.push((idx, cols, y));
                 block_rows.push(r);
+                block_runs.push(run);
+                targets.push(block_targets);
             }
         }
         if n_tot <= p {
             return None;
         }
-        let (theta_all, h_inv) = solve_scaled(&hmat, &bvec)?;
-        let mut sse = 0.0;
+        Some(Normal {
+            rows,
+            freed,
+            base_index,
+            theta_index,
+            load_index,
+            hmat,
+            blocks,
+            block_rows,
+            block_runs,
+            targets,
+            n_tot,
+            m_ref: m_ref.clone(),
+            d_ref: d_ref.clone(),
+            water,
+        })
+    }
+
+    /// The fit of θ (all parameters) on `normal`: with `h_inv` (H⁻¹ and
+    /// whether the HAC covariance is wanted) its residuals too; without,
+    /// θ alone (`sse` NaN, no residuals).
+    fn fit_out(
+        &self,
+        normal: &Normal,
+        specs: &[Spec],
+        theta_all: Vec<f64>,
+        h_inv: Option<(&DMatrix<f64>, bool)>,
+    ) -> FitOut {
+        let Normal {
+            rows,
+            freed,
+            base_index,
+            theta_index,
+            load_index,
+            blocks,
+            ..
+        } = normal;
+        let p = normal.hmat.nrows();
+        let mut sse = if h_inv.is_some() { 0.0 } else { f64::NAN };
         let mut resid = Vec::with_capacity(blocks.len());
-        for (idx, cols, y) in &blocks {
+        for (idx, cols, y) in blocks.iter().filter(|_| h_inv.is_some()) {
             // Σ_i θ_i c_i[k] column by column (the same order per sample).
             let mut fitted = vec![0.0; y.len()];
             for (&i, c) in idx.iter().zip(cols) {
@@ -258,9 +424,9 @@ impl Prepared<'_> {
         }
         // Sandwich H⁻¹ S H⁻¹ on the θ block only: with C = H⁻¹[θ, :] the
         // block is C S Cᵀ = Σ_l w_l Σ_k h_k h_{k−l}ᵀ over the projected
-        // scores h_k = C φ_k e_k, which costs t² per lag instead of p².
+        // scores h_k = C φ_k e_k, which costs t² instead of p² ([`hac`]).
         let t0 = theta_index.first().copied().unwrap_or(p);
-        let cov = hac.then(|| {
+        let cov = h_inv.filter(|(_, hac)| *hac).map(|(h_inv, _)| {
             let t = p - t0;
             let mut s = DMatrix::<f64>::zeros(t, t);
             for ((idx, cols, _), e) in blocks.iter().zip(&resid) {
@@ -276,19 +442,7 @@ impl Prepared<'_> {
                         }
                     }
                 }
-                for l in 0..=self.hac_lags.min(len.saturating_sub(1)) {
-                    let wl = 1.0 - l as f64 / (self.hac_lags as f64 + 1.0);
-                    for a in 0..t {
-                        for b in 0..t {
-                            let acc = dot(&h[a][l..], &h[b][..len - l]);
-                            let v = if l == 0 { acc } else { wl * acc };
-                            s[(a, b)] += v;
-                            if l > 0 {
-                                s[(b, a)] += v;
-                            }
-                        }
-                    }
-                }
+                hac::add_bartlett(&h, self.hac_lags, &mut s);
             }
             s
         });
@@ -317,7 +471,7 @@ impl Prepared<'_> {
             .collect();
         let theta = specs
             .iter()
-            .zip(&theta_index)
+            .zip(theta_index)
             .map(|(s, &i)| match self.held_values(s.effect) {
                 Some(t) => t.coefficients.clone(),
                 None => theta_all[i..i + s.effect.n_linear()].to_vec(),
@@ -331,22 +485,30 @@ impl Prepared<'_> {
             .iter()
             .map(|li| li.map(|i| theta_all[i]))
             .collect();
-        Some(FitOut {
-            rows,
+        FitOut {
+            rows: rows.clone(),
             base,
             theta,
-            theta_index,
+            theta_index: theta_index.clone(),
             sse,
-            n: n_tot,
+            n: normal.n_tot,
             cov,
             resid,
-            block_rows,
-            d_ref: d_ref.clone(),
-            m_ref: m_ref.clone(),
+            block_rows: normal.block_rows.clone(),
+            d_ref: normal.d_ref.clone(),
+            m_ref: normal.m_ref.clone(),
             loads,
             held,
-        })
+        }
     }
+}
+
+/// The (effect, shape) of every spec that has a shape.
+fn shapes_of(specs: &[Spec]) -> Vec<(Effect, f64)> {
+    specs
+        .iter()
+        .filter_map(|s| s.shape.map(|v| (s.effect, v)))
+        .collect()
 }
 
 /// Smallest Cholesky pivot of the Jacobi-scaled normal matrix accepted as

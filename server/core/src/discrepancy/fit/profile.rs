@@ -79,12 +79,21 @@ pub(crate) fn profile(
                 && !(lag && matches!((m, d), (Some(m), Some(d)) if d > 0.0 && m / d <= v))
         })
     };
+    let shaped = prep.shape_profile(&specs_at(grid[0]), extra, runs);
+    // θ alone at a point of the search; the optimum's fit in full.
+    let theta_at = |v: f64| -> Option<FitOut> {
+        match &shaped {
+            Some(s) => s.at(v),
+            None => prep.fit(&specs_at(v), extra, runs, false),
+        }
+        .filter(|f| admissible(f, v))
+    };
     let eval = |v: f64| -> Option<FitOut> {
         prep.fit(&specs_at(v), extra, runs, false)
             .filter(|f| admissible(f, v))
     };
     let sse = |v: f64| {
-        eval(v)
+        theta_at(v)
             .and_then(|f| prep.kstep_rows(&specs_at(v), &f, extra, runs, k))
             .map_or(f64::INFINITY, |x| x.0)
     };
@@ -136,7 +145,12 @@ pub(crate) fn profile(
     let (s0, resid) = prep.kstep_rows(&specs_at(best), &fit, extra, runs, k)?;
     let delta = 0.03 * best.abs().max(1e-9);
     let (sm, sp) = (sse(best - delta), sse(best + delta));
-    let curv = (sp - 2.0 * s0 + sm) / (delta * delta);
+    // The curvature from three points of one kind of fit.
+    let sc = match &shaped {
+        Some(s) if !s.exact => sse(best),
+        _ => s0,
+    };
+    let curv = (sp - 2.0 * sc + sm) / (delta * delta);
     let n: usize = resid.iter().map(Vec::len).sum();
     let kappa = long_run_inflation(&resid, prep.hac_lags.max(2 * k));
     let sigma2 = s0 / n.max(1) as f64;

@@ -213,6 +213,52 @@ fn fits_from_kept_baseline_blocks_equal_fresh_ones() {
     );
 }
 
+/// A shape profile's points from normal equations assembled once
+/// ([`Prepared::shape_profile`]) give θ bit for bit as full fits at each
+/// shape, with a quadratic term fitted beside the lag, a held lag and a
+/// delay of other rows untouched; a profile over specs with a current is
+/// not exact and says so.
+#[test]
+fn profile_points_from_one_assembly_equal_full_fits() {
+    let nu = |t: f64| {
+        (
+            0.6 * (0.3 * t).sin() + 0.2 * (1.1 * t).sin(),
+            0.18 * (0.3 * t).cos() + 0.22 * (1.1 * t).cos(),
+        )
+    };
+    let (baseline, records) = surge_record(nu, 400.0);
+    let prep = Prepared::new(&baseline, &records, 0.5, 10, 5).expect("prepared");
+    let quad = Spec {
+        effect: Effect::QuadraticDamping { dof: Dof::Surge },
+        shape: None,
+    };
+    let lag = |v: f64| Spec {
+        effect: Effect::ActuatorLag { dof: Dof::Surge },
+        shape: Some(v),
+    };
+    let fits = prep
+        .shape_profile(&[quad, lag(0.05)], &[], &[0])
+        .expect("a profile");
+    assert!(fits.exact);
+    let mut thetas = Vec::new();
+    for v in [0.05, 0.2, 0.7] {
+        let fast = fits.at(v).expect("θ");
+        let full = prep.fit(&[quad, lag(v)], &[], &[0], false).expect("fit");
+        assert_eq!(fast.theta, full.theta, "lag {v}");
+        assert_eq!(fast.base, full.base, "lag {v}");
+        assert!(fast.sse.is_nan() && fast.resid.is_empty());
+        thetas.push(fast.theta[0][0]);
+    }
+    // The shape changes the fit.
+    assert_ne!(thetas[0], thetas[2]);
+    let current = Spec {
+        effect: Effect::Current,
+        shape: None,
+    };
+    let with_current = prep.shape_profile(&[current, lag(0.05)], &[], &[0]);
+    assert!(with_current.is_none_or(|f| !f.exact));
+}
+
 /// Sway never forced (τ_Y = 0), moved only by yaw through the coupling
 /// D̄_vr: M_v v̇ + D_v v + D_vr r = 0, M_r ṙ + D_r r = τ_N. The sway row is
 /// homogeneous, so its mass is held at the baseline's and the row's
