@@ -315,7 +315,8 @@ impl<'a> Prepared<'a> {
         runs: &[usize],
         hac: bool,
     ) -> Option<FitOut> {
-        self.fit_holding(specs, extra, runs, hac, false)
+        self.fit_iterated(specs, extra, runs, hac, false)
+            .map(|(f, ..)| f)
     }
 
     /// [`Self::fit`] for the model that is kept: the refitted rows'
@@ -325,7 +326,8 @@ impl<'a> Prepared<'a> {
     /// with the most flexible row) but through M⁻¹ moves the predictions of
     /// DOFs the hypothesis never touched.
     pub fn fit_for_model(&self, specs: &[Spec], runs: &[usize], hac: bool) -> Option<FitOut> {
-        self.fit_holding(specs, &[], runs, hac, true)
+        self.fit_iterated(specs, &[], runs, hac, true)
+            .map(|(f, ..)| f)
     }
 
     /// The fits of `specs` over a shape profile of its last spec: its
@@ -359,20 +361,9 @@ impl<'a> Prepared<'a> {
         })
     }
 
-    fn fit_holding(
-        &self,
-        specs: &[Spec],
-        extra: &[usize],
-        runs: &[usize],
-        hac: bool,
-        hold: bool,
-    ) -> Option<FitOut> {
-        self.fit_iterated(specs, extra, runs, hac, hold)
-            .map(|(f, ..)| f)
-    }
-
-    /// [`Self::fit_holding`], with the M, D̄ and current its last pass was
-    /// assembled with.
+    /// A fit of `specs` (couplings to rows not refitted held at the
+    /// baseline's with `hold`), with the M, D̄ and current its last pass
+    /// was assembled with.
     #[allow(clippy::type_complexity)]
     fn fit_iterated(
         &self,

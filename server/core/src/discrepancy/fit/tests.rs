@@ -31,6 +31,14 @@ fn surge_record(nu: impl Fn(f64) -> (f64, f64), theta: f64) -> (Baseline, [Recor
     (baseline, [rec])
 }
 
+/// ν(t) of two sines (0.3 and 1.1 rad/s) and its derivative.
+fn two_sines(t: f64) -> (f64, f64) {
+    (
+        0.6 * (0.3 * t).sin() + 0.2 * (1.1 * t).sin(),
+        0.18 * (0.3 * t).cos() + 0.22 * (1.1 * t).cos(),
+    )
+}
+
 /// The force share of `spec` on the surge record (fits without and with
 /// it, the surge row refitted) and its fitted coefficient.
 fn share_of(spec: Spec, baseline: &Baseline, records: &[Record]) -> (f64, f64) {
@@ -52,13 +60,7 @@ fn a_terms_force_share_is_the_force_it_explains_not_its_coefficient() {
     // A real quadratic drag: the share is the part of θ|ν|ν that M and
     // D̄ cannot take over, at most the whole of it against τ.
     let theta = 400.0;
-    let nu = |t: f64| {
-        (
-            0.6 * (0.3 * t).sin() + 0.2 * (1.1 * t).sin(),
-            0.18 * (0.3 * t).cos() + 0.22 * (1.1 * t).cos(),
-        )
-    };
-    let (baseline, records) = surge_record(nu, theta);
+    let (baseline, records) = surge_record(two_sines, theta);
     let (share, fitted) = share_of(quad, &baseline, &records);
     let rms = |f: &dyn Fn(usize) -> f64| {
         ((0..records[0].len()).map(|k| f(k).powi(2)).sum::<f64>() / records[0].len() as f64).sqrt()
@@ -164,13 +166,7 @@ fn the_current_regressor_from_kept_signals_is_the_filtered_direct_one() {
 /// all kept) gives the same again.
 #[test]
 fn fits_from_kept_baseline_blocks_equal_fresh_ones() {
-    let nu = |t: f64| {
-        (
-            0.6 * (0.3 * t).sin() + 0.2 * (1.1 * t).sin(),
-            0.18 * (0.3 * t).cos() + 0.22 * (1.1 * t).cos(),
-        )
-    };
-    let (baseline, records) = surge_record(nu, 400.0);
+    let (baseline, records) = surge_record(two_sines, 400.0);
     let quad = Spec {
         effect: Effect::QuadraticDamping { dof: Dof::Surge },
         shape: None,
@@ -220,13 +216,7 @@ fn fits_from_kept_baseline_blocks_equal_fresh_ones() {
 /// not exact and says so.
 #[test]
 fn profile_points_from_one_assembly_equal_full_fits() {
-    let nu = |t: f64| {
-        (
-            0.6 * (0.3 * t).sin() + 0.2 * (1.1 * t).sin(),
-            0.18 * (0.3 * t).cos() + 0.22 * (1.1 * t).cos(),
-        )
-    };
-    let (baseline, records) = surge_record(nu, 400.0);
+    let (baseline, records) = surge_record(two_sines, 400.0);
     let prep = Prepared::new(&baseline, &records, 0.5, 10, 5).expect("prepared");
     let quad = Spec {
         effect: Effect::QuadraticDamping { dof: Dof::Surge },
