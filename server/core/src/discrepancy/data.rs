@@ -31,8 +31,11 @@ pub struct Restoring {
 impl Restoring {
     /// g(η) in all six DOFs for η = [x y z φ θ ψ] (thesis eq. 1.6).
     pub fn g(&self, eta: &[f64; 6]) -> [f64; 6] {
-        let (sp, cp) = eta[3].sin_cos();
-        let (st, ct) = eta[4].sin_cos();
+        self.g_at(eta[3].sin_cos(), eta[4].sin_cos())
+    }
+
+    /// [`Self::g`] from (sin φ, cos φ) and (sin θ, cos θ).
+    pub fn g_at(&self, (sp, cp): (f64, f64), (st, ct): (f64, f64)) -> [f64; 6] {
         let w = self.w_minus_b;
         let z = self.zg_w_minus_zb_b;
         let b = &self.constant;

@@ -11,7 +11,7 @@ use std::rc::Rc;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use super::candidates::{Effect, ShapeKind, TermContext};
+use super::candidates::{Effect, ShapeKind, TermContext, Trig};
 use super::data::{Baseline, Record, Restoring};
 use super::svf::lag_zoh;
 use crate::identification::attitude_loop::euler_rates;
@@ -264,7 +264,15 @@ impl AugmentedModel {
     }
 
     /// ν̇ from (ν, τ_a, η): M⁻¹(τ_a − g(η) − D̄ν − Σθφ(ν, η)).
-    fn nu_dot(&self, nu: &[f64], tau_a: &[f64], g: &[f64], eta: &[f64; 6], out: &mut [f64]) {
+    fn nu_dot(
+        &self,
+        nu: &[f64],
+        tau_a: &[f64],
+        g: &[f64],
+        eta: &[f64; 6],
+        trig: Option<&Trig>,
+        out: &mut [f64],
+    ) {
         let n = self.dofs.len();
         let ctx = self.ctx();
         // The terms' left-hand-side forces, then γ − D̄ν minus them.
@@ -274,7 +282,7 @@ impl AugmentedModel {
                 continue;
             }
             t.effect
-                .add_force(&t.coefficients, &ctx, nu, eta, &mut lhs[..n]);
+                .add_force_at(&t.coefficients, &ctx, nu, eta, trig, &mut lhs[..n]);
         }
         let mut f = [0.0; 6];
         for i in 0..n {
@@ -430,12 +438,22 @@ impl AugmentedModel {
                 tau_a[i] = x[n + s];
                 dx[n + s] = (u[i] - x[n + s]) / t_a;
             }
-            let g6 = self.restoring.g(&eta);
+            // The angles' sines and cosines once per stage, for g(η) and
+            // every term that reads them.
+            let trig = Trig::of(&eta);
+            let g6 = self.restoring.g_at(trig.phi, trig.theta);
             let mut g = [0.0; 6];
             for (gi, d) in g.iter_mut().zip(&self.dofs) {
                 *gi = g6[d.index()];
             }
-            self.nu_dot(&x[..n], &tau_a[..n], &g[..n], &eta, &mut dx[..n]);
+            self.nu_dot(
+                &x[..n],
+                &tau_a[..n],
+                &g[..n],
+                &eta,
+                Some(&trig),
+                &mut dx[..n],
+            );
         };
         if stiff {
             let etd = drive.etd(sub, || EtdRk4::new(&self.linear, h));

@@ -142,6 +142,20 @@ impl Effect {
         eta: &[f64; 6],
         out: &mut [f64],
     ) {
+        self.add_force_at(theta, ctx, nu, eta, None, out)
+    }
+
+    /// [`Self::add_force`] with the angles' sines and cosines given when
+    /// the caller has them (`trig` must be [`Trig::of`] `eta`).
+    pub fn add_force_at(
+        &self,
+        theta: &[f64],
+        ctx: &TermContext<'_>,
+        nu: &[f64],
+        eta: &[f64; 6],
+        trig: Option<&Trig>,
+        out: &mut [f64],
+    ) {
         match *self {
             Effect::CoriolisFromM => {
                 let c = coriolis_force6(ctx.dofs, ctx.m_ref, nu);
@@ -154,7 +168,7 @@ impl Effect {
                     return;
                 };
                 let r = ctx.index(Dof::Yaw).map_or(0.0, |j| nu[j]);
-                let (s, c) = eta[5].sin_cos();
+                let (s, c) = trig.map_or_else(|| eta[5].sin_cos(), |t| t.psi);
                 for (row, o) in out.iter_mut().enumerate().take(ctx.dofs.len()) {
                     let (du, dv) = (ctx.d_ref[(row, iu)], ctx.d_ref[(row, iv)]);
                     let (mu, mv) = (ctx.m_ref[(row, iu)], ctx.m_ref[(row, iv)]);
@@ -164,10 +178,11 @@ impl Effect {
                 }
             }
             _ => {
-                let trig = self.reads_attitude().then(|| Trig::of(eta));
+                let own = (trig.is_none() && self.reads_attitude()).then(|| Trig::of(eta));
+                let trig = trig.or(own.as_ref());
                 for (row, o) in out.iter_mut().enumerate().take(ctx.dofs.len()) {
                     for (p, th) in theta.iter().enumerate() {
-                        *o += th * self.regressor_at(p, row, ctx, nu, eta, trig.as_ref());
+                        *o += th * self.regressor_at(p, row, ctx, nu, eta, trig);
                     }
                 }
             }
