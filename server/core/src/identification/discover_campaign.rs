@@ -365,10 +365,21 @@ pub fn discover_campaign(
         .into_iter()
         .partition(|s| s.agree);
     if !shapes.is_empty() {
-        for (k, p) in points.iter_mut().enumerate() {
-            let i = todo[k];
-            let start = augmented_at(doc, &lpv.points[i])?;
-            if let Some(q) = shapes::held_shapes(p, &start, &est[i].0, &dset, &shapes) {
+        let held = crate::par::fan_out(
+            points.len(),
+            progress,
+            (0.9, 0.9),
+            "holding the shared shapes at every grid speed",
+            |k, _| {
+                let i = todo[k];
+                let start = augmented_at(doc, &lpv.points[i])?;
+                Ok::<_, IdentifyError>(shapes::held_shapes(
+                    &points[k], &start, &est[i].0, &dset, &shapes,
+                ))
+            },
+        )?;
+        for (p, q) in points.iter_mut().zip(held) {
+            if let Some(q) = q {
                 *p = q;
             }
         }
@@ -415,17 +426,17 @@ pub fn discover_campaign(
     let assembled = if pooled.is_empty() {
         None
     } else {
-        progress.update(
-            0.9,
+        Some(crate::par::fan_out(
+            points.len(),
+            progress,
+            (0.9, 0.9),
             "refitting every grid speed with the shared forces held",
-        )?;
-        let mut out = Vec::with_capacity(points.len());
-        for (k, p) in points.iter().enumerate() {
-            let i = todo[k];
-            let start = augmented_at(doc, &lpv.points[i])?;
-            out.push(shared::held_at(p, &start, &est[i].0, &dset, &pooled)?);
-        }
-        Some(out)
+            |k, _| {
+                let i = todo[k];
+                let start = augmented_at(doc, &lpv.points[i])?;
+                shared::held_at(&points[k], &start, &est[i].0, &dset, &pooled)
+            },
+        )?)
     };
     // The grid speeds not examined hold the shared force too.
     let unexamined: Vec<(f64, AugmentedModel, &[Record])> = (0..grid.len())

@@ -36,10 +36,23 @@ pub(crate) fn fit_chosen(
     let base_on_fitted: Vec<Predictions> =
         fitted.iter().map(|r| predict(base_model, r, k)).collect();
     let mut best: Option<(usize, (bool, f64, f64))> = None;
+    // A variant that frees nothing more than an earlier one (the chosen
+    // terms touch every row) is the same fit: judged once.
+    let mut judged: Vec<FitKey> = Vec::new();
     for v in 0..3 {
         let Some(f) = fit_variant(v, false) else {
             continue;
         };
+        let key = (
+            f.rows.clone(),
+            f.base.clone(),
+            f.theta.clone(),
+            f.loads.clone(),
+        );
+        if judged.contains(&key) {
+            continue;
+        }
+        judged.push(key);
         let candidate = prep.model(chosen, &f, &[]);
         let (harm, gain) = change_score(&base_on_fitted, &candidate, &fitted, k);
         let score = (candidate.inertia_positive(), harm, gain);
@@ -50,6 +63,15 @@ pub(crate) fn fit_chosen(
     best.and_then(|(v, _)| fit_variant(v, true))
         .map_or_else(|| base_model.clone(), |f| prep.model(chosen, &f, shape_std))
 }
+
+/// What makes a fit's model: its rows, their M and D̄ entries, the terms'
+/// coefficients and the constant loads.
+type FitKey = (
+    Vec<usize>,
+    Vec<(Vec<f64>, Vec<f64>)>,
+    Vec<Vec<f64>>,
+    Vec<Option<f64>>,
+);
 
 /// The terms of `start` and `terms` refitted on `estimation_runs` with the
 /// coefficients of `held` fixed: a force the campaign shares (a current, a
