@@ -16,8 +16,10 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::document::{LpvDoc, from_rows};
-use crate::estimation::lambda::{Experiment, Inversion, LambdaEstimate, LambdaSettings, identify};
-use crate::estimation::{Cancelled, Progress};
+use crate::estimation::lambda::{
+    Experiment, Inversion, LambdaError, LambdaEstimate, LambdaSettings, identify,
+};
+use crate::estimation::{Cancelled, NoProgress, Progress};
 use crate::models::coriolis::{coriolis, second_order_force_about};
 use crate::planning::dof::Dof;
 
@@ -98,13 +100,13 @@ pub(crate) fn identify_with_coriolis(
     settings: &LambdaSettings,
     u0: f64,
     progress: &mut dyn Progress,
-) -> Result<(LambdaEstimate, Option<DMatrix<f64>>), crate::estimation::lambda::LambdaError> {
+) -> Result<(LambdaEstimate, Option<DMatrix<f64>>), LambdaError> {
     let mut est = identify(exps, settings)?;
     let mut jc = None;
     for pass in 0..PASSES {
         progress
             .update(pass as f64 / PASSES as f64, "C(ν) from M at the grid speed")
-            .map_err(|Cancelled| crate::estimation::lambda::LambdaError::Cancelled)?;
+            .map_err(|Cancelled| LambdaError::Cancelled)?;
         let vehicle = match &settings.inertia_offset {
             Some(s) if s.shape() == est.m.shape() => &est.m + s,
             _ => est.m.clone(),
@@ -134,48 +136,74 @@ pub(crate) fn identify_with_coriolis(
 }
 
 /// Every grid point's sub-model ([`identify_with_coriolis`] when
-/// `coriolis`, else the plain fit), progress spread over the points.
+/// `coriolis`, else the plain fit). The points are independent: they are
+/// fitted side by side on the pool, as many at a time as it has threads,
+/// and progress (and a cancel) is taken between those rounds. The first
+/// error by point is returned, as in order.
 pub(crate) fn fit_points(
     points: &[(f64, Vec<Experiment>)],
     settings: &LambdaSettings,
     coriolis: bool,
     progress: &mut dyn Progress,
     notes: &mut Vec<String>,
-) -> Result<Vec<(f64, LambdaEstimate)>, crate::estimation::lambda::LambdaError> {
+) -> Result<Vec<(f64, LambdaEstimate)>, LambdaError> {
+    use rayon::prelude::*;
     let count = points.len().max(1);
+    let width = rayon::current_num_threads().max(1);
     let mut out = Vec::with_capacity(points.len());
-    for (g, (u0, exps)) in points.iter().enumerate() {
-        let mut sub = crate::estimation::SubProgress::new(
-            progress,
-            g as f64 / count as f64,
-            (g + 1) as f64 / count as f64,
-        );
-        sub.update(0.0, &format!("grid point {:.2} m/s", u0))
-            .map_err(|Cancelled| crate::estimation::lambda::LambdaError::Cancelled)?;
-        let fit = |s: &LambdaSettings, sub: &mut dyn Progress| {
-            if coriolis {
-                identify_with_coriolis(exps, s, *u0, sub).map(|r| r.0)
-            } else {
-                identify(exps, s)
-            }
-        };
-        let est = match fit(settings, &mut sub) {
-            // A mode faster than the sample rate leaves Φ with a negative
-            // eigenvalue, which has no continuous-time logarithm: the
-            // thesis's map (eq. 2.14–2.15) still gives a model.
-            Err(e) if e.field() == "a_lambda" && settings.inversion == Inversion::Exact => {
-                let mut thesis = settings.clone();
-                thesis.inversion = Inversion::Thesis;
-                notes.push(format!(
-                    "at {u0:.2} m/s the exact sampled-data map failed ({e}); the thesis's map A = (A_λ − I)/T was used"
-                ));
-                fit(&thesis, &mut sub)?
-            }
-            r => r?,
-        };
-        out.push((*u0, est));
+    for round in points.chunks(width) {
+        let done = out.len();
+        progress
+            .update(
+                done as f64 / count as f64,
+                &format!("grid point {:.2} m/s", round[0].0),
+            )
+            .map_err(|Cancelled| LambdaError::Cancelled)?;
+        let fitted: Vec<_> = round
+            .par_iter()
+            .map(|(u0, exps)| fit_point(*u0, exps, settings, coriolis))
+            .collect();
+        for ((u0, _), r) in round.iter().zip(fitted) {
+            let (est, note) = r?;
+            notes.extend(note);
+            out.push((*u0, est));
+        }
     }
+    progress
+        .update(1.0, "grid points fitted")
+        .map_err(|Cancelled| LambdaError::Cancelled)?;
     Ok(out)
+}
+
+/// One grid point's fit, with a note when the exact sampled-data map had
+/// to give way to the thesis's.
+fn fit_point(
+    u0: f64,
+    exps: &[Experiment],
+    settings: &LambdaSettings,
+    coriolis: bool,
+) -> Result<(LambdaEstimate, Option<String>), LambdaError> {
+    let fit = |s: &LambdaSettings| {
+        if coriolis {
+            identify_with_coriolis(exps, s, u0, &mut NoProgress).map(|r| r.0)
+        } else {
+            identify(exps, s)
+        }
+    };
+    match fit(settings) {
+        // A mode faster than the sample rate leaves Φ with a negative
+        // eigenvalue, which has no continuous-time logarithm: the
+        // thesis's map (eq. 2.14–2.15) still gives a model.
+        Err(e) if e.field() == "a_lambda" && settings.inversion == Inversion::Exact => {
+            let mut thesis = settings.clone();
+            thesis.inversion = Inversion::Thesis;
+            let note = format!(
+                "at {u0:.2} m/s the exact sampled-data map failed ({e}); the thesis's map A = (A_λ − I)/T was used"
+            );
+            Ok((fit(&thesis)?, Some(note)))
+        }
+        r => Ok((r?, None)),
+    }
 }
 
 /// One M for the vehicle from the grid points' `m` with their σ `std`:
