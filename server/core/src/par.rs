@@ -1,6 +1,7 @@
 //! Two-way fork–join for the heavy stages of the quality report (the
 //! service's machines have two cores, and a report is one request), and
-//! [`fan_out`] for independent pieces of a job (discovery's grid speeds).
+//! [`fan_out`] for independent pieces of a job (discovery's grid speeds),
+//! [`beside`] for a job's part that can run while the caller works.
 //!
 //! Callers split their work at points fixed by the input alone (never by
 //! timing or by the pool's size), so a result is the same whether the
@@ -124,6 +125,41 @@ where
         .collect()
 }
 
+/// `(main(progress), side(relay))`: `main` on the calling thread, `side`
+/// meanwhile as a task on rayon's pool. The side reports nothing; its
+/// `relay` asks it to stop once `progress` has asked `main` to. Returns
+/// when both are done (a panic in either reaches the caller).
+pub(crate) fn beside<A, B: Send>(
+    progress: &mut dyn Progress,
+    main: impl FnOnce(&mut dyn Progress) -> A,
+    side: impl FnOnce(&mut dyn Progress) -> B + Send,
+) -> (A, B) {
+    let cancel = AtomicBool::new(false);
+    let mut out = None;
+    let a = rayon::in_place_scope(|s| {
+        let (cancel, slot) = (&cancel, &mut out);
+        s.spawn(move |_| {
+            let mut relay = |_: f64, _: &str| {
+                if cancel.load(Ordering::Relaxed) {
+                    Err(Cancelled)
+                } else {
+                    Ok(())
+                }
+            };
+            *slot = Some(side(&mut relay));
+        });
+        let mut watch = |f: f64, stage: &str| {
+            let r = progress.update(f, stage);
+            if r.is_err() {
+                cancel.store(true, Ordering::Relaxed);
+            }
+            r
+        };
+        main(&mut watch)
+    });
+    (a, out.expect("the scope waits for its task"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -197,6 +233,31 @@ mod tests {
             panic!("not stopped");
         });
         assert_eq!(r.unwrap_err(), Cancelled);
+    }
+
+    /// Both results; the side stops when the caller's progress stops the
+    /// main part.
+    #[test]
+    fn beside_runs_both_and_passes_a_cancellation_on() {
+        let mut sink = |_: f64, _: &str| Ok(());
+        let (a, b) = beside(&mut sink, |p| p.update(0.5, "x").map(|_| 2), |_| 3);
+        assert_eq!((a, b), (Ok(2), 3));
+
+        let mut stop = |_: f64, _: &str| Err(Cancelled);
+        let (a, b) = beside(
+            &mut stop,
+            |p| p.update(0.5, "x"),
+            |p| {
+                for _ in 0..5000 {
+                    if p.update(0.0, "side").is_err() {
+                        return Err(Cancelled);
+                    }
+                    std::thread::sleep(std::time::Duration::from_millis(1));
+                }
+                Ok(())
+            },
+        );
+        assert_eq!((a, b), (Err(Cancelled), Err(Cancelled)));
     }
 
     #[test]

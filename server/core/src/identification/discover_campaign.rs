@@ -459,8 +459,8 @@ pub fn discover_campaign(
     };
     let again = current_again::applies(doc, settings, &effects, &carried);
     let gate_to = if again { 0.96 } else { 0.99 };
-    let (mut augmented, mut overall, before) = if effects.is_empty() {
-        (None, None, None)
+    let (mut augmented, mut overall, before, again_found) = if effects.is_empty() {
+        (None, None, None, None)
     } else {
         // The start model through the same validation, on the same runs.
         let before = asm.validate(doc)?;
@@ -468,14 +468,14 @@ pub fn discover_campaign(
             .iter()
             .map(|&i| Ok((augmented_at(doc, &lpv.points[i])?, &est[i].0[..])))
             .collect::<Result<Vec<_>, IdentifyError>>()?;
-        let gate = keep_better(
-            &asm,
-            (&starts, &dset),
-            &effects,
-            &before,
+        // The re-identification with the current reads nothing the gate
+        // decides: it runs beside it.
+        let (gate, again_found) = crate::par::beside(
             progress,
-            (0.9, gate_to),
-        )?;
+            |p| keep_better(&asm, (&starts, &dset), &effects, &before, p, (0.9, gate_to)),
+            |p| again.then(|| current_again::identify_again(&asm, profile, &grid, &before, p)),
+        );
+        let gate = gate?;
         credit::set_advantages(&asm, &mut effects, &gate.alone, assembled.is_some());
         shared_notes.extend(credit::refit_note(&gate.refits));
         for ((e, v), u) in effects
@@ -508,12 +508,21 @@ pub fn discover_campaign(
         // runs, then (stable) by how many speeds chose them and their
         // gains there.
         effects.sort_by(|a, b| b.held_out_advantage.total_cmp(&a.held_out_advantage));
-        (gate.model, Some(gate.overall.text()), Some(before))
+        (
+            gate.model,
+            Some(gate.overall.text()),
+            Some(before),
+            again_found,
+        )
     };
     // A force fixed in NED on a surface model without a current: the
     // current, estimated with the damping, is tested against it.
-    if let (true, Some(before)) = (again, &before) {
-        match current_again::identify_again(&asm, profile, &grid, before, progress, (0.96, 0.975))? {
+    if let (Some(found), Some(before)) = (again_found, &before) {
+        progress.update(
+            0.975,
+            "identified the campaign again with the NED current estimated",
+        )?;
+        match found? {
             Ok(a) => {
                 let continued =
                     current_again::continue_discovery(&asm, profile, &a, augmented.as_ref(), progress)?;

@@ -61,19 +61,18 @@ pub(super) struct Again {
 }
 
 /// Identifies the campaign's runs again with the NED current estimated
-/// (between progress `from` and `to`). `Ok(Err(why))` when it gave no
-/// current model (no heading logged, an identification error): discovery
-/// then goes on without it.
+/// (progress 0–1). `Ok(Err(why))` when it gave no current model (no
+/// heading logged, an identification error): discovery then goes on
+/// without it.
 pub(super) fn identify_again(
     asm: &Assembly<'_>,
     profile: &VesselProfile,
     grid: &[f64],
     before: &[RunValidation],
     progress: &mut dyn Progress,
-    (from, to): (f64, f64),
 ) -> Result<Result<Again, String>, IdentifyError> {
     progress.update(
-        from,
+        0.0,
         "identifying the campaign again with the NED current estimated",
     )?;
     let mut s = asm.settings.identification.clone().unwrap_or_default();
@@ -85,8 +84,7 @@ pub(super) fn identify_again(
         .filter(|r| asm.est_ids.contains(&r.run_id) || asm.val_ids.contains(&r.run_id))
         .cloned()
         .collect();
-    let mut sub = SubProgress::new(progress, from, to - from);
-    let model = match identify_lambda_campaign(profile, grid, asm.forces, &runs, &s, &mut sub) {
+    let model = match identify_lambda_campaign(profile, grid, asm.forces, &runs, &s, progress) {
         Ok(m) => m,
         Err(IdentifyError::Cancelled) => return Err(IdentifyError::Cancelled),
         Err(e) => return Ok(Err(e.to_string())),
